@@ -1,0 +1,62 @@
+// shapematch: consistent, orientation-preserving 3D shape matching (Windheuser et al. 2011).
+#include "commands.hpp"
+#include "shapematch/errors.hpp"
+
+#include <spdlog/sinks/stdout_color_sinks.h>
+#include <spdlog/spdlog.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <iostream>
+#include <map>
+#include <new>
+
+namespace shapematch::app {
+
+std::string default_mesh_x() { return std::string(SHAPEMATCH_ASSETS_DIR) + "/finger_straight.off"; }
+std::string default_mesh_y() { return std::string(SHAPEMATCH_ASSETS_DIR) + "/finger_bent.off"; }
+
+}  // namespace shapematch::app
+
+int main(int argc, char** argv) {
+  using namespace shapematch;
+  // Logs go to stderr so that stdout carries only the machine-readable result.
+  spdlog::set_default_logger(spdlog::stderr_color_mt("shapematch"));
+  spdlog::set_pattern("[%H:%M:%S.%e] %^%l%$ %v");
+
+  CLI::App cli{"shapematch: consistent, orientation-preserving 3D shape matching"};
+  cli.set_version_flag("--version", std::string(SHAPEMATCH_VERSION));
+  cli.require_subcommand(1);
+  bool verbose = false;
+  cli.add_flag("-v,--verbose", verbose, "debug logging");
+
+  std::map<CLI::App*, app::Action> actions;
+  auto add = [&](app::Action (*make)(CLI::App&), const char* name, const char* help) {
+    CLI::App* sub = cli.add_subcommand(name, help);
+    actions[sub] = make(*sub);
+  };
+  add(app::add_lp_command, "lp", "build the single-level matching LP and solve its relaxation");
+  add(app::add_devices_command, "devices", "list Vulkan compute devices");
+  add(app::add_generate_assets_command, "generate-assets", "regenerate the bundled demo meshes");
+
+  try {
+    cli.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return cli.exit(e);
+  }
+  spdlog::set_level(verbose ? spdlog::level::debug : spdlog::level::info);
+  try {
+    for (auto& [sub, action] : actions)
+      if (sub->parsed()) return action();
+  } catch (const shapematch::Error& e) {
+    std::cerr << "shapematch: error: " << e.what() << "\n";
+    return 1;
+  } catch (const std::bad_alloc&) {
+    std::cerr << "shapematch: error: out of memory\n";
+    return 1;
+  } catch (const std::exception& e) {
+    std::cerr << "shapematch: internal error: " << e.what() << "\n";
+    return 2;
+  }
+  return 1;
+}

@@ -1,0 +1,50 @@
+#pragma once
+// The thin-shell matching energy of DESIGN.md §5, in double precision.
+#include "shapematch/geometry.hpp"
+#include "shapematch/product_space.hpp"
+
+namespace shapematch {
+
+struct EnergyOptions {
+  double lame_lambda = 1.0;   // Lamé λ of the membrane (St. Venant–Kirchhoff)
+  double lame_mu = 1.0;       // Lamé μ
+  double bending_weight = 1.0;
+  double feature_weight = 0.0;
+};
+
+using Triangle3 = std::array<Eigen::Vector3d, 3>;
+
+// W(s→t) = A_s((λ/2)(tr E)² + μ tr(E²)), E = (G_s⁻¹G_t − I)/2: the membrane energy of mapping the
+// source triangle onto the target, vertices matched in order. 0 if the source is degenerate.
+double membrane_energy(const Triangle3& source, const Triangle3& target, double lambda, double mu);
+// The same quantity in Delingette's biquadratic spring form (an independent formula for tests).
+double membrane_energy_springs(const Triangle3& source, const Triangle3& target, double lambda, double mu);
+
+// Energy of product triangles for a fixed pair of shapes. Per-vertex descriptors are optional.
+class EnergyModel {
+public:
+  EnergyModel(const Mesh& x, const Geometry& gx, const Mesh& y, const Geometry& gy,
+              EnergyOptions options = {});
+  // Per-vertex descriptors (rows = vertices) for the feature term; empty disables it.
+  void set_features(Eigen::MatrixXd fx, Eigen::MatrixXd fy);
+
+  double membrane(const ProductTriangle& t) const;
+  double bending(const ProductTriangle& t) const;
+  double feature(const ProductTriangle& t) const;
+  double operator()(const ProductTriangle& t) const;
+
+  const EnergyOptions& options() const { return options_; }
+
+private:
+  const Mesh& x_;
+  const Geometry& gx_;
+  const Mesh& y_;
+  const Geometry& gy_;
+  EnergyOptions options_;
+  Eigen::MatrixXd fx_, fy_;
+};
+
+// c_j = energy of every variable of the space (multi-threaded).
+std::vector<double> energy_vector(const ProductSpace& space, const EnergyModel& model);
+
+}  // namespace shapematch

@@ -1,0 +1,38 @@
+#pragma once
+// The exception hierarchy of shapematch. Every error that reaches the command line is one of
+// these; what() is a single line that names the file (if any) and the problem.
+#include <stdexcept>
+#include <string>
+
+namespace shapematch {
+
+class Error : public std::runtime_error {
+public:
+  using std::runtime_error::runtime_error;
+};
+
+// Input that violates a documented precondition (bad mesh, bad option value, bad file content).
+class InvalidInputError : public Error {
+public:
+  using Error::Error;
+};
+
+// A file could not be opened, read or written.
+class IoError : public Error {
+public:
+  using Error::Error;
+};
+
+// A solver failed as a program (not as an LP: infeasibility is a status, not an exception).
+class SolverError : public Error {
+public:
+  using Error::Error;
+};
+
+// No usable Vulkan device, out of device memory, a failed Vulkan call.
+class DeviceError : public Error {
+public:
+  using Error::Error;
+};
+
+}  // namespace shapematch

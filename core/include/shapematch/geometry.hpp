@@ -1,0 +1,20 @@
+#pragma once
+// Per-vertex and per-face differential geometry (Meyer et al. 2002).
+#include "shapematch/mesh.hpp"
+
+#include <Eigen/Sparse>
+
+namespace shapematch {
+
+struct Geometry {
+  std::vector<double> face_area;                   // |F|
+  std::vector<std::array<double, 3>> corner_area;  // |F|: mixed Voronoi area of corner i inside face f
+  std::vector<double> vertex_area;                 // |V|: sum of the corner areas (mixed Voronoi area)
+  std::vector<Eigen::Vector3d> vertex_normal;      // |V|: area-weighted, unit length
+  std::vector<double> mean_curvature;              // |V|: signed, H = 1/r on a sphere of radius r
+  Eigen::SparseMatrix<double> cotan_laplacian;     // |V|x|V| positive semi-definite: L_ij = -(cot a + cot b)/2
+};
+
+Geometry compute_geometry(const Mesh& mesh);
+
+}  // namespace shapematch

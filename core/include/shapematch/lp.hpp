@@ -1,0 +1,89 @@
+#pragma once
+// Linear programs of the form  min cᵀx  s.t.  A x = b,  0 ≤ x ≤ 1,  A with entries ±1,
+// and the solver interface (HiGHS/cuPDLPx style: problem + parameters in, result out, with a
+// termination status that is separate from whether the call itself worked).
+#include "shapematch/sparse.hpp"
+
+#include <limits>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace shapematch {
+
+struct LpProblem {
+  SignedCsr a;                  // m x n, entries ±1
+  SignedCsr at;                 // n x m, the transpose (kept explicitly for gather-only SpMV)
+  std::vector<double> b;        // m
+  std::vector<double> c;        // n, already scaled for conditioning
+  double objective_scale = 1.0; // reported objective = objective_scale * cᵀx
+
+  int64_t rows() const { return a.rows; }
+  int64_t cols() const { return a.cols; }
+  int64_t nonzeros() const { return static_cast<int64_t>(a.entry.size()); }
+  // Throws InvalidInputError if the sizes disagree or a value is not finite.
+  void check() const;
+};
+
+enum class LpStatus {
+  Optimal,         // converged to the requested tolerance (exact for simplex)
+  Infeasible,      // certified primal infeasible
+  IterationLimit,
+  TimeLimit,
+  NumericalTrouble,
+};
+const char* to_string(LpStatus status);
+
+struct SolverParams {
+  double tolerance = 1e-4;        // relative primal residual and gap (first-order methods)
+  int64_t max_iterations = 1'000'000;
+  double time_limit = std::numeric_limits<double>::infinity();  // seconds
+  int threads = 0;                // 0 = all hardware threads
+  int device = -1;                // Vulkan device index, -1 = preferred
+  bool verbose = false;
+  // Warm start (first-order methods): both empty or of the right sizes.
+  std::vector<double> initial_x;
+  std::vector<double> initial_y;
+};
+
+struct LpResult {
+  LpStatus status = LpStatus::NumericalTrouble;
+  double objective = std::numeric_limits<double>::quiet_NaN();    // objective_scale * cᵀx
+  double lower_bound = -std::numeric_limits<double>::infinity();  // certified, see certified_lower_bound
+  double primal_residual = std::numeric_limits<double>::quiet_NaN();  // ‖Ax−b‖₂ / (1 + ‖b‖₂)
+  double dual_residual = std::numeric_limits<double>::quiet_NaN();    // relative
+  double gap = std::numeric_limits<double>::quiet_NaN();  // |objective − bound| / (1 + |objective| + |bound|)
+  std::vector<double> x;
+  std::vector<double> y;
+  int64_t iterations = 0;
+  double seconds = 0.0;
+  std::string solver;
+  std::string device;
+};
+
+class LpSolver {
+public:
+  virtual ~LpSolver() = default;
+  virtual std::string name() const = 0;
+  // Throws SolverError/DeviceError when the call itself fails; LP outcomes are statuses.
+  virtual LpResult solve(const LpProblem& problem, const SolverParams& params) = 0;
+};
+
+// "clp-dual", "clp-barrier" (and later "pdhg-cpu", "pdhg-vulkan"). Throws InvalidInputError
+// for an unknown name.
+std::unique_ptr<LpSolver> make_solver(const std::string& name);
+std::vector<std::string> solver_names();
+
+// One-off convenience.
+LpResult solve_lp(const LpProblem& problem, const std::string& solver, const SolverParams& params = {});
+
+// L(y) = bᵀy + Σ_j min(0, (c − Aᵀy)_j) in the problem's reported units (times objective_scale):
+// a lower bound on the LP optimum for ANY y because 0 ≤ x ≤ 1. Evaluated in double precision.
+double certified_lower_bound(const LpProblem& problem, const std::vector<double>& y);
+// Fills residual and gap fields of `result` from its x and y, in double precision.
+void evaluate_solution(const LpProblem& problem, LpResult& result);
+
+// Writes the LP in free MPS format (through a temporary file renamed into place).
+void write_mps(const LpProblem& problem, const std::string& path);
+
+}  // namespace shapematch

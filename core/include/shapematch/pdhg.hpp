@@ -1,0 +1,34 @@
+#pragma once
+// Restarted Halpern PDHG with reflection (the cuPDLPx family) for
+//   min cᵀx  s.t.  A x = b,  0 ≤ x ≤ 1,  A with entries ±1,
+// one algorithm on two backends: native multi-threaded C++ and Vulkan compute shaders.
+#include "shapematch/lp.hpp"
+
+namespace shapematch {
+
+struct PdhgOptions {
+  int ruiz_iterations = 10;        // Ruiz equilibration passes before Pock–Chambolle scaling
+  int power_iterations = 40;       // for the estimate of ‖Ã‖₂ that sets the step
+  double step_safety = 0.998;      // η = step_safety / ‖Ã‖₂
+  double reflection = 1.0;         // γ in z⁺ = (k+1)/(k+2)((1+γ)T(z) − γz) + z⁰/(k+2)
+  int check_interval = 64;         // iterations between termination/restart checks
+  double restart_sufficient = 0.2; // restart when the fixed-point residual fell below this × its value at the last restart
+  double restart_necessary = 0.8;  // … or below this and stopped falling
+  double restart_artificial = 0.36;// … or when this fraction of all iterations passed since the last restart
+  double primal_weight_smoothing = 0.5;
+};
+
+enum class PdhgBackendKind { Cpu, Vulkan };
+
+class PdhgSolver final : public LpSolver {
+public:
+  explicit PdhgSolver(PdhgBackendKind backend, PdhgOptions options = {}) : backend_(backend), options_(options) {}
+  std::string name() const override { return backend_ == PdhgBackendKind::Cpu ? "pdhg-cpu" : "pdhg-vulkan"; }
+  LpResult solve(const LpProblem& problem, const SolverParams& params) override;
+
+private:
+  PdhgBackendKind backend_;
+  PdhgOptions options_;
+};
+
+}  // namespace shapematch

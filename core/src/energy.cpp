@@ -1,0 +1,117 @@
+#include "shapematch/energy.hpp"
+
+#include "parallel.hpp"
+
+#include <Eigen/Dense>
+#include <cmath>
+
+namespace shapematch {
+namespace {
+
+Eigen::Matrix2d gram(const Triangle3& t) {
+  const Eigen::Vector3d e1 = t[1] - t[0], e2 = t[2] - t[0];
+  Eigen::Matrix2d g;
+  g << e1.dot(e1), e1.dot(e2), e1.dot(e2), e2.dot(e2);
+  return g;
+}
+
+double area(const Triangle3& t) { return 0.5 * (t[1] - t[0]).cross(t[2] - t[0]).norm(); }
+
+// A triangle whose area is below this fraction of its squared longest edge counts as degenerate
+// (then it has no metric to be a source of strain).
+constexpr double kDegenerate = 1e-14;
+
+bool degenerate(const Triangle3& t) {
+  const double l2 = std::max({(t[1] - t[0]).squaredNorm(), (t[2] - t[1]).squaredNorm(), (t[0] - t[2]).squaredNorm()});
+  return !(area(t) > kDegenerate * l2);
+}
+
+int corner_of(const std::array<int, 3>& face, int v) {
+  for (int k = 0; k < 3; ++k)
+    if (face[k] == v) return k;
+  return -1;
+}
+
+
+}  // namespace
+
+double membrane_energy(const Triangle3& s, const Triangle3& t, double lambda, double mu) {
+  if (degenerate(s)) return 0.0;
+  const Eigen::Matrix2d e = 0.5 * (gram(s).inverse() * gram(t) - Eigen::Matrix2d::Identity());
+  const double tr = e.trace();
+  return area(s) * (0.5 * lambda * tr * tr + mu * (e * e).trace());
+}
+
+double membrane_energy_springs(const Triangle3& s, const Triangle3& t, double lambda, double mu) {
+  if (degenerate(s)) return 0.0;
+  const double a = area(s);
+  std::array<double, 3> cot{}, delta{};
+  for (int i = 0; i < 3; ++i) {
+    const int j = (i + 1) % 3, k = (i + 2) % 3;
+    const Eigen::Vector3d u = s[j] - s[i], v = s[k] - s[i];
+    cot[i] = u.dot(v) / u.cross(v).norm();
+    delta[i] = (t[k] - t[j]).squaredNorm() - (s[k] - s[j]).squaredNorm();  // edge opposite vertex i
+  }
+  double w = 0.0;
+  for (int i = 0; i < 3; ++i) w += (cot[i] * cot[i] * (lambda + 2 * mu) + mu) / (32 * a) * delta[i] * delta[i];
+  for (int i = 0; i < 3; ++i)
+    for (int j = i + 1; j < 3; ++j)
+      w += (cot[i] * cot[j] * (lambda + 2 * mu) - mu) / (16 * a) * delta[i] * delta[j];
+  return w;
+}
+
+EnergyModel::EnergyModel(const Mesh& x, const Geometry& gx, const Mesh& y, const Geometry& gy, EnergyOptions options)
+    : x_(x), gx_(gx), y_(y), gy_(gy), options_(options) {}
+
+void EnergyModel::set_features(Eigen::MatrixXd fx, Eigen::MatrixXd fy) {
+  fx_ = std::move(fx);
+  fy_ = std::move(fy);
+}
+
+double EnergyModel::membrane(const ProductTriangle& p) const {
+  const Triangle3 s{x_.vertices[p.a[0]], x_.vertices[p.a[1]], x_.vertices[p.a[2]]};
+  const Triangle3 t{y_.vertices[p.b[0]], y_.vertices[p.b[1]], y_.vertices[p.b[2]]};
+  const double l = options_.lame_lambda, m = options_.lame_mu;
+  // Symmetrised (DESIGN.md §5): a degenerate side has no area, so the other direction counts twice.
+  if (p.fa >= 0 && p.fb >= 0) return membrane_energy(s, t, l, m) + membrane_energy(t, s, l, m);
+  if (p.fa >= 0) return 2.0 * membrane_energy(s, t, l, m);
+  return 2.0 * membrane_energy(t, s, l, m);
+}
+
+double EnergyModel::bending(const ProductTriangle& p) const {
+  double e = 0.0;
+  for (int i = 0; i < 3; ++i) {
+    // A vertex repeated in a degenerate tuple is counted once per corner, with zero area on that side.
+    const double ax = p.fa >= 0 ? gx_.corner_area[p.fa][corner_of(x_.faces[p.fa], p.a[i])] : 0.0;
+    const double ay = p.fb >= 0 ? gy_.corner_area[p.fb][corner_of(y_.faces[p.fb], p.b[i])] : 0.0;
+    const double dh = gx_.mean_curvature[p.a[i]] - gy_.mean_curvature[p.b[i]];
+    e += (ax + ay) * dh * dh;
+  }
+  return e;
+}
+
+double EnergyModel::feature(const ProductTriangle& p) const {
+  if (fx_.size() == 0) return 0.0;
+  double e = 0.0;
+  for (int i = 0; i < 3; ++i) {
+    const double ax = p.fa >= 0 ? gx_.corner_area[p.fa][corner_of(x_.faces[p.fa], p.a[i])] : 0.0;
+    const double ay = p.fb >= 0 ? gy_.corner_area[p.fb][corner_of(y_.faces[p.fb], p.b[i])] : 0.0;
+    e += (ax + ay) * (fx_.row(p.a[i]) - fy_.row(p.b[i])).squaredNorm();
+  }
+  return e;
+}
+
+double EnergyModel::operator()(const ProductTriangle& p) const {
+  double e = membrane(p);
+  if (options_.bending_weight != 0.0) e += options_.bending_weight * bending(p);
+  if (options_.feature_weight != 0.0) e += options_.feature_weight * feature(p);
+  return e;
+}
+
+std::vector<double> energy_vector(const ProductSpace& space, const EnergyModel& model) {
+  std::vector<double> c(space.size());
+  detail::parallel_for(space.size(), 0, [&](int64_t j) { c[j] = model(space[j]); });
+  return c;
+}
+
+}  // namespace shapematch

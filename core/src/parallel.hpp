@@ -1,0 +1,43 @@
+#pragma once
+// A minimal static-partition parallel loop over index ranges (the hot loops of assembly and the
+// native PDHG kernels are uniform, so static chunks balance well and need no scheduler).
+#include <algorithm>
+#include <cstdint>
+#include <thread>
+#include <vector>
+
+namespace shapematch::detail {
+
+inline int hardware_threads() {
+  const unsigned n = std::thread::hardware_concurrency();
+  return n == 0 ? 1 : static_cast<int>(n);
+}
+
+// Calls body(begin, end, chunk) for `threads` contiguous chunks of [0, n).
+template <class Body>
+void parallel_chunks(int64_t n, int threads, Body&& body) {
+  if (threads <= 0) threads = hardware_threads();
+  threads = static_cast<int>(std::max<int64_t>(1, std::min<int64_t>(threads, n / 4096 + 1)));
+  if (threads == 1) {
+    body(int64_t{0}, n, 0);
+    return;
+  }
+  std::vector<std::thread> pool;
+  pool.reserve(threads - 1);
+  const int64_t step = (n + threads - 1) / threads;
+  for (int t = 1; t < threads; ++t) {
+    const int64_t b = std::min(n, t * step), e = std::min(n, (t + 1) * step);
+    pool.emplace_back([&body, b, e, t] { body(b, e, t); });
+  }
+  body(int64_t{0}, std::min(n, step), 0);
+  for (auto& th : pool) th.join();
+}
+
+template <class Body>
+void parallel_for(int64_t n, int threads, Body&& body) {
+  parallel_chunks(n, threads, [&](int64_t b, int64_t e, int) {
+    for (int64_t i = b; i < e; ++i) body(i);
+  });
+}
+
+}  // namespace shapematch::detail

@@ -1,0 +1,254 @@
+// The host driver of restarted Halpern PDHG: scaling, step size, restarts, primal weight and
+// termination. The kernels live in a PdhgBackend (native C++ or Vulkan).
+#include "shapematch/pdhg.hpp"
+
+#include "pdhg_backend.hpp"
+#include "shapematch/errors.hpp"
+#include "shapematch/system.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <random>
+
+namespace shapematch {
+namespace {
+
+// Ruiz equilibration then Pock–Chambolle (α = 1) scaling of A, kept as two diagonal vectors.
+void compute_scaling(const LpProblem& p, int ruiz_iterations, std::vector<double>& r, std::vector<double>& d) {
+  const int64_t m = p.rows(), n = p.cols();
+  r.assign(m, 1.0);
+  d.assign(n, 1.0);
+  std::vector<double> row(m), col(n);
+  for (int it = 0; it < ruiz_iterations; ++it) {
+    // |Ã_ij| = r_i d_j: infinity norms of rows and columns.
+    for (int64_t i = 0; i < m; ++i) {
+      double mx = 0.0;
+      for (uint32_t k = p.a.row_ptr[i]; k < p.a.row_ptr[i + 1]; ++k) mx = std::max(mx, d[col_of(p.a.entry[k])]);
+      row[i] = r[i] * mx;
+    }
+    for (int64_t j = 0; j < n; ++j) {
+      double mx = 0.0;
+      for (uint32_t k = p.at.row_ptr[j]; k < p.at.row_ptr[j + 1]; ++k) mx = std::max(mx, r[col_of(p.at.entry[k])]);
+      col[j] = d[j] * mx;
+    }
+    for (int64_t i = 0; i < m; ++i)
+      if (row[i] > 0) r[i] /= std::sqrt(row[i]);
+    for (int64_t j = 0; j < n; ++j)
+      if (col[j] > 0) d[j] /= std::sqrt(col[j]);
+  }
+  for (int64_t i = 0; i < m; ++i) {
+    double s = 0.0;
+    for (uint32_t k = p.a.row_ptr[i]; k < p.a.row_ptr[i + 1]; ++k) s += d[col_of(p.a.entry[k])];
+    row[i] = r[i] * s;
+  }
+  for (int64_t j = 0; j < n; ++j) {
+    double s = 0.0;
+    for (uint32_t k = p.at.row_ptr[j]; k < p.at.row_ptr[j + 1]; ++k) s += r[col_of(p.at.entry[k])];
+    col[j] = d[j] * s;
+  }
+  for (int64_t i = 0; i < m; ++i)
+    if (row[i] > 0) r[i] /= std::sqrt(row[i]);
+  for (int64_t j = 0; j < n; ++j)
+    if (col[j] > 0) d[j] /= std::sqrt(col[j]);
+}
+
+// ‖D_r A D_c‖₂ by power iteration on ÃᵀÃ (a slight overestimate is safe; the step has a margin).
+double estimate_norm(const LpProblem& p, const std::vector<double>& r, const std::vector<double>& d, int iterations) {
+  const int64_t m = p.rows(), n = p.cols();
+  std::vector<double> v(n), u(m), w(n);
+  std::mt19937 rng(12345);
+  std::uniform_real_distribution<double> uni(0.5, 1.5);
+  for (auto& x : v) x = uni(rng);
+  double lambda = 0.0;
+  for (int it = 0; it < iterations; ++it) {
+    const double nv = std::sqrt(std::inner_product(v.begin(), v.end(), v.begin(), 0.0));
+    if (nv == 0.0) return 1.0;
+    for (auto& x : v) x /= nv;
+    for (int64_t i = 0; i < m; ++i) {
+      double s = 0.0;
+      for (uint32_t k = p.a.row_ptr[i]; k < p.a.row_ptr[i + 1]; ++k) {
+        const uint32_t e = p.a.entry[k];
+        s += (is_negative(e) ? -1.0 : 1.0) * d[col_of(e)] * v[col_of(e)];
+      }
+      u[i] = r[i] * s;
+    }
+    for (int64_t j = 0; j < n; ++j) {
+      double s = 0.0;
+      for (uint32_t k = p.at.row_ptr[j]; k < p.at.row_ptr[j + 1]; ++k) {
+        const uint32_t e = p.at.entry[k];
+        s += (is_negative(e) ? -1.0 : 1.0) * r[col_of(e)] * u[col_of(e)];
+      }
+      w[j] = d[j] * s;
+    }
+    lambda = std::sqrt(std::inner_product(w.begin(), w.end(), w.begin(), 0.0));  // ≈ σ_max² as v converges
+    v.swap(w);
+  }
+  return std::sqrt(lambda);
+}
+
+// A row whose achievable range over the box excludes b_i proves infeasibility at once
+// (e.g. a face of X left with no product triangle after fixing).
+bool row_bounds_infeasible(const LpProblem& p) {
+  for (int64_t i = 0; i < p.rows(); ++i) {
+    double lo = 0.0, hi = 0.0;
+    for (uint32_t k = p.a.row_ptr[i]; k < p.a.row_ptr[i + 1]; ++k) (is_negative(p.a.entry[k]) ? lo : hi) += 1.0;
+    if (p.b[i] > hi + 1e-9 || p.b[i] < -lo - 1e-9) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+LpResult PdhgSolver::solve(const LpProblem& problem, const SolverParams& params) {
+  problem.check();
+  Stopwatch clock;
+  const int64_t m = problem.rows(), n = problem.cols();
+  LpResult result;
+  result.solver = name();
+
+  if (row_bounds_infeasible(problem)) {
+    result.status = LpStatus::Infeasible;
+    result.device = "presolve";
+    result.seconds = clock.seconds();
+    return result;
+  }
+  if (!params.initial_x.empty() && params.initial_x.size() != size_t(n))
+    throw InvalidInputError("warm start x has " + std::to_string(params.initial_x.size()) + " entries, expected " + std::to_string(n));
+  if (!params.initial_y.empty() && params.initial_y.size() != size_t(m))
+    throw InvalidInputError("warm start y has " + std::to_string(params.initial_y.size()) + " entries, expected " + std::to_string(m));
+
+  std::vector<double> r, d;
+  compute_scaling(problem, options_.ruiz_iterations, r, d);
+  const double norm = estimate_norm(problem, r, d, options_.power_iterations);
+  const double eta = options_.step_safety / norm;
+
+  detail::ScaledLp lp;
+  lp.a = &problem.a;
+  lp.at = &problem.at;
+  lp.c.resize(n);
+  lp.col_scale.resize(n);
+  lp.b.resize(m);
+  lp.row_scale.resize(m);
+  double cnorm = 0.0, bnorm = 0.0, bnorm_orig = 0.0, positive_c = 0.0;
+  for (int64_t j = 0; j < n; ++j) {
+    lp.c[j] = d[j] * problem.c[j];
+    lp.col_scale[j] = d[j];
+    cnorm += double(lp.c[j]) * lp.c[j];
+    positive_c += std::max(0.0, problem.c[j]);
+  }
+  for (int64_t i = 0; i < m; ++i) {
+    lp.b[i] = r[i] * problem.b[i];
+    lp.row_scale[i] = r[i];
+    bnorm += double(lp.b[i]) * lp.b[i];
+    bnorm_orig += problem.b[i] * problem.b[i];
+  }
+  cnorm = std::sqrt(cnorm);
+  bnorm = std::sqrt(bnorm);
+  bnorm_orig = std::sqrt(bnorm_orig);
+  double omega = (cnorm > 1e-10 && bnorm > 1e-10) ? cnorm / bnorm : 1.0;
+
+  std::vector<double> x0(n, 0.0), y0(m, 0.0);
+  if (!params.initial_x.empty())
+    for (int64_t j = 0; j < n; ++j) x0[j] = std::clamp(params.initial_x[j], 0.0, 1.0) / d[j];
+  if (!params.initial_y.empty())
+    for (int64_t i = 0; i < m; ++i) y0[i] = params.initial_y[i] / r[i];
+
+  auto backend = backend_ == PdhgBackendKind::Cpu ? detail::make_cpu_backend(params.threads)
+                                                  : detail::make_vulkan_backend(params.device);
+  result.device = backend->device();
+  backend->load(lp, x0, y0);
+  spdlog::debug("{}: {} x {}, ‖Ã‖ ≈ {:.4g}, step {:.4g}, primal weight {:.4g}, on {}", name(), m, n, norm, eta,
+                omega, result.device);
+
+  int64_t total = 0, k = 0;
+  double restart_base = -1.0, previous = std::numeric_limits<double>::infinity();
+  int restarts = 0;
+  result.status = LpStatus::IterationLimit;
+  while (true) {
+    if (total >= params.max_iterations) {
+      result.status = LpStatus::IterationLimit;
+      break;
+    }
+    if (clock.seconds() >= params.time_limit) {
+      result.status = LpStatus::TimeLimit;
+      break;
+    }
+    const int count = static_cast<int>(std::min<int64_t>(options_.check_interval, params.max_iterations - total));
+    const detail::Step step{eta / omega, eta * omega, options_.reflection};
+    const detail::BatchStats s = backend->iterate(count, k, step);
+    total += count;
+    k += count;
+
+    const double primal = std::sqrt(s.residual2) / (1.0 + bnorm_orig);
+    const double dual_obj = s.by + s.reduced_neg;
+    const double gap = std::abs(s.cx - dual_obj) / (1.0 + std::abs(s.cx) + std::abs(dual_obj));
+    const double fixed_point = std::sqrt(omega * s.dx2 + s.dy2 / omega);
+    if (params.verbose || spdlog::should_log(spdlog::level::debug))
+      spdlog::debug("{:>8} it  primal {:.3e}  gap {:.3e}  obj {:.8g}  bound {:.8g}  fp {:.3e}  ω {:.3g}", total,
+                    primal, gap, s.cx * problem.objective_scale, dual_obj * problem.objective_scale, fixed_point, omega);
+    if (!std::isfinite(fixed_point) || !std::isfinite(dual_obj)) {
+      result.status = LpStatus::NumericalTrouble;
+      break;
+    }
+    if (primal <= params.tolerance && gap <= params.tolerance) {
+      result.status = LpStatus::Optimal;
+      break;
+    }
+    // Any dual point whose bound exceeds the largest objective the box allows proves infeasibility;
+    // confirm in double precision before trusting the fp32 reduction.
+    if (dual_obj > positive_c + 1e-3 * (1.0 + positive_c)) {
+      std::vector<double> xh, yh;
+      backend->read(xh, yh);
+      std::vector<double> y(m);
+      for (int64_t i = 0; i < m; ++i) y[i] = r[i] * yh[i];
+      if (certified_lower_bound(problem, y) > problem.objective_scale * positive_c) {
+        result.status = LpStatus::Infeasible;
+        result.y = std::move(y);
+        break;
+      }
+    }
+
+    // Restarts on the fixed-point residual (cuPDLPx): sufficient decay, necessary decay without
+    // progress, or a long stretch since the last restart.
+    if (restart_base < 0.0) {
+      restart_base = fixed_point;
+    } else if (fixed_point <= options_.restart_sufficient * restart_base ||
+               (fixed_point <= options_.restart_necessary * restart_base && fixed_point > previous) ||
+               k >= options_.restart_artificial * total) {
+      const auto [dx2, dy2] = backend->restart();
+      const double dx = std::sqrt(dx2), dy = std::sqrt(dy2);
+      if (dx > 1e-10 && dy > 1e-10) {
+        const double theta = options_.primal_weight_smoothing;
+        omega = std::exp(theta * std::log(dy / dx) + (1.0 - theta) * std::log(omega));
+      }
+      ++restarts;
+      k = 0;
+      restart_base = fixed_point;
+      previous = std::numeric_limits<double>::infinity();
+      continue;
+    }
+    previous = fixed_point;
+  }
+
+  if (result.status != LpStatus::Infeasible) {
+    std::vector<double> xh, yh;
+    backend->read(xh, yh);
+    result.x.resize(n);
+    result.y.resize(m);
+    for (int64_t j = 0; j < n; ++j) result.x[j] = d[j] * xh[j];
+    for (int64_t i = 0; i < m; ++i) result.y[i] = r[i] * yh[i];
+    evaluate_solution(problem, result);
+  } else {
+    result.lower_bound = certified_lower_bound(problem, result.y);
+  }
+  result.iterations = total;
+  result.seconds = clock.seconds();
+  spdlog::debug("{}: {} after {} iterations and {} restarts ({:.3f} s)", name(), to_string(result.status), total,
+                restarts, result.seconds);
+  return result;
+}
+
+}  // namespace shapematch

@@ -1,0 +1,69 @@
+#version 450
+// PDHG dual step over rows i (core/src/pdhg_backend.hpp): gathers the extrapolated xr through A,
+// then the Halpern update of y and yr = r·y, fused. On the last iteration of a batch it also keeps
+// ŷ, r·ŷ (for the evaluation) and per-workgroup partial sums of (ŷ − y)².
+// Buffers are reached by device address, as in pdhg_primal.comp.
+#extension GL_EXT_buffer_reference : require
+#extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
+layout(local_size_x = 256) in;
+
+layout(buffer_reference, std430, buffer_reference_align = 4) restrict readonly buffer Words { uint v[]; };
+layout(buffer_reference, std430, buffer_reference_align = 4) restrict buffer Floats { float v[]; };
+
+layout(push_constant) uniform Push {
+  Words a_ptr;        // A row offsets (m + 1)
+  uint64_t a_entry;   // A entries: address of uint[nnz]
+  Floats xr, b, r, y, y0, yr, yhat, ys, partial;
+  uint m;
+  float sigma, gamma, w;
+  uint last;
+} pc;
+
+shared float sums[256];
+
+// Sum over the workgroup; every invocation must reach it (it has barriers).
+float workgroup_sum(float value) {
+  const uint i = gl_LocalInvocationIndex;
+  sums[i] = value;
+  barrier();
+  for (uint s = 128u; s > 0u; s >>= 1) {
+    if (i < s) sums[i] += sums[i + s];
+    barrier();
+  }
+  return sums[0];
+}
+
+// Σ_k ±v[col_k] over entries [begin, end), in entry order like the CPU backend.
+float gather(uint64_t entry, uint begin, uint end, Floats v) {
+  Words e = Words(entry + uint64_t(begin) * 4ul);
+  float s = 0.0;
+  for (uint t = 0u; t < end - begin; ++t) {
+    const uint k = e.v[t];
+    const float f = v.v[k & 0x7fffffffu];
+    s += (k & 0x80000000u) != 0u ? -f : f;
+  }
+  return s;
+}
+
+void main() {
+  // A grid wider than the per-dimension workgroup limit continues in y (vk::dispatch_grid).
+  const uint i = gl_GlobalInvocationID.x + gl_GlobalInvocationID.y * gl_NumWorkGroups.x * 256u;
+  float change = 0.0;
+  if (i < pc.m) {
+    const float ri = pc.r.v[i];
+    const float yi = pc.y.v[i];
+    const float yh = yi + pc.sigma * (pc.b.v[i] - ri * gather(pc.a_entry, pc.a_ptr.v[i], pc.a_ptr.v[i + 1u], pc.xr));
+    const float y = pc.w * ((1.0 + pc.gamma) * yh - pc.gamma * yi) + (1.0 - pc.w) * pc.y0.v[i];
+    pc.y.v[i] = y;
+    pc.yr.v[i] = ri * y;
+    if (pc.last != 0u) {
+      pc.yhat.v[i] = yh;
+      pc.ys.v[i] = ri * yh;
+      change = (yh - yi) * (yh - yi);
+    }
+  }
+  if (pc.last != 0u) {  // uniform: the whole workgroup reduces or none does
+    const float s = workgroup_sum(change);
+    if (gl_LocalInvocationIndex == 0u) pc.partial.v[gl_WorkGroupID.x + gl_WorkGroupID.y * gl_NumWorkGroups.x] = s;
+  }
+}

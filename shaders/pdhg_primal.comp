@@ -1,0 +1,71 @@
+#version 450
+// PDHG primal step over columns j (core/src/pdhg_backend.hpp): gathers yr through Aᵀ, then the
+// clamp, the extrapolated point xr and the Halpern update of x, fused so that each vector is read
+// and written once. On the last iteration of a batch it also keeps x̂, d·x̂ (for the evaluation)
+// and per-workgroup partial sums of (x̂ − x)².
+// Buffers are reached by device address (GL_EXT_buffer_reference), so no binding limits the size
+// of A; an entry offset becomes a 64-bit address once per column.
+#extension GL_EXT_buffer_reference : require
+#extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
+layout(local_size_x = 256) in;
+
+layout(buffer_reference, std430, buffer_reference_align = 4) restrict readonly buffer Words { uint v[]; };
+layout(buffer_reference, std430, buffer_reference_align = 4) restrict buffer Floats { float v[]; };
+
+layout(push_constant) uniform Push {
+  Words at_ptr;       // Aᵀ row offsets (n + 1)
+  uint64_t at_entry; // Aᵀ entries: address of uint[nnz]
+  Floats yr, c, d, x, x0, xhat, xs, xr, partial;
+  uint n;
+  float tau, gamma, w;
+  uint last;
+} pc;
+
+shared float sums[256];
+
+// Σ_k ±v[col_k] over entries [begin, end), in entry order like the CPU backend.
+float gather(uint64_t entry, uint begin, uint end, Floats v) {
+  Words e = Words(entry + uint64_t(begin) * 4ul);
+  float s = 0.0;
+  for (uint t = 0u; t < end - begin; ++t) {
+    const uint k = e.v[t];
+    const float f = v.v[k & 0x7fffffffu];
+    s += (k & 0x80000000u) != 0u ? -f : f;
+  }
+  return s;
+}
+
+// Sum over the workgroup; every invocation must reach it (it has barriers).
+float workgroup_sum(float value) {
+  const uint i = gl_LocalInvocationIndex;
+  sums[i] = value;
+  barrier();
+  for (uint s = 128u; s > 0u; s >>= 1) {
+    if (i < s) sums[i] += sums[i + s];
+    barrier();
+  }
+  return sums[0];
+}
+
+void main() {
+  // A grid wider than the per-dimension workgroup limit continues in y (vk::dispatch_grid).
+  const uint j = gl_GlobalInvocationID.x + gl_GlobalInvocationID.y * gl_NumWorkGroups.x * 256u;
+  float change = 0.0;
+  if (j < pc.n) {
+    const float dj = pc.d.v[j];
+    const float g = pc.c.v[j] - dj * gather(pc.at_entry, pc.at_ptr.v[j], pc.at_ptr.v[j + 1u], pc.yr);
+    const float xj = pc.x.v[j];
+    const float xh = clamp(xj - pc.tau * g, 0.0, 1.0 / dj);
+    pc.xr.v[j] = dj * (2.0 * xh - xj);
+    pc.x.v[j] = pc.w * ((1.0 + pc.gamma) * xh - pc.gamma * xj) + (1.0 - pc.w) * pc.x0.v[j];
+    if (pc.last != 0u) {
+      pc.xhat.v[j] = xh;
+      pc.xs.v[j] = dj * xh;
+      change = (xh - xj) * (xh - xj);
+    }
+  }
+  if (pc.last != 0u) {  // uniform: the whole workgroup reduces or none does
+    const float s = workgroup_sum(change);
+    if (gl_LocalInvocationIndex == 0u) pc.partial.v[gl_WorkGroupID.x + gl_WorkGroupID.y * gl_NumWorkGroups.x] = s;
+  }
+}

@@ -1,0 +1,40 @@
+#version 450
+// Restart over columns (core/src/pdhg_backend.hpp): x⁰ ← x ← x̂, with per-workgroup partial sums
+// of the anchor's displacement (x̂ − x⁰)².
+#extension GL_EXT_buffer_reference : require
+layout(local_size_x = 256) in;
+
+layout(buffer_reference, std430, buffer_reference_align = 4) restrict buffer Floats { float v[]; };
+
+layout(push_constant) uniform Push {
+  Floats xhat, x, x0, partial;
+  uint n;
+} pc;
+
+shared float sums[256];
+
+// Sum over the workgroup; every invocation must reach it (it has barriers).
+float workgroup_sum(float value) {
+  const uint i = gl_LocalInvocationIndex;
+  sums[i] = value;
+  barrier();
+  for (uint s = 128u; s > 0u; s >>= 1) {
+    if (i < s) sums[i] += sums[i + s];
+    barrier();
+  }
+  return sums[0];
+}
+
+void main() {
+  // A grid wider than the per-dimension workgroup limit continues in y (vk::dispatch_grid).
+  const uint j = gl_GlobalInvocationID.x + gl_GlobalInvocationID.y * gl_NumWorkGroups.x * 256u;
+  float change = 0.0;
+  if (j < pc.n) {
+    const float xh = pc.xhat.v[j];
+    change = (xh - pc.x0.v[j]) * (xh - pc.x0.v[j]);
+    pc.x.v[j] = xh;
+    pc.x0.v[j] = xh;
+  }
+  const float s = workgroup_sum(change);
+  if (gl_LocalInvocationIndex == 0u) pc.partial.v[gl_WorkGroupID.x + gl_WorkGroupID.y * gl_NumWorkGroups.x] = s;
+}

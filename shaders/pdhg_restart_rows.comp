@@ -1,0 +1,41 @@
+#version 450
+// Restart over rows (core/src/pdhg_backend.hpp): y⁰ ← y ← ŷ and yr = r·ŷ, with per-workgroup
+// partial sums of the anchor's displacement (ŷ − y⁰)².
+#extension GL_EXT_buffer_reference : require
+layout(local_size_x = 256) in;
+
+layout(buffer_reference, std430, buffer_reference_align = 4) restrict buffer Floats { float v[]; };
+
+layout(push_constant) uniform Push {
+  Floats yhat, r, y, y0, yr, partial;
+  uint m;
+} pc;
+
+shared float sums[256];
+
+// Sum over the workgroup; every invocation must reach it (it has barriers).
+float workgroup_sum(float value) {
+  const uint i = gl_LocalInvocationIndex;
+  sums[i] = value;
+  barrier();
+  for (uint s = 128u; s > 0u; s >>= 1) {
+    if (i < s) sums[i] += sums[i + s];
+    barrier();
+  }
+  return sums[0];
+}
+
+void main() {
+  // A grid wider than the per-dimension workgroup limit continues in y (vk::dispatch_grid).
+  const uint i = gl_GlobalInvocationID.x + gl_GlobalInvocationID.y * gl_NumWorkGroups.x * 256u;
+  float change = 0.0;
+  if (i < pc.m) {
+    const float yh = pc.yhat.v[i];
+    change = (yh - pc.y0.v[i]) * (yh - pc.y0.v[i]);
+    pc.y.v[i] = yh;
+    pc.y0.v[i] = yh;
+    pc.yr.v[i] = pc.r.v[i] * yh;
+  }
+  const float s = workgroup_sum(change);
+  if (gl_LocalInvocationIndex == 0u) pc.partial.v[gl_WorkGroupID.x + gl_WorkGroupID.y * gl_NumWorkGroups.x] = s;
+}

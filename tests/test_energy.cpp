@@ -1,0 +1,100 @@
+#include "shapematch/energy.hpp"
+#include "shapematch/shapes.hpp"
+#include "test_helpers.hpp"
+
+#include <doctest/doctest.h>
+
+#include <cmath>
+
+using namespace shapematch;
+
+namespace {
+
+Triangle3 random_triangle(std::mt19937& rng) {
+  std::uniform_real_distribution<double> u(-1, 1);
+  return {Eigen::Vector3d(u(rng), u(rng), u(rng)), Eigen::Vector3d(u(rng), u(rng), u(rng)),
+          Eigen::Vector3d(u(rng), u(rng), u(rng))};
+}
+
+}  // namespace
+
+TEST_CASE("energy: membrane equals Delingette's spring form on random triangles") {
+  std::mt19937 rng(7);
+  for (int k = 0; k < 1000; ++k) {
+    const Triangle3 s = random_triangle(rng), t = random_triangle(rng);
+    const double lambda = 0.2 + (k % 5), mu = 0.5 + (k % 3);
+    const double w = membrane_energy(s, t, lambda, mu), ws = membrane_energy_springs(s, t, lambda, mu);
+    CHECK(w >= 0.0);
+    CHECK(std::abs(w - ws) <= 1e-10 * std::max(1.0, std::abs(w)));
+  }
+}
+
+TEST_CASE("energy: membrane matches the continuum formula for a uniaxial stretch") {
+  // Stretching by s along an axis of an orthonormal frame gives E = diag((s²−1)/2, 0), so
+  // W = A((λ/2)e² + μe²) with e = (s²−1)/2, for any triangle shape.
+  std::mt19937 rng(3);
+  for (int k = 0; k < 100; ++k) {
+    Triangle3 src = random_triangle(rng);
+    for (auto& p : src) p.z() = 0.0;
+    const double s = 0.5 + 0.01 * k, lambda = 1.3, mu = 0.7;
+    Triangle3 dst = src;
+    for (auto& p : dst) p.x() *= s;
+    const double area = 0.5 * (src[1] - src[0]).cross(src[2] - src[0]).norm();
+    const double e = (s * s - 1) / 2;
+    CHECK(membrane_energy(src, dst, lambda, mu) == doctest::Approx(area * (lambda / 2 + mu) * e * e).epsilon(1e-10));
+  }
+}
+
+TEST_CASE("energy: membrane is zero for rigid motions and positive otherwise") {
+  std::mt19937 rng(11);
+  for (int k = 0; k < 200; ++k) {
+    const Triangle3 s = random_triangle(rng);
+    const Eigen::Matrix3d R = test::random_rotation(rng);
+    const Eigen::Vector3d t(0.3, -2.0, 5.0);
+    Triangle3 rigid, scaled;
+    for (int i = 0; i < 3; ++i) {
+      rigid[i] = R * s[i] + t;
+      scaled[i] = 1.05 * (R * s[i]) + t;
+    }
+    CHECK(membrane_energy(s, rigid, 1, 1) < 1e-9);
+    CHECK(membrane_energy(s, scaled, 1, 1) > 1e-6);
+  }
+  // Degenerate source: no area, no energy; degenerate target: finite, positive.
+  const Triangle3 line{Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(2, 0, 0)};
+  const Triangle3 tri{Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(0, 1, 0)};
+  CHECK(membrane_energy(line, tri, 1, 1) == 0.0);
+  const double collapse = membrane_energy(tri, line, 1, 1);
+  CHECK(std::isfinite(collapse));
+  CHECK(collapse > 0.0);
+}
+
+TEST_CASE("energy: the identity matching costs nothing; swapping X and Y preserves energies") {
+  const Mesh x = shapes::icosphere(1);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-0.05, 0.05);
+  const Mesh y = test::deformed(x, [&](const Eigen::Vector3d& p) {
+    return Eigen::Vector3d(1.2 * p.x() + u(rng), p.y() + u(rng), 0.9 * p.z() + u(rng));
+  });
+  const Geometry gx = compute_geometry(x), gy = compute_geometry(y);
+  EnergyOptions opt;
+  opt.bending_weight = 0.7;
+  const EnergyModel xx(x, gx, x, gx, opt);
+  for (const auto& t : identity_matching(x)) CHECK(xx(t) == doctest::Approx(0.0).epsilon(1e-14));
+
+  const EnergyModel xy(x, gx, y, gy, opt), yx(y, gy, x, gx, opt);
+  const ProductSpace s = ProductSpace::full(x, y);
+  double total = 0.0;
+  for (int64_t j = 0; j < s.size(); j += 7) {
+    const ProductTriangle t = s[j];
+    const ProductTriangle swapped{t.b, t.a, t.fb, t.fa};
+    const double e = xy(t);
+    CHECK(e >= 0.0);
+    CHECK(yx(swapped) == doctest::Approx(e).epsilon(1e-12));
+    total += e;
+  }
+  CHECK(total > 0.0);
+  // Identity-like triangles of the deformed pair cost something, but far less than random ones.
+  double id_energy = 0.0;
+  for (const auto& t : identity_matching(x)) id_energy += xy(t);
+  CHECK(id_energy > 0.0);
+}

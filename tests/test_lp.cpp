@@ -1,0 +1,108 @@
+#include "shapematch/errors.hpp"
+#include "shapematch/lp.hpp"
+#include "shapematch/matching.hpp"
+#include "shapematch/shapes.hpp"
+#include "test_helpers.hpp"
+
+#include <doctest/doctest.h>
+
+#include <filesystem>
+#include <fstream>
+
+using namespace shapematch;
+
+namespace {
+
+// Builds an LP from dense rows with entries in {-1, 0, 1}.
+LpProblem dense_lp(const std::vector<std::vector<int>>& rows, std::vector<double> b, std::vector<double> c) {
+  LpProblem p;
+  p.a.rows = static_cast<int64_t>(rows.size());
+  p.a.cols = static_cast<int64_t>(c.size());
+  p.a.row_ptr.push_back(0);
+  for (const auto& r : rows) {
+    for (size_t j = 0; j < r.size(); ++j)
+      if (r[j] != 0) p.a.entry.push_back(static_cast<uint32_t>(j) | (r[j] < 0 ? SignedCsr::kNegative : 0u));
+    p.a.row_ptr.push_back(static_cast<uint32_t>(p.a.entry.size()));
+  }
+  p.at = transpose(p.a);
+  p.b = std::move(b);
+  p.c = std::move(c);
+  return p;
+}
+
+}  // namespace
+
+TEST_CASE("clp: tiny LPs with known optima and an infeasible one") {
+  for (const std::string solver : {"clp-dual", "clp-barrier"}) {
+    CAPTURE(solver);
+    // min x0 + 2 x1  s.t. x0 + x1 = 1  →  1 at x = (1, 0).
+    LpResult r = solve_lp(dense_lp({{1, 1}}, {1}, {1, 2}), solver);
+    REQUIRE(r.status == LpStatus::Optimal);
+    CHECK(r.objective == doctest::Approx(1.0));
+    CHECK(r.x[0] == doctest::Approx(1.0));
+    CHECK(r.lower_bound == doctest::Approx(1.0).epsilon(1e-7));
+    // min −x0 + x2  s.t. x0 − x1 = 0, x1 + x2 = 1  →  −1 at x = (1, 1, 0).
+    r = solve_lp(dense_lp({{1, -1, 0}, {0, 1, 1}}, {0, 1}, {-1, 0, 1}), solver);
+    REQUIRE(r.status == LpStatus::Optimal);
+    CHECK(r.objective == doctest::Approx(-1.0));
+    // The box makes x0 + x1 = 3 impossible.
+    r = solve_lp(dense_lp({{1, 1}}, {3}, {1, 1}), solver);
+    CHECK(r.status == LpStatus::Infeasible);
+  }
+}
+
+TEST_CASE("clp: a mesh against itself has LP optimum 0; a deformed copy a positive one") {
+  const Mesh x = shapes::octahedron();
+  const Mesh y = test::deformed(x, [](const Eigen::Vector3d& p) {
+    return Eigen::Vector3d(1.3 * p.x() + 0.1 * p.z(), p.y(), 0.8 * p.z() + 0.05 * p.x() * p.y());
+  });
+  const Geometry gx = compute_geometry(x), gy = compute_geometry(y);
+
+  const MatchingLp self = build_matching_lp(x, gx, x, gx);
+  const LpResult r0 = solve_lp(self.lp, "clp-dual");
+  REQUIRE(r0.status == LpStatus::Optimal);
+  CHECK(std::abs(r0.objective) < 1e-9);
+
+  const MatchingLp m = build_matching_lp(x, gx, y, gy);
+  const LpResult dual = solve_lp(m.lp, "clp-dual");
+  const LpResult barrier = solve_lp(m.lp, "clp-barrier");
+  REQUIRE(dual.status == LpStatus::Optimal);
+  REQUIRE(barrier.status == LpStatus::Optimal);
+  CHECK(dual.objective > 1e-6);
+  CHECK(std::abs(dual.objective - barrier.objective) <= 1e-6 * std::abs(dual.objective));
+  // The certified bound from Clp's duals is tight, and never above the optimum.
+  CHECK(dual.lower_bound <= dual.objective + 1e-9 * std::abs(dual.objective));
+  CHECK(dual.lower_bound == doctest::Approx(dual.objective).epsilon(1e-6));
+  CHECK(dual.primal_residual < 1e-9);
+}
+
+TEST_CASE("lp: the certified lower bound holds for arbitrary duals") {
+  const Mesh x = shapes::tetrahedron();
+  const Mesh y = test::deformed(x, [](const Eigen::Vector3d& p) { return Eigen::Vector3d(p.x(), 1.5 * p.y(), p.z()); });
+  const Geometry gx = compute_geometry(x), gy = compute_geometry(y);
+  const MatchingLp m = build_matching_lp(x, gx, y, gy);
+  const LpResult opt = solve_lp(m.lp, "clp-dual");
+  REQUIRE(opt.status == LpStatus::Optimal);
+  std::mt19937 rng(1);
+  std::normal_distribution<double> n(0.0, 0.3);
+  for (int k = 0; k < 50; ++k) {
+    std::vector<double> y = opt.y;
+    for (auto& v : y) v += n(rng) * (k % 5) * 0.1;
+    CHECK(certified_lower_bound(m.lp, y) <= opt.objective * (1 + 1e-9));
+  }
+}
+
+TEST_CASE("lp: MPS export and problem checks") {
+  LpProblem p = dense_lp({{1, 1}}, {1}, {1, 2});
+  const auto path = std::filesystem::temp_directory_path() / "shapematch_test.mps";
+  write_mps(p, path.string());
+  std::ifstream f(path);
+  std::string first;
+  std::getline(f, first);
+  CHECK(first.rfind("NAME", 0) == 0);
+  std::filesystem::remove(path);
+
+  p.c.pop_back();
+  CHECK_THROWS_AS(p.check(), InvalidInputError);
+  CHECK_THROWS_AS(make_solver("simplex-magic"), InvalidInputError);
+}

@@ -1,0 +1,232 @@
+// Tests of the Vulkan PDHG backend against the native one (the oracle for every kernel) and of
+// the solver on it against Clp. They need a Vulkan device (CI points VK_ICD_FILENAMES at
+// lavapipe) and fail without one, unless SHAPEMATCH_SKIP_VULKAN=1.
+#include "pdhg_backend.hpp"
+#include "shapematch/device.hpp"
+#include "shapematch/errors.hpp"
+#include "shapematch/matching.hpp"
+#include "shapematch/shapes.hpp"
+#include "test_helpers.hpp"
+#include "vk/context.hpp"
+
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <random>
+#include <string>
+
+using namespace shapematch;
+
+namespace {
+
+// False (the test returns) only when skipping was asked for; no device otherwise fails.
+bool vulkan_wanted() {
+  const char* skip = std::getenv("SHAPEMATCH_SKIP_VULKAN");
+  if (skip && std::string(skip) == "1") {
+    MESSAGE("SHAPEMATCH_SKIP_VULKAN=1: Vulkan test skipped");
+    return false;
+  }
+  std::string problem;
+  try {
+    if (list_devices().empty()) problem = "no Vulkan device with a compute queue";
+  } catch (const DeviceError& e) {
+    problem = e.what();
+  }
+  if (!problem.empty())
+    FAIL("Vulkan unavailable (" << problem << "). Set VK_ICD_FILENAMES="
+         "/usr/share/vulkan/icd.d/lvp_icd.x86_64.json for lavapipe, or "
+         "SHAPEMATCH_SKIP_VULKAN=1 to skip the Vulkan tests.");
+  return true;
+}
+
+// A random scaled problem with a starting point; ScaledLp points into a and at, so this stays put.
+struct RandomLp {
+  SignedCsr a, at;
+  detail::ScaledLp lp;
+  std::vector<float> x, y;
+
+  // rows x cols with 0..max_per_row entries per row (empty rows and columns occur).
+  RandomLp(int64_t rows, int64_t cols, int max_per_row, uint32_t seed) {
+    std::minstd_rand rng(seed);  // fast enough for the 40M-entry case
+    std::uniform_int_distribution<int> count(0, max_per_row);
+    std::uniform_int_distribution<uint32_t> col(0, static_cast<uint32_t>(cols - 1));
+    std::uniform_real_distribution<float> u(0.0f, 1.0f);
+    a.rows = rows;
+    a.cols = cols;
+    a.row_ptr.reserve(size_t(rows) + 1);
+    a.entry.reserve(size_t(rows) * max_per_row / 2 + 16);
+    a.row_ptr.push_back(0);
+    for (int64_t r = 0; r < rows; ++r) {
+      for (int k = count(rng); k > 0; --k) a.entry.push_back(col(rng) | (u(rng) < 0.5f ? SignedCsr::kNegative : 0u));
+      a.row_ptr.push_back(static_cast<uint32_t>(a.entry.size()));
+    }
+    at = transpose(a);
+    lp.a = &a;
+    lp.at = &at;
+    for (int64_t j = 0; j < cols; ++j) {
+      lp.col_scale.push_back(0.5f + u(rng));
+      lp.c.push_back(2.0f * u(rng) - 0.5f);
+      x.push_back(u(rng) < 0.3f ? 0.0f : u(rng) / lp.col_scale.back());
+    }
+    for (int64_t i = 0; i < rows; ++i) {
+      lp.row_scale.push_back(0.5f + u(rng));
+      lp.b.push_back(3.0f * u(rng) - 1.0f);
+      y.push_back(2.0f * u(rng) - 1.0f);
+    }
+  }
+};
+
+// |a − b| within tol of the larger magnitude (plus a floor for sums that cancel to ~0).
+void check_close(const char* what, double gpu, double cpu, double tol, double floor) {
+  CAPTURE(what);
+  CAPTURE(gpu);
+  CAPTURE(cpu);
+  CHECK(std::abs(gpu - cpu) <= tol * std::max(std::abs(gpu), std::abs(cpu)) + floor);
+}
+
+void check_stats(const detail::BatchStats& gpu, const detail::BatchStats& cpu, double tol, double floor) {
+  check_close("dx2", gpu.dx2, cpu.dx2, tol, floor);
+  check_close("dy2", gpu.dy2, cpu.dy2, tol, floor);
+  check_close("residual2", gpu.residual2, cpu.residual2, tol, floor);
+  check_close("cx", gpu.cx, cpu.cx, tol, floor);
+  check_close("by", gpu.by, cpu.by, tol, floor);
+  check_close("reduced_neg", gpu.reduced_neg, cpu.reduced_neg, tol, floor);
+}
+
+// Entrywise within tol of the vector's largest magnitude: sums in a different order differ by
+// rounding relative to their terms, not to a result that cancels.
+void check_vector(const char* what, const std::vector<float>& gpu, const std::vector<float>& cpu, double tol) {
+  CAPTURE(what);
+  REQUIRE(gpu.size() == cpu.size());
+  double scale = 0.0;
+  for (float v : cpu) scale = std::max(scale, double(std::abs(v)));
+  size_t worst = 0;
+  double worst_error = 0.0;
+  for (size_t k = 0; k < cpu.size(); ++k) {
+    const double error = std::abs(double(gpu[k]) - cpu[k]);
+    if (error > worst_error) worst_error = error, worst = k;
+  }
+  CAPTURE(worst);
+  CAPTURE(scale);
+  CHECK(worst_error <= tol * scale);
+}
+
+void check_read(detail::PdhgBackend& gpu, detail::PdhgBackend& cpu, double tol) {
+  std::vector<float> gx, gy, cx, cy;
+  gpu.read(gx, gy);
+  cpu.read(cx, cy);
+  check_vector("x̂", gx, cx, tol);
+  check_vector("ŷ", gy, cy, tol);
+}
+
+// Runs both backends side by side: one iteration, a batch, a restart, a batch after it.
+void compare_backends(const RandomLp& p, const detail::Step& step, int batch) {
+  const auto gpu = detail::make_vulkan_backend(-1);
+  const auto cpu = detail::make_cpu_backend(2);
+  gpu->load(p.lp, p.x, p.y);
+  cpu->load(p.lp, p.x, p.y);
+  check_read(*gpu, *cpu, 0.0);  // zeros before any iteration
+
+  check_stats(gpu->iterate(1, 0, step), cpu->iterate(1, 0, step), 1e-5, 1e-6);
+  check_read(*gpu, *cpu, 1e-5);
+
+  check_stats(gpu->iterate(batch, 1, step), cpu->iterate(batch, 1, step), 1e-4, 1e-5);
+  check_read(*gpu, *cpu, 1e-4);
+
+  const auto [gdx, gdy] = gpu->restart();
+  const auto [cdx, cdy] = cpu->restart();
+  check_close("restart dx2", gdx, cdx, 1e-4, 1e-5);
+  check_close("restart dy2", gdy, cdy, 1e-4, 1e-5);
+  // After the restart both continue from x̂, ŷ (and yr = r ŷ).
+  check_stats(gpu->iterate(batch, 0, step), cpu->iterate(batch, 0, step), 1e-4, 1e-5);
+  check_read(*gpu, *cpu, 1e-4);
+}
+
+LpProblem matching_lp() {
+  const Mesh x = shapes::octahedron();
+  const Mesh y = test::deformed(x, [](const Eigen::Vector3d& p) {
+    return Eigen::Vector3d(1.3 * p.x() + 0.1 * p.z(), p.y(), 0.8 * p.z() + 0.05 * p.x() * p.y());
+  });
+  return build_matching_lp(x, compute_geometry(x), y, compute_geometry(y)).lp;
+}
+
+SolverParams tight() {
+  SolverParams params;
+  params.tolerance = 1e-5;
+  params.max_iterations = 400000;
+  return params;
+}
+
+}  // namespace
+
+TEST_CASE("pdhg-vulkan: every kernel equals the CPU backend on a small random problem") {
+  if (!vulkan_wanted()) return;
+  // Sizes not multiples of the workgroup; more columns than rows and the converse.
+  for (const auto& [rows, cols] : {std::pair<int64_t, int64_t>{333, 1000}, {1000, 333}}) {
+    CAPTURE(rows);
+    const RandomLp p(rows, cols, 8, 7);
+    for (float gamma : {1.0f, 0.5f}) {
+      CAPTURE(gamma);
+      compare_backends(p, detail::Step{0.3f, 0.2f, gamma}, 7);
+    }
+  }
+}
+
+// lavapipe: A's entry arrays exceed maxStorageBufferRange (128 MiB) and the rows need a 2D grid
+// (more than 65535 workgroups).
+TEST_CASE("pdhg-vulkan: kernels on arrays above 128 MiB and a 2D grid equal the CPU backend" *
+          doctest::test_suite("slow")) {
+  if (!vulkan_wanted()) return;
+  const int64_t rows = int64_t{65535} * 256 + 1000;
+  const RandomLp p(rows, 4'000'000, 4, 11);
+  REQUIRE(p.a.entry.size() * sizeof(uint32_t) > (uint64_t{128} << 20));
+  compare_backends(p, detail::Step{0.2f, 0.2f, 1.0f}, 2);
+}
+
+TEST_CASE("pdhg-vulkan: a buffer beyond one allocation is a clear DeviceError") {
+  if (!vulkan_wanted()) return;
+  vk::Context context;
+  REQUIRE(context.limits().buffer_device_address);
+  try {
+    context.addressed_buffer(context.limits().max_memory_allocation_size + 4);
+    FAIL("no DeviceError");
+  } catch (const DeviceError& e) {
+    CHECK(std::string(e.what()).find("maxMemoryAllocationSize") != std::string::npos);
+  }
+}
+
+TEST_CASE("pdhg-vulkan: calls before load() are refused") {
+  if (!vulkan_wanted()) return;
+  const auto gpu = detail::make_vulkan_backend(-1);
+  CHECK_THROWS_AS(gpu->iterate(1, 0, detail::Step{}), DeviceError);
+  CHECK_THROWS_AS(gpu->restart(), DeviceError);
+}
+
+TEST_CASE("pdhg-vulkan: a matching LP agrees with Clp within 1e-4 relative") {
+  if (!vulkan_wanted()) return;
+  const LpProblem lp = matching_lp();
+  const LpResult exact = solve_lp(lp, "clp-dual");
+  REQUIRE(exact.status == LpStatus::Optimal);
+  const LpResult r = solve_lp(lp, "pdhg-vulkan", tight());
+  CAPTURE(r.iterations);
+  REQUIRE(r.status == LpStatus::Optimal);
+  CHECK(r.device.find("vulkan") != std::string::npos);
+  CHECK(std::abs(r.objective - exact.objective) <= 1e-4 * std::abs(exact.objective));
+  CHECK(r.lower_bound <= exact.objective * (1 + 1e-9));
+}
+
+TEST_CASE("pdhg-vulkan: both backends converge to the same objective") {
+  if (!vulkan_wanted()) return;
+  const LpProblem lp = matching_lp();
+  const LpResult cpu = solve_lp(lp, "pdhg-cpu", tight());
+  const LpResult gpu = solve_lp(lp, "pdhg-vulkan", tight());
+  REQUIRE(cpu.status == LpStatus::Optimal);
+  REQUIRE(gpu.status == LpStatus::Optimal);
+  CAPTURE(cpu.iterations);
+  CAPTURE(gpu.iterations);
+  CHECK(std::abs(gpu.objective - cpu.objective) <= 1e-4 * std::abs(cpu.objective));
+  // The same algorithm in fp32 with sums in another order: the paths stay close.
+  CHECK(std::abs(double(gpu.iterations - cpu.iterations)) <= 0.25 * double(cpu.iterations));
+}
