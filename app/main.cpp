@@ -35,9 +35,11 @@ int main(int argc, char** argv) {
     CLI::App* sub = cli.add_subcommand(name, help);
     actions[sub] = make(*sub);
   };
+  add(app::add_match_command, "match", "match two meshes: LP, rounding, verified outputs");
   add(app::add_lp_command, "lp", "build the single-level matching LP and solve its relaxation");
   add(app::add_devices_command, "devices", "list Vulkan compute devices");
   add(app::add_generate_assets_command, "generate-assets", "regenerate the bundled demo meshes");
+  add(app::add_bench_command, "bench", "benchmark the LP solvers (Fig. 4) and the memory bandwidth");
 
   try {
     cli.parse(argc, argv);

@@ -8,21 +8,20 @@
 layout(local_size_x = 256) in;
 
 layout(buffer_reference, std430, buffer_reference_align = 4) restrict readonly buffer Words { uint v[]; };
-layout(buffer_reference, std430, buffer_reference_align = 4) restrict buffer Floats { float v[]; };
+layout(buffer_reference, std430, buffer_reference_align = 8) restrict buffer Doubles { double v[]; };
 
 layout(push_constant) uniform Push {
   Words a_ptr;        // A row offsets (m + 1)
   uint64_t a_entry;   // A entries: address of uint[nnz]
-  Floats xr, b, r, y, y0, yr, yhat, ys, partial;
-  uint m;
-  float sigma, gamma, w;
-  uint last;
+  Doubles xr, b, r, y, y0, yr, yhat, ys, partial;
+  double sigma, gamma, w;  // doubles before the uints: the block stays within 128 bytes
+  uint m, last;
 } pc;
 
-shared float sums[256];
+shared double sums[256];
 
 // Sum over the workgroup; every invocation must reach it (it has barriers).
-float workgroup_sum(float value) {
+double workgroup_sum(double value) {
   const uint i = gl_LocalInvocationIndex;
   sums[i] = value;
   barrier();
@@ -34,12 +33,12 @@ float workgroup_sum(float value) {
 }
 
 // Σ_k ±v[col_k] over entries [begin, end), in entry order like the CPU backend.
-float gather(uint64_t entry, uint begin, uint end, Floats v) {
+double gather(uint64_t entry, uint begin, uint end, Doubles v) {
   Words e = Words(entry + uint64_t(begin) * 4ul);
-  float s = 0.0;
+  double s = 0.0lf;
   for (uint t = 0u; t < end - begin; ++t) {
     const uint k = e.v[t];
-    const float f = v.v[k & 0x7fffffffu];
+    const double f = v.v[k & 0x7fffffffu];
     s += (k & 0x80000000u) != 0u ? -f : f;
   }
   return s;
@@ -48,12 +47,12 @@ float gather(uint64_t entry, uint begin, uint end, Floats v) {
 void main() {
   // A grid wider than the per-dimension workgroup limit continues in y (vk::dispatch_grid).
   const uint i = gl_GlobalInvocationID.x + gl_GlobalInvocationID.y * gl_NumWorkGroups.x * 256u;
-  float change = 0.0;
+  double change = 0.0lf;
   if (i < pc.m) {
-    const float ri = pc.r.v[i];
-    const float yi = pc.y.v[i];
-    const float yh = yi + pc.sigma * (pc.b.v[i] - ri * gather(pc.a_entry, pc.a_ptr.v[i], pc.a_ptr.v[i + 1u], pc.xr));
-    const float y = pc.w * ((1.0 + pc.gamma) * yh - pc.gamma * yi) + (1.0 - pc.w) * pc.y0.v[i];
+    const double ri = pc.r.v[i];
+    const double yi = pc.y.v[i];
+    const double yh = yi + pc.sigma * (pc.b.v[i] - ri * gather(pc.a_entry, pc.a_ptr.v[i], pc.a_ptr.v[i + 1u], pc.xr));
+    const double y = pc.w * ((1.0lf + pc.gamma) * yh - pc.gamma * yi) + (1.0lf - pc.w) * pc.y0.v[i];
     pc.y.v[i] = y;
     pc.yr.v[i] = ri * y;
     if (pc.last != 0u) {
@@ -63,7 +62,7 @@ void main() {
     }
   }
   if (pc.last != 0u) {  // uniform: the whole workgroup reduces or none does
-    const float s = workgroup_sum(change);
+    const double s = workgroup_sum(change);
     if (gl_LocalInvocationIndex == 0u) pc.partial.v[gl_WorkGroupID.x + gl_WorkGroupID.y * gl_NumWorkGroups.x] = s;
   }
 }

@@ -6,19 +6,19 @@
 layout(local_size_x = 256) in;
 
 layout(buffer_reference, std430, buffer_reference_align = 4) restrict readonly buffer Words { uint v[]; };
-layout(buffer_reference, std430, buffer_reference_align = 4) restrict buffer Floats { float v[]; };
+layout(buffer_reference, std430, buffer_reference_align = 8) restrict buffer Doubles { double v[]; };
 
 layout(push_constant) uniform Push {
   Words at_ptr;
   uint64_t at_entry;
-  Floats ys, c, d, xhat, cx_out, negative_out;
+  Doubles ys, c, d, xhat, cx_out, negative_out;
   uint n;
 } pc;
 
-shared vec2 sums[256];
+shared dvec2 sums[256];
 
 // Two sums over the workgroup; every invocation must reach it (it has barriers).
-vec2 workgroup_sum(vec2 value) {
+dvec2 workgroup_sum(dvec2 value) {
   const uint i = gl_LocalInvocationIndex;
   sums[i] = value;
   barrier();
@@ -30,12 +30,12 @@ vec2 workgroup_sum(vec2 value) {
 }
 
 // Σ_k ±v[col_k] over entries [begin, end), in entry order like the CPU backend.
-float gather(uint64_t entry, uint begin, uint end, Floats v) {
+double gather(uint64_t entry, uint begin, uint end, Doubles v) {
   Words e = Words(entry + uint64_t(begin) * 4ul);
-  float s = 0.0;
+  double s = 0.0lf;
   for (uint t = 0u; t < end - begin; ++t) {
     const uint k = e.v[t];
-    const float f = v.v[k & 0x7fffffffu];
+    const double f = v.v[k & 0x7fffffffu];
     s += (k & 0x80000000u) != 0u ? -f : f;
   }
   return s;
@@ -44,13 +44,13 @@ float gather(uint64_t entry, uint begin, uint end, Floats v) {
 void main() {
   // A grid wider than the per-dimension workgroup limit continues in y (vk::dispatch_grid).
   const uint j = gl_GlobalInvocationID.x + gl_GlobalInvocationID.y * gl_NumWorkGroups.x * 256u;
-  vec2 terms = vec2(0.0);
+  dvec2 terms = dvec2(0.0lf);
   if (j < pc.n) {
-    const float cj = pc.c.v[j];
-    const float reduced = cj / pc.d.v[j] - gather(pc.at_entry, pc.at_ptr.v[j], pc.at_ptr.v[j + 1u], pc.ys);
-    terms = vec2(cj * pc.xhat.v[j], min(0.0, reduced));
+    const double cj = pc.c.v[j];
+    const double reduced = cj / pc.d.v[j] - gather(pc.at_entry, pc.at_ptr.v[j], pc.at_ptr.v[j + 1u], pc.ys);
+    terms = dvec2(cj * pc.xhat.v[j], min(0.0lf, reduced));
   }
-  const vec2 s = workgroup_sum(terms);
+  const dvec2 s = workgroup_sum(terms);
   if (gl_LocalInvocationIndex == 0u) {
     const uint g = gl_WorkGroupID.x + gl_WorkGroupID.y * gl_NumWorkGroups.x;
     pc.cx_out.v[g] = s.x;

@@ -6,19 +6,19 @@
 layout(local_size_x = 256) in;
 
 layout(buffer_reference, std430, buffer_reference_align = 4) restrict readonly buffer Words { uint v[]; };
-layout(buffer_reference, std430, buffer_reference_align = 4) restrict buffer Floats { float v[]; };
+layout(buffer_reference, std430, buffer_reference_align = 8) restrict buffer Doubles { double v[]; };
 
 layout(push_constant) uniform Push {
   Words a_ptr;
   uint64_t a_entry;
-  Floats xs, b, r, yhat, residual_out, by_out;
+  Doubles xs, b, r, yhat, residual_out, by_out;
   uint m;
 } pc;
 
-shared vec2 sums[256];
+shared dvec2 sums[256];
 
 // Two sums over the workgroup; every invocation must reach it (it has barriers).
-vec2 workgroup_sum(vec2 value) {
+dvec2 workgroup_sum(dvec2 value) {
   const uint i = gl_LocalInvocationIndex;
   sums[i] = value;
   barrier();
@@ -30,12 +30,12 @@ vec2 workgroup_sum(vec2 value) {
 }
 
 // Σ_k ±v[col_k] over entries [begin, end), in entry order like the CPU backend.
-float gather(uint64_t entry, uint begin, uint end, Floats v) {
+double gather(uint64_t entry, uint begin, uint end, Doubles v) {
   Words e = Words(entry + uint64_t(begin) * 4ul);
-  float s = 0.0;
+  double s = 0.0lf;
   for (uint t = 0u; t < end - begin; ++t) {
     const uint k = e.v[t];
-    const float f = v.v[k & 0x7fffffffu];
+    const double f = v.v[k & 0x7fffffffu];
     s += (k & 0x80000000u) != 0u ? -f : f;
   }
   return s;
@@ -44,13 +44,13 @@ float gather(uint64_t entry, uint begin, uint end, Floats v) {
 void main() {
   // A grid wider than the per-dimension workgroup limit continues in y (vk::dispatch_grid).
   const uint i = gl_GlobalInvocationID.x + gl_GlobalInvocationID.y * gl_NumWorkGroups.x * 256u;
-  vec2 terms = vec2(0.0);
+  dvec2 terms = dvec2(0.0lf);
   if (i < pc.m) {
-    const float bi = pc.b.v[i];
-    const float residual = gather(pc.a_entry, pc.a_ptr.v[i], pc.a_ptr.v[i + 1u], pc.xs) - bi / pc.r.v[i];
-    terms = vec2(residual * residual, bi * pc.yhat.v[i]);
+    const double bi = pc.b.v[i];
+    const double residual = gather(pc.a_entry, pc.a_ptr.v[i], pc.a_ptr.v[i + 1u], pc.xs) - bi / pc.r.v[i];
+    terms = dvec2(residual * residual, bi * pc.yhat.v[i]);
   }
-  const vec2 s = workgroup_sum(terms);
+  const dvec2 s = workgroup_sum(terms);
   if (gl_LocalInvocationIndex == 0u) {
     const uint g = gl_WorkGroupID.x + gl_WorkGroupID.y * gl_NumWorkGroups.x;
     pc.residual_out.v[g] = s.x;

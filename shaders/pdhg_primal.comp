@@ -10,33 +10,32 @@
 layout(local_size_x = 256) in;
 
 layout(buffer_reference, std430, buffer_reference_align = 4) restrict readonly buffer Words { uint v[]; };
-layout(buffer_reference, std430, buffer_reference_align = 4) restrict buffer Floats { float v[]; };
+layout(buffer_reference, std430, buffer_reference_align = 8) restrict buffer Doubles { double v[]; };
 
 layout(push_constant) uniform Push {
   Words at_ptr;       // Aᵀ row offsets (n + 1)
   uint64_t at_entry; // Aᵀ entries: address of uint[nnz]
-  Floats yr, c, d, x, x0, xhat, xs, xr, partial;
-  uint n;
-  float tau, gamma, w;
-  uint last;
+  Doubles yr, c, d, x, x0, xhat, xs, xr, partial;
+  double tau, gamma, w;  // doubles before the uints: the block stays within 128 bytes
+  uint n, last;
 } pc;
 
-shared float sums[256];
+shared double sums[256];
 
 // Σ_k ±v[col_k] over entries [begin, end), in entry order like the CPU backend.
-float gather(uint64_t entry, uint begin, uint end, Floats v) {
+double gather(uint64_t entry, uint begin, uint end, Doubles v) {
   Words e = Words(entry + uint64_t(begin) * 4ul);
-  float s = 0.0;
+  double s = 0.0lf;
   for (uint t = 0u; t < end - begin; ++t) {
     const uint k = e.v[t];
-    const float f = v.v[k & 0x7fffffffu];
+    const double f = v.v[k & 0x7fffffffu];
     s += (k & 0x80000000u) != 0u ? -f : f;
   }
   return s;
 }
 
 // Sum over the workgroup; every invocation must reach it (it has barriers).
-float workgroup_sum(float value) {
+double workgroup_sum(double value) {
   const uint i = gl_LocalInvocationIndex;
   sums[i] = value;
   barrier();
@@ -50,14 +49,14 @@ float workgroup_sum(float value) {
 void main() {
   // A grid wider than the per-dimension workgroup limit continues in y (vk::dispatch_grid).
   const uint j = gl_GlobalInvocationID.x + gl_GlobalInvocationID.y * gl_NumWorkGroups.x * 256u;
-  float change = 0.0;
+  double change = 0.0lf;
   if (j < pc.n) {
-    const float dj = pc.d.v[j];
-    const float g = pc.c.v[j] - dj * gather(pc.at_entry, pc.at_ptr.v[j], pc.at_ptr.v[j + 1u], pc.yr);
-    const float xj = pc.x.v[j];
-    const float xh = clamp(xj - pc.tau * g, 0.0, 1.0 / dj);
-    pc.xr.v[j] = dj * (2.0 * xh - xj);
-    pc.x.v[j] = pc.w * ((1.0 + pc.gamma) * xh - pc.gamma * xj) + (1.0 - pc.w) * pc.x0.v[j];
+    const double dj = pc.d.v[j];
+    const double g = pc.c.v[j] - dj * gather(pc.at_entry, pc.at_ptr.v[j], pc.at_ptr.v[j + 1u], pc.yr);
+    const double xj = pc.x.v[j];
+    const double xh = clamp(xj - pc.tau * g, 0.0lf, 1.0lf / dj);
+    pc.xr.v[j] = dj * (2.0lf * xh - xj);
+    pc.x.v[j] = pc.w * ((1.0lf + pc.gamma) * xh - pc.gamma * xj) + (1.0lf - pc.w) * pc.x0.v[j];
     if (pc.last != 0u) {
       pc.xhat.v[j] = xh;
       pc.xs.v[j] = dj * xh;
@@ -65,7 +64,7 @@ void main() {
     }
   }
   if (pc.last != 0u) {  // uniform: the whole workgroup reduces or none does
-    const float s = workgroup_sum(change);
+    const double s = workgroup_sum(change);
     if (gl_LocalInvocationIndex == 0u) pc.partial.v[gl_WorkGroupID.x + gl_WorkGroupID.y * gl_NumWorkGroups.x] = s;
   }
 }

@@ -4,17 +4,17 @@
 #extension GL_EXT_buffer_reference : require
 layout(local_size_x = 256) in;
 
-layout(buffer_reference, std430, buffer_reference_align = 4) restrict buffer Floats { float v[]; };
+layout(buffer_reference, std430, buffer_reference_align = 8) restrict buffer Doubles { double v[]; };
 
 layout(push_constant) uniform Push {
-  Floats xhat, x, x0, partial;
+  Doubles xhat, x, x0, partial;
   uint n;
 } pc;
 
-shared float sums[256];
+shared double sums[256];
 
 // Sum over the workgroup; every invocation must reach it (it has barriers).
-float workgroup_sum(float value) {
+double workgroup_sum(double value) {
   const uint i = gl_LocalInvocationIndex;
   sums[i] = value;
   barrier();
@@ -28,13 +28,13 @@ float workgroup_sum(float value) {
 void main() {
   // A grid wider than the per-dimension workgroup limit continues in y (vk::dispatch_grid).
   const uint j = gl_GlobalInvocationID.x + gl_GlobalInvocationID.y * gl_NumWorkGroups.x * 256u;
-  float change = 0.0;
+  double change = 0.0lf;
   if (j < pc.n) {
-    const float xh = pc.xhat.v[j];
+    const double xh = pc.xhat.v[j];
     change = (xh - pc.x0.v[j]) * (xh - pc.x0.v[j]);
     pc.x.v[j] = xh;
     pc.x0.v[j] = xh;
   }
-  const float s = workgroup_sum(change);
+  const double s = workgroup_sum(change);
   if (gl_LocalInvocationIndex == 0u) pc.partial.v[gl_WorkGroupID.x + gl_WorkGroupID.y * gl_NumWorkGroups.x] = s;
 }

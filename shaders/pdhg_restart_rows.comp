@@ -4,17 +4,17 @@
 #extension GL_EXT_buffer_reference : require
 layout(local_size_x = 256) in;
 
-layout(buffer_reference, std430, buffer_reference_align = 4) restrict buffer Floats { float v[]; };
+layout(buffer_reference, std430, buffer_reference_align = 8) restrict buffer Doubles { double v[]; };
 
 layout(push_constant) uniform Push {
-  Floats yhat, r, y, y0, yr, partial;
+  Doubles yhat, r, y, y0, yr, partial;
   uint m;
 } pc;
 
-shared float sums[256];
+shared double sums[256];
 
 // Sum over the workgroup; every invocation must reach it (it has barriers).
-float workgroup_sum(float value) {
+double workgroup_sum(double value) {
   const uint i = gl_LocalInvocationIndex;
   sums[i] = value;
   barrier();
@@ -28,14 +28,14 @@ float workgroup_sum(float value) {
 void main() {
   // A grid wider than the per-dimension workgroup limit continues in y (vk::dispatch_grid).
   const uint i = gl_GlobalInvocationID.x + gl_GlobalInvocationID.y * gl_NumWorkGroups.x * 256u;
-  float change = 0.0;
+  double change = 0.0lf;
   if (i < pc.m) {
-    const float yh = pc.yhat.v[i];
+    const double yh = pc.yhat.v[i];
     change = (yh - pc.y0.v[i]) * (yh - pc.y0.v[i]);
     pc.y.v[i] = yh;
     pc.y0.v[i] = yh;
     pc.yr.v[i] = pc.r.v[i] * yh;
   }
-  const float s = workgroup_sum(change);
+  const double s = workgroup_sum(change);
   if (gl_LocalInvocationIndex == 0u) pc.partial.v[gl_WorkGroupID.x + gl_WorkGroupID.y * gl_NumWorkGroups.x] = s;
 }

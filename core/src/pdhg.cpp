@@ -251,4 +251,11 @@ LpResult PdhgSolver::solve(const LpProblem& problem, const SolverParams& params)
   return result;
 }
 
+double pdhg_bytes_per_iteration(const LpProblem& problem) {
+  const double n = double(problem.cols()), m = double(problem.rows()), nnz = double(problem.nonzeros());
+  const double primal = 4.0 * (n + 1) + (4.0 + 8.0) * nnz + 8.0 * 4 * n + 8.0 * 2 * n;
+  const double dual = 4.0 * (m + 1) + (4.0 + 8.0) * nnz + 8.0 * 4 * m + 8.0 * 2 * m;
+  return primal + dual;
+}
+
 }  // namespace shapematch

@@ -37,15 +37,13 @@ constexpr uint32_t kLocalSize = 256;  // local_size_x of every pdhg_*.comp
 // Push-constant blocks, member for member as declared in the shaders (addresses are 8 bytes).
 struct PrimalPush {
   uint64_t at_ptr, at_entry, yr, c, d, x, x0, xhat, xs, xr, partial;
-  uint32_t n;
-  float tau, gamma, w;
-  uint32_t last;
+  double tau, gamma, w;
+  uint32_t n, last;
 };
 struct DualPush {
   uint64_t a_ptr, a_entry, xr, b, r, y, y0, yr, yhat, ys, partial;
-  uint32_t m;
-  float sigma, gamma, w;
-  uint32_t last;
+  double sigma, gamma, w;
+  uint32_t m, last;
 };
 struct EvalRowsPush {
   uint64_t a_ptr, a_entry, xs, b, r, yhat, residual_out, by_out;
@@ -64,9 +62,18 @@ struct RestartRowsPush {
   uint32_t m;
 };
 
+// The kernels compute in fp64 and reach buffers by address: one clear error where a device
+// cannot, before any pipeline is made.
+const vk::Context& capable(const vk::Context& context) {
+  if (!context.limits().shader_float64 || !context.limits().buffer_device_address)
+    throw DeviceError("pdhg-vulkan: " + context.info().name + " lacks shaderFloat64, shaderInt64 or "
+                      "bufferDeviceAddress (Vulkan 1.2), which the PDHG kernels need; use pdhg-cpu");
+  return context;
+}
+
 uint32_t groups_in(const std::array<uint32_t, 3>& grid) { return grid[0] * grid[1] * grid[2]; }
 
-// Partial sums: one slot of `groups` floats per reduced quantity, each written by one kernel.
+// Partial sums: one slot of `groups` doubles per reduced quantity, each written by one kernel.
 enum Slot { kDx2, kCx, kNegative, kDy2, kResidual, kBy, kSlots };
 
 // The problem on the device: A and Aᵀ, the column vectors (xs = d·x̂ and xr are scratch), the
@@ -82,7 +89,7 @@ class VulkanBackend final : public PdhgBackend {
 public:
   explicit VulkanBackend(int device_index)
       : context_(device_index),
-        primal_(context_, spv::pdhg_primal, 0, sizeof(PrimalPush)),
+        primal_(capable(context_), spv::pdhg_primal, 0, sizeof(PrimalPush)),
         dual_(context_, spv::pdhg_dual, 0, sizeof(DualPush)),
         eval_rows_(context_, spv::pdhg_eval_rows, 0, sizeof(EvalRowsPush)),
         eval_cols_(context_, spv::pdhg_eval_cols, 0, sizeof(EvalColsPush)),
@@ -91,7 +98,7 @@ public:
 
   std::string device() const override { return "vulkan: " + context_.info().name; }
 
-  void load(const ScaledLp& lp, const std::vector<float>& x, const std::vector<float>& y) override {
+  void load(const ScaledLp& lp, const std::vector<double>& x, const std::vector<double>& y) override {
     const SignedCsr& a = *lp.a;
     const SignedCsr& at = *lp.at;
     n_ = a.cols;
@@ -113,17 +120,19 @@ public:
     const auto u32 = [&](const std::vector<uint32_t>& v) {
       return context_.upload_addressed(std::span<const uint32_t>(v));
     };
-    const auto f32 = [&](const std::vector<float>& v) { return context_.upload_addressed(std::span<const float>(v)); };
-    const auto scratch = [&](int64_t size) { return context_.addressed_buffer(uint64_t(size) * sizeof(float)); };
-    const std::vector<float> zeros_n(n_, 0.0f), zeros_m(m_, 0.0f);  // x̂, ŷ read before any iteration
-    std::vector<float> yr(m_);
+    const auto f64 = [&](const std::vector<double>& v) {
+      return context_.upload_addressed(std::span<const double>(v));
+    };
+    const auto scratch = [&](int64_t size) { return context_.addressed_buffer(uint64_t(size) * sizeof(double)); };
+    const std::vector<double> zeros_n(n_, 0.0), zeros_m(m_, 0.0);  // x̂, ŷ read before any iteration
+    std::vector<double> yr(m_);
     for (int64_t i = 0; i < m_; ++i) yr[i] = lp.row_scale[i] * y[i];
     const uint32_t stride = std::max(col_groups_, row_groups_);
     // Braced initialisation runs in member order, so the first failed allocation stops the rest.
     problem_.emplace(DeviceProblem{u32(a.row_ptr), u32(a.entry), u32(at.row_ptr), u32(at.entry),
-                                   f32(lp.c), f32(lp.col_scale), f32(x), f32(x), f32(zeros_n), scratch(n_),
-                                   scratch(n_), f32(lp.b), f32(lp.row_scale), f32(y), f32(y), f32(yr),
-                                   f32(zeros_m), scratch(m_), scratch(int64_t(kSlots) * stride)});
+                                   f64(lp.c), f64(lp.col_scale), f64(x), f64(x), f64(zeros_n), scratch(n_),
+                                   scratch(n_), f64(lp.b), f64(lp.row_scale), f64(y), f64(y), f64(yr),
+                                   f64(zeros_m), scratch(m_), scratch(int64_t(kSlots) * stride)});
     partials_.resize(size_t(kSlots) * stride);
   }
 
@@ -134,18 +143,18 @@ public:
     for (int it = 0; it < count; ++it) {
       const uint32_t last = it + 1 == count;
       const double kk = static_cast<double>(k0 + it);
-      const float w = static_cast<float>((kk + 1.0) / (kk + 2.0));
+      const double w = (kk + 1.0) / (kk + 2.0);
       sequence.dispatch(primal_,
                         PrimalPush{p.at_ptr.address(), p.at_entry.address(), p.yr.address(), p.c.address(),
                                    p.d.address(), p.x.address(), p.x0.address(), p.xhat.address(),
-                                   p.xs.address(), p.xr.address(), slot(kDx2), uint32_t(n_), step.tau,
-                                   step.gamma, w, last},
+                                   p.xs.address(), p.xr.address(), slot(kDx2), step.tau, step.gamma, w,
+                                   uint32_t(n_), last},
                         col_grid_);
       sequence.dispatch(dual_,
                         DualPush{p.a_ptr.address(), p.a_entry.address(), p.xr.address(), p.b.address(),
                                  p.r.address(), p.y.address(), p.y0.address(), p.yr.address(),
-                                 p.yhat.address(), p.ys.address(), slot(kDy2), uint32_t(m_), step.sigma,
-                                 step.gamma, w, last},
+                                 p.yhat.address(), p.ys.address(), slot(kDy2), step.sigma, step.gamma, w,
+                                 uint32_t(m_), last},
                         row_grid_);
     }
     sequence.dispatch(eval_rows_,
@@ -183,20 +192,20 @@ public:
     return {sum(kDx2, col_groups_), sum(kDy2, row_groups_)};
   }
 
-  void read(std::vector<float>& xhat, std::vector<float>& yhat) override {
+  void read(std::vector<double>& xhat, std::vector<double>& yhat) override {
     const DeviceProblem& p = loaded("read");
-    xhat = context_.download<float>(p.xhat, size_t(n_));
-    yhat = context_.download<float>(p.yhat, size_t(m_));
+    xhat = context_.download<double>(p.xhat, size_t(n_));
+    yhat = context_.download<double>(p.yhat, size_t(m_));
   }
 
 private:
   // One clear error before allocating a problem that cannot fit, rather than a failed
   // allocation halfway through the uploads.
   void check_memory(const SignedCsr& a, const SignedCsr& at) const {
-    const uint64_t words = a.row_ptr.size() + a.entry.size() + at.row_ptr.size() + at.entry.size() +
-                           7 * uint64_t(n_) + 7 * uint64_t(m_) +
-                           uint64_t(kSlots) * std::max(col_groups_, row_groups_);
-    const uint64_t bytes = 4 * words, available = context_.limits().device_local_bytes;
+    const uint64_t bytes = 4 * (a.row_ptr.size() + a.entry.size() + at.row_ptr.size() + at.entry.size()) +
+                           8 * (7 * uint64_t(n_) + 7 * uint64_t(m_) +
+                                uint64_t(kSlots) * std::max(col_groups_, row_groups_));
+    const uint64_t available = context_.limits().device_local_bytes;
     if (bytes > available)
       throw DeviceError("pdhg-vulkan: the problem (" + std::to_string(m_) + " x " + std::to_string(n_) + ", " +
                         std::to_string(a.entry.size()) + " nonzeros) needs " + std::to_string(bytes >> 20) +
@@ -210,11 +219,11 @@ private:
   }
 
   uint64_t slot(Slot s) const {
-    return problem_->partial.address() + uint64_t(s) * std::max(col_groups_, row_groups_) * sizeof(float);
+    return problem_->partial.address() + uint64_t(s) * std::max(col_groups_, row_groups_) * sizeof(double);
   }
 
   void download_partials() {
-    context_.download(problem_->partial, partials_.data(), partials_.size() * sizeof(float));
+    context_.download(problem_->partial, partials_.data(), partials_.size() * sizeof(double));
   }
 
   double sum(Slot s, uint32_t groups) const {
@@ -228,7 +237,7 @@ private:
   int64_t n_ = 0, m_ = 0;
   std::array<uint32_t, 3> col_grid_{}, row_grid_{};
   uint32_t col_groups_ = 0, row_groups_ = 0;
-  std::vector<float> partials_;
+  std::vector<double> partials_;
 };
 
 }  // namespace

@@ -31,4 +31,11 @@ private:
   PdhgOptions options_;
 };
 
+// Memory traffic of one PDHG iteration in the data layout of pdhg_backend.hpp, counting every
+// array element touched once (gathers as 8 bytes, no write-allocate): the primal kernel reads
+// Aᵀ's row_ptr and entries (4 bytes each), gathers yr per nonzero and reads c, d, x, x⁰ and writes
+// x, xr (8 bytes each); the dual kernel does the same over A with b, r, y, y⁰ and writes y, yr.
+// Dividing it by a measured streaming bandwidth gives the time bound of one iteration.
+double pdhg_bytes_per_iteration(const LpProblem& problem);
+
 }  // namespace shapematch

@@ -62,6 +62,7 @@ void describe(VkPhysicalDevice physical, int index, DeviceInfo& info, Limits& li
   limits.device_local_bytes = largest_device_local_heap(memory);
   limits.max_memory_allocation_size = maintenance3.maxMemoryAllocationSize;
   limits.buffer_device_address = address.bufferDeviceAddress && features.features.shaderInt64;
+  limits.shader_float64 = features.features.shaderFloat64;
 
   info.index = index;
   info.name = props.properties.deviceName;
@@ -166,9 +167,11 @@ Context::Context(int requested_index, Transfers transfers) : instance_(create_in
   VkPhysicalDeviceBufferDeviceAddressFeatures address{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_BUFFER_DEVICE_ADDRESS_FEATURES};
   address.bufferDeviceAddress = VK_TRUE;
   VkPhysicalDeviceFeatures2 features{VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2, &address};
-  features.features.shaderInt64 = VK_TRUE;
+  features.features.shaderInt64 = limits_.buffer_device_address;
+  features.features.shaderFloat64 = limits_.shader_float64;
+  if (!limits_.buffer_device_address) features.pNext = nullptr;
   VkDeviceCreateInfo create{VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO};
-  if (limits_.buffer_device_address) create.pNext = &features;
+  create.pNext = &features;
   create.queueCreateInfoCount = 1;
   create.pQueueCreateInfos = &queue;
   VkDevice device = VK_NULL_HANDLE;
@@ -198,7 +201,7 @@ Buffer Context::storage_buffer(uint64_t bytes) {
 Buffer Context::addressed_buffer(uint64_t bytes) {
   if (!limits_.buffer_device_address)
     throw DeviceError(info_.name + " lacks the Vulkan 1.2 features bufferDeviceAddress and "
-                      "shaderInt64 that the PDHG kernels need");
+                      "shaderInt64 that addressed buffers need");
   if (bytes > limits_.max_memory_allocation_size)
     throw DeviceError("a buffer of " + std::to_string(bytes) + " bytes (" + mib(bytes) +
                       ") exceeds the maxMemoryAllocationSize of " + mib(limits_.max_memory_allocation_size) +

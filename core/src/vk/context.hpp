@@ -23,8 +23,9 @@ struct Limits {
   uint64_t device_local_bytes = 0;  // largest device-local heap
   uint64_t max_memory_allocation_size = 0;  // bytes one allocation (so one buffer) may span
   // Buffer device addresses and 64-bit integers in shaders (Vulkan 1.2 features), what
-  // addressed buffers need; enabled on the device when present.
+  // addressed buffers need; enabled on the device when present, as is shader_float64.
   bool buffer_device_address = false;
+  bool shader_float64 = false;
 };
 
 // Instance creation and device enumeration, shared by Context and shapematch::list_devices()

@@ -1,0 +1,249 @@
+// `shapematch match X Y`: the whole pipeline — load, LP, rounding, verification, outputs.
+#include "commands.hpp"
+#include "shapematch/device.hpp"
+#include "shapematch/errors.hpp"
+#include "shapematch/json.hpp"
+#include "shapematch/matching.hpp"
+#include "shapematch/render.hpp"
+#include "shapematch/rounding.hpp"
+#include "shapematch/system.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <sstream>
+
+namespace fs = std::filesystem;
+
+namespace shapematch::app {
+namespace {
+
+struct MatchArgs {
+  std::string x, y;
+  std::string out = "shapematch-out";
+  std::string backend = "auto";
+  int faces = 200;
+  bool keep_scale = false;
+  double bending = 1.0;
+  std::vector<double> lame{1.0, 1.0};
+  double threshold = 0.5;
+  int max_rounds = 50;
+  double tolerance = 1e-4;
+  double time_limit = std::numeric_limits<double>::infinity();
+  int device = -1;
+};
+
+// auto: a GPU if there is one, else the native solver (lavapipe is for testing, not speed).
+std::string solver_for(const MatchArgs& a) {
+  if (a.backend == "cpu") return "pdhg-cpu";
+  if (a.backend == "vulkan") return "pdhg-vulkan";
+  if (a.backend == "clp") return "clp-dual";
+  try {
+    const DeviceInfo d = choose_device(a.device);
+    if (d.type == "discrete" || d.type == "integrated") return "pdhg-vulkan";
+  } catch (const DeviceError&) {
+  }
+  return "pdhg-cpu";
+}
+
+std::string lines(const std::vector<int>& values) {
+  std::string s;
+  for (int v : values) s += std::to_string(v) + "\n";
+  return s;
+}
+
+// Writes everything into a fresh temporary directory next to `out` and renames it into place,
+// so that a failure never leaves a half-written output directory.
+void publish(const fs::path& tmp, const fs::path& out) {
+  std::error_code ec;
+  fs::path old;
+  if (fs::exists(out)) {
+    old = out.string() + ".old-" + std::to_string(std::random_device{}());
+    fs::rename(out, old, ec);
+    if (ec) throw IoError(out.string() + ": cannot replace (" + ec.message() + ")");
+  }
+  fs::rename(tmp, out, ec);
+  if (ec) {
+    if (!old.empty()) fs::rename(old, out);
+    throw IoError(out.string() + ": " + ec.message());
+  }
+  if (!old.empty()) fs::remove_all(old);
+}
+
+int run_match(const MatchArgs& args) {
+  Stopwatch total, stage;
+  Json seconds = Json::object();
+  LoadOptions load;
+  load.normalize_area = !args.keep_scale;
+  Mesh x = load_mesh(args.x, load);
+  Mesh y = load_mesh(args.y, load);
+  const int vx_input = x.num_vertices(), vy_input = y.num_vertices();
+  if (args.faces > 0) {
+    x = decimate(x, args.faces);
+    y = decimate(y, args.faces);
+  }
+  const Geometry gx = compute_geometry(x), gy = compute_geometry(y);
+  seconds.set("load", stage.seconds());
+  spdlog::info("X: {} ({} faces), Y: {} ({} faces)", x.name, x.num_faces(), y.name, y.num_faces());
+
+  stage.reset();
+  MatchingLpOptions lp_options;
+  lp_options.energy.bending_weight = args.bending;
+  lp_options.energy.lame_lambda = args.lame.at(0);
+  lp_options.energy.lame_mu = args.lame.at(1);
+  const MatchingLp m = build_matching_lp(x, gx, y, gy, lp_options);
+  seconds.set("build", stage.seconds());
+  spdlog::info("LP: {} variables, {} constraints, {} nonzeros", m.lp.cols(), m.lp.rows(), m.lp.nonzeros());
+
+  stage.reset();
+  RoundingOptions ro;
+  ro.solver = solver_for(args);
+  ro.threshold = args.threshold;
+  ro.max_rounds = args.max_rounds;
+  ro.lp.tolerance = args.tolerance;
+  ro.lp.time_limit = args.time_limit;
+  ro.lp.device = args.device;
+  const RoundingResult rr = round_to_graph_surface(m.space, m.lp, m.energy, ro, [](const RoundingRound& r) {
+    spdlog::info("round {:>2}: {:>9} variables, LP {} in {} it, objective {:.6g}, fixed {} to 1 and {} to 0{} ({:.2f} s)",
+                 r.round, r.variables, to_string(r.status), r.iterations, r.objective, r.fixed_to_one,
+                 r.fixed_to_zero, r.undone ? " (undone: fixed fewer)" : "", r.seconds);
+  });
+  seconds.set("solve_and_round", stage.seconds());
+
+  stage.reset();
+  // satisfies_exactly already ran inside the rounding; Theorem 1 is checked here independently.
+  const bool verified = satisfies_exactly(m.lp, rr.gamma);
+  const GraphSurfaceCheck theorem = check_graph_surface(m.space, rr.gamma);
+  // Exactness, coverage and orientation are guaranteed by construction: a failure is a bug.
+  if (!verified || !theorem.covers_x || !theorem.covers_y || !theorem.orientation)
+    throw SolverError(std::string("the rounded matching failed verification (a bug; A x = b ") +
+                      (verified ? "holds" : "fails") + ", covers X " + (theorem.covers_x ? "yes" : "no") +
+                      ", covers Y " + (theorem.covers_y ? "yes" : "no") + ", orientation " +
+                      (theorem.orientation ? "yes" : "no") + "); nothing was written");
+  // The constraints of (13) admit solutions that are not continuous everywhere (measured on
+  // coarse pairs): report them rather than hide them.
+  if (!theorem.continuous)
+    spdlog::warn("continuity: {} edges of X and {} edges of Y have images that are not one connected piece",
+                 theorem.discontinuous_edges_x, theorem.discontinuous_edges_y);
+  const VertexMaps maps = vertex_maps(m.space, rr.gamma);
+  seconds.set("verify", stage.seconds());
+  spdlog::info("energy {:.6g}, lower bound {:.6g}, gap {:.2f} %, {} rounds, verified", rr.energy, rr.lower_bound,
+               100 * rr.gap, rr.rounds.size());
+
+  stage.reset();
+  const fs::path out = fs::absolute(args.out);
+  const fs::path tmp = out.string() + ".tmp-" + std::to_string(std::random_device{}());
+  fs::create_directories(tmp);
+  try {
+    write_file_atomic((tmp / "map_x_to_y.txt").string(), lines(maps.x_to_y));
+    write_file_atomic((tmp / "map_y_to_x.txt").string(), lines(maps.y_to_x));
+    std::ostringstream gs;
+    for (int64_t j : rr.gamma) {
+      const ProductTriangle t = m.space[j];
+      gs << t.a[0] << ' ' << t.a[1] << ' ' << t.a[2] << ' ' << t.b[0] << ' ' << t.b[1] << ' ' << t.b[2] << '\n';
+    }
+    write_file_atomic((tmp / "graph_surface.txt").string(), gs.str());
+    const auto colors_x = smooth_colors(x);
+    const auto colors_y = transfer_colors(colors_x, maps.y_to_x);
+    save_mesh(x, (tmp / "x.ply").string(), colors_x);
+    save_mesh(y, (tmp / "y.ply").string(), colors_y);
+    write_png(render_side_by_side(x, colors_x, y, colors_y, RenderOptions{}), (tmp / "match.png").string());
+    seconds.set("output", stage.seconds());
+    seconds.set("total", total.seconds());
+
+    Json rounds = Json::array();
+    for (const auto& r : rr.rounds)
+      rounds.push(Json::object()
+                      .set("round", r.round)
+                      .set("variables", r.variables)
+                      .set("constraints", r.constraints)
+                      .set("status", to_string(r.status))
+                      .set("iterations", r.iterations)
+                      .set("objective", r.objective)
+                      .set("fixed_to_one", r.fixed_to_one)
+                      .set("fixed_to_zero", r.fixed_to_zero)
+                      .set("undone", r.undone)
+                      .set("seconds", r.seconds));
+    Json report = Json::object();
+    report.set("x", Json::object()
+                        .set("file", args.x)
+                        .set("vertices_input", vx_input)
+                        .set("vertices", x.num_vertices())
+                        .set("faces", x.num_faces()));
+    report.set("y", Json::object()
+                        .set("file", args.y)
+                        .set("vertices_input", vy_input)
+                        .set("vertices", y.num_vertices())
+                        .set("faces", y.num_faces()));
+    report.set("variables", m.lp.cols()).set("constraints", m.lp.rows()).set("nonzeros", m.lp.nonzeros());
+    report.set("backend", ro.solver).set("device", rr.first_lp.device);
+    report.set("energy", rr.energy).set("lower_bound", rr.lower_bound).set("gap", rr.gap);
+    report.set("first_lp_objective", rr.first_lp.objective).set("first_lp_status", to_string(rr.first_lp.status));
+    report.set("rounds", static_cast<int64_t>(rr.rounds.size()));
+    report.set("verified", true);
+    report.set("theorem1", Json::object()
+                               .set("covers_x", theorem.covers_x)
+                               .set("covers_y", theorem.covers_y)
+                               .set("orientation_preserved", theorem.orientation)
+                               .set("continuous", theorem.continuous)
+                               .set("discontinuous_edges_x", theorem.discontinuous_edges_x)
+                               .set("discontinuous_edges_y", theorem.discontinuous_edges_y));
+    report.set("graph_surface_triangles", static_cast<int64_t>(rr.gamma.size()));
+    report.set("options", Json::object()
+                              .set("bending", args.bending)
+                              .set("lame_lambda", args.lame.at(0))
+                              .set("lame_mu", args.lame.at(1))
+                              .set("threshold", args.threshold)
+                              .set("tolerance", args.tolerance)
+                              .set("faces", args.faces)
+                              .set("keep_scale", args.keep_scale));
+    report.set("seconds", seconds);
+    report.set("peak_rss_mb", peak_rss_mb());
+    report.set("round_log", rounds);
+    write_file_atomic((tmp / "report.json").string(), report.dump() + "\n");
+    publish(tmp, out);
+  } catch (...) {
+    std::error_code ec;
+    fs::remove_all(tmp, ec);
+    throw;
+  }
+  spdlog::info("wrote {}", out.string());
+  return 0;
+}
+
+}  // namespace
+
+Action add_match_command(CLI::App& app) {
+  auto a = std::make_shared<MatchArgs>();
+  app.add_option("x", a->x, "first mesh (OFF, OBJ, PLY, STL); default: bundled asset");
+  app.add_option("y", a->y, "second mesh; default: bundled asset");
+  app.add_option("-o,--out", a->out, "output directory")->capture_default_str();
+  app.add_option("--backend", a->backend, "LP backend")
+      ->check(CLI::IsMember({"auto", "vulkan", "cpu", "clp"}))
+      ->capture_default_str();
+  app.add_option("--device", a->device, "Vulkan device index (see `shapematch devices`)");
+  app.add_option("--faces", a->faces, "decimate both meshes to about N faces first (0: keep)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  app.add_flag("--keep-scale", a->keep_scale, "do not normalise both shapes to unit area");
+  app.add_option("--bending", a->bending, "bending weight")->capture_default_str();
+  app.add_option("--lame", a->lame, "Lamé parameters λ,μ of the membrane")->delimiter(',')->expected(2);
+  app.add_option("--threshold", a->threshold, "fix LP values above this to 1")
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str();
+  app.add_option("--max-rounds", a->max_rounds, "rounding rounds before giving up")->capture_default_str();
+  app.add_option("--tol", a->tolerance, "LP tolerance")->capture_default_str();
+  app.add_option("--time-limit", a->time_limit, "time limit of each LP solve, seconds");
+  return [a] {
+    if (a->x.empty() != a->y.empty()) throw InvalidInputError("give both meshes X and Y, or neither");
+    if (a->x.empty()) {
+      a->x = default_mesh_x();
+      a->y = default_mesh_y();
+    }
+    return run_match(*a);
+  };
+}
+
+}  // namespace shapematch::app

@@ -1,0 +1,68 @@
+#pragma once
+// Rounding the LP relaxation to a binary discrete graph surface by iterative fixing (§4.1,
+// DESIGN.md §6), and reading the result (DESIGN.md §8).
+#include "shapematch/lp.hpp"
+#include "shapematch/product_space.hpp"
+
+#include <functional>
+
+namespace shapematch {
+
+struct RoundingOptions {
+  double threshold = 0.5;      // fix every variable above this to 1
+  int max_rounds = 50;         // then fail with SolverError rather than return a wrong answer
+  std::string solver = "pdhg-cpu";
+  SolverParams lp;             // parameters of every LP solve (warm starts are filled in)
+};
+
+struct RoundingRound {
+  int round = 0;
+  int64_t variables = 0;       // free variables in this round's LP
+  int64_t constraints = 0;
+  int64_t fixed_to_one = 0;    // fixed after this round's solve
+  int64_t fixed_to_zero = 0;   // forced to 0 by propagation
+  LpStatus status = LpStatus::Optimal;
+  int64_t iterations = 0;
+  double objective = 0.0;      // of this round's LP, including the fixed part
+  double seconds = 0.0;
+  bool undone = false;         // the fixing made the LP infeasible and was replaced by a smaller one
+};
+
+struct RoundingResult {
+  std::vector<int64_t> gamma;  // selected variables (indices into the space), sorted
+  double energy = 0.0;         // Σ energy of Γ, unscaled
+  double lower_bound = 0.0;    // certified bound of the first LP
+  double gap = 0.0;            // (energy − bound) / |bound|
+  LpResult first_lp;           // the relaxation before any fixing
+  std::vector<RoundingRound> rounds;
+};
+
+// Calls `progress(round)` after each round (for a progress line); may be empty.
+RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem& lp, const std::vector<double>& energy,
+                                      const RoundingOptions& options = {},
+                                      const std::function<void(const RoundingRound&)>& progress = {});
+
+// A x = b checked exactly in integers for the 0/1 vector with ones at `gamma`.
+bool satisfies_exactly(const LpProblem& lp, const std::vector<int64_t>& gamma);
+
+// What Theorem 1 promises, checked on a result.
+struct GraphSurfaceCheck {
+  bool covers_x = false, covers_y = false;      // every face of X (Y) in exactly one product triangle
+  bool orientation = false;                     // every real face mapped with its own cyclic order
+  bool continuous = false;                      // no discontinuous edge on either side
+  int64_t discontinuous_edges_x = -1;           // edges of X whose two faces' images, the patch
+  int64_t discontinuous_edges_y = -1;           // the edge is stretched over and the patches of its
+                                                // end points are not one connected piece
+  bool ok() const { return covers_x && covers_y && orientation && continuous; }
+};
+GraphSurfaceCheck check_graph_surface(const ProductSpace& space, const std::vector<int64_t>& gamma);
+
+// Vertex maps read off Γ: for every vertex one partner on the other shape, preferring partners
+// from product triangles that are real on both sides.
+struct VertexMaps {
+  std::vector<int> x_to_y;
+  std::vector<int> y_to_x;
+};
+VertexMaps vertex_maps(const ProductSpace& space, const std::vector<int64_t>& gamma);
+
+}  // namespace shapematch

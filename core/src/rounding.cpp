@@ -1,0 +1,385 @@
+#include "shapematch/rounding.hpp"
+
+#include "shapematch/errors.hpp"
+#include "shapematch/system.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <cmath>
+#include <deque>
+#include <numeric>
+#include <optional>
+
+namespace shapematch {
+namespace {
+
+// The fixing state: each variable free (−1), 0 or 1, and for every row its residual right-hand
+// side and number of free +1 / −1 entries. Unit propagation keeps it consistent.
+struct FixState {
+  std::vector<int8_t> value;
+  std::vector<int64_t> rhs;
+  std::vector<int32_t> free_pos, free_neg;
+  int64_t unsatisfied = 0;  // rows with rhs ≠ 0
+  int64_t ones = 0, zeros = 0;
+};
+
+class Fixer {
+public:
+  explicit Fixer(const LpProblem& lp) : lp_(lp) {
+    s_.value.assign(lp.cols(), -1);
+    s_.rhs.resize(lp.rows());
+    s_.free_pos.assign(lp.rows(), 0);
+    s_.free_neg.assign(lp.rows(), 0);
+    for (int64_t i = 0; i < lp.rows(); ++i) {
+      s_.rhs[i] = std::llround(lp.b[i]);
+      s_.unsatisfied += s_.rhs[i] != 0;
+      for (uint32_t k = lp.a.row_ptr[i]; k < lp.a.row_ptr[i + 1]; ++k)
+        ++(is_negative(lp.a.entry[k]) ? s_.free_neg : s_.free_pos)[i];
+    }
+  }
+
+  const FixState& state() const { return s_; }
+  void restore(const FixState& s) { s_ = s; }
+
+  // Fixes the variables and propagates; false if that proves the system infeasible.
+  bool fix(const std::vector<std::pair<int64_t, int>>& assignments) {
+    std::deque<int64_t> queue;
+    for (const auto& [j, v] : assignments)
+      if (!assign(j, v, queue)) return false;
+    return propagate(queue);
+  }
+
+  // Propagates from every row (used once at the start).
+  bool propagate_all() {
+    std::deque<int64_t> queue(lp_.rows());
+    std::iota(queue.begin(), queue.end(), 0);
+    return propagate(queue);
+  }
+
+private:
+  bool assign(int64_t j, int v, std::deque<int64_t>& queue) {
+    if (s_.value[j] >= 0) return s_.value[j] == v;
+    s_.value[j] = static_cast<int8_t>(v);
+    ++(v ? s_.ones : s_.zeros);
+    for (uint32_t k = lp_.at.row_ptr[j]; k < lp_.at.row_ptr[j + 1]; ++k) {
+      const uint32_t e = lp_.at.entry[k];
+      const int64_t i = col_of(e);
+      const bool neg = is_negative(e);
+      --(neg ? s_.free_neg : s_.free_pos)[i];
+      if (v) {
+        const bool was = s_.rhs[i] != 0;
+        s_.rhs[i] -= neg ? -1 : 1;
+        s_.unsatisfied += (s_.rhs[i] != 0) - was;
+      }
+      queue.push_back(i);
+    }
+    return true;
+  }
+
+  // A row's free entries can reach [−free_neg, free_pos]: outside is infeasible, at either end
+  // every free entry is determined.
+  bool propagate(std::deque<int64_t>& queue) {
+    while (!queue.empty()) {
+      const int64_t i = queue.front();
+      queue.pop_front();
+      const int64_t r = s_.rhs[i], pos = s_.free_pos[i], neg = s_.free_neg[i];
+      if (r > pos || r < -neg) return false;
+      if (pos + neg == 0 || (r != pos && r != -neg)) continue;
+      // r == pos: + entries 1, − entries 0; r == −neg: − entries 1, + entries 0.
+      const bool plus_is_one = r == pos && !(r == -neg && pos == 0);
+      for (uint32_t k = lp_.a.row_ptr[i]; k < lp_.a.row_ptr[i + 1]; ++k) {
+        const uint32_t e = lp_.a.entry[k];
+        const int64_t j = col_of(e);
+        if (s_.value[j] >= 0) continue;
+        const int v = (is_negative(e) != plus_is_one) ? 1 : 0;
+        if (!assign(j, v, queue)) return false;
+      }
+    }
+    return true;
+  }
+
+  const LpProblem& lp_;
+  FixState s_;
+};
+
+// The LP over the free variables and the rows that still contain one.
+struct Reduced {
+  LpProblem lp;
+  std::vector<int64_t> cols, rows;
+  double fixed_cost = 0.0;  // scaled cost of the variables fixed to 1
+};
+
+Reduced reduce(const LpProblem& full, const FixState& s) {
+  Reduced r;
+  std::vector<int64_t> row_new(full.rows(), -1);
+  for (int64_t i = 0; i < full.rows(); ++i)
+    if (s.free_pos[i] + s.free_neg[i] > 0) {
+      row_new[i] = static_cast<int64_t>(r.rows.size());
+      r.rows.push_back(i);
+    }
+  for (int64_t j = 0; j < full.cols(); ++j) {
+    if (s.value[j] < 0) r.cols.push_back(j);
+    else if (s.value[j] == 1) r.fixed_cost += full.c[j];
+  }
+  SignedCsr& at = r.lp.at;
+  at.rows = static_cast<int64_t>(r.cols.size());
+  at.cols = static_cast<int64_t>(r.rows.size());
+  at.row_ptr.assign(1, 0);
+  for (int64_t j : r.cols) {
+    for (uint32_t k = full.at.row_ptr[j]; k < full.at.row_ptr[j + 1]; ++k) {
+      const uint32_t e = full.at.entry[k];
+      at.entry.push_back(static_cast<uint32_t>(row_new[col_of(e)]) | (e & SignedCsr::kNegative));
+    }
+    at.row_ptr.push_back(static_cast<uint32_t>(at.entry.size()));
+  }
+  r.lp.a = transpose(at);
+  r.lp.b.resize(r.rows.size());
+  for (size_t i = 0; i < r.rows.size(); ++i) r.lp.b[i] = static_cast<double>(s.rhs[r.rows[i]]);
+  r.lp.c.resize(r.cols.size());
+  for (size_t j = 0; j < r.cols.size(); ++j) r.lp.c[j] = full.c[r.cols[j]];
+  r.lp.objective_scale = full.objective_scale;
+  return r;
+}
+
+// Fixes the batch (largest first); a fixing that propagation proves infeasible is undone and
+// replaced by fixing fewer (halving down to the single largest), and a single variable that
+// cannot be 1 is fixed to 0 instead: each retry strictly shrinks the search space. Returns
+// whether anything had to be undone.
+bool shrink_and_fix(Fixer& fixer, std::vector<std::pair<int64_t, int>> batch, const FixState& before) {
+  bool undone = false;
+  while (!fixer.fix(batch)) {
+    fixer.restore(before);
+    undone = true;
+    if (batch.size() > 1) {
+      batch.resize(batch.size() / 2);
+    } else if (batch.front().second == 1) {
+      batch.front().second = 0;
+    } else {
+      throw SolverError("rounding: no consistent fixing exists (the LP is infeasible)");
+    }
+  }
+  return undone;
+}
+
+}  // namespace
+
+bool satisfies_exactly(const LpProblem& lp, const std::vector<int64_t>& gamma) {
+  std::vector<int64_t> ax(lp.rows(), 0);
+  for (int64_t j : gamma) {
+    if (j < 0 || j >= lp.cols()) return false;
+    for (uint32_t k = lp.at.row_ptr[j]; k < lp.at.row_ptr[j + 1]; ++k)
+      ax[col_of(lp.at.entry[k])] += is_negative(lp.at.entry[k]) ? -1 : 1;
+  }
+  for (int64_t i = 0; i < lp.rows(); ++i)
+    if (ax[i] != std::llround(lp.b[i]) || std::abs(lp.b[i] - std::round(lp.b[i])) > 0) return false;
+  return true;
+}
+
+RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem& lp, const std::vector<double>& energy,
+                                      const RoundingOptions& options,
+                                      const std::function<void(const RoundingRound&)>& progress) {
+  if (static_cast<int64_t>(energy.size()) != lp.cols() || space.size() != lp.cols())
+    throw InvalidInputError("rounding: the space, the LP and the energies disagree in size");
+  auto solver = make_solver(options.solver);
+  RoundingResult result;
+  Fixer fixer(lp);
+  if (!fixer.propagate_all()) throw SolverError("rounding: the matching LP is infeasible before any fixing");
+
+  std::vector<double> x_full(lp.cols(), 0.0), y_full(lp.rows(), 0.0);
+  struct Step {
+    FixState before;
+    std::vector<std::pair<int64_t, int>> batch;
+  };
+  std::optional<Step> last;  // the last fixing, to undo if the next LP is infeasible
+  for (int round = 1; fixer.state().unsatisfied > 0; ++round) {
+    if (round > options.max_rounds)
+      throw SolverError("rounding did not reach a binary solution in " + std::to_string(options.max_rounds) +
+                        " rounds (raise --max-rounds or lower --threshold)");
+    Stopwatch clock;
+    const Reduced red = reduce(lp, fixer.state());
+    SolverParams params = options.lp;
+    if (round > 1) {
+      params.initial_x.resize(red.cols.size());
+      params.initial_y.resize(red.rows.size());
+      for (size_t j = 0; j < red.cols.size(); ++j) params.initial_x[j] = x_full[red.cols[j]];
+      for (size_t i = 0; i < red.rows.size(); ++i) params.initial_y[i] = y_full[red.rows[i]];
+    }
+    const LpResult r = solver->solve(red.lp, params);
+    RoundingRound info;
+    info.round = round;
+    info.variables = red.lp.cols();
+    info.constraints = red.lp.rows();
+    info.status = r.status;
+    info.iterations = r.iterations;
+    info.objective = r.objective + lp.objective_scale * red.fixed_cost;
+    if (round == 1) result.first_lp = r;
+
+    if (r.status == LpStatus::Infeasible) {
+      // The last fixing left an infeasible LP that propagation could not see: undo it and fix less.
+      if (!last) throw SolverError("rounding: the matching LP is infeasible");
+      fixer.restore(last->before);
+      info.undone = true;
+      auto smaller = last->batch;
+      if (smaller.size() > 1) smaller.resize(smaller.size() / 2);
+      else if (smaller.front().second == 1) smaller.front().second = 0;  // the single variable cannot be 1
+      else throw SolverError("rounding: no consistent fixing exists (the LP is infeasible)");
+      shrink_and_fix(fixer, smaller, last->before);
+      info.fixed_to_one = fixer.state().ones - last->before.ones;
+      info.fixed_to_zero = fixer.state().zeros - last->before.zeros;
+      info.seconds = clock.seconds();
+      result.rounds.push_back(info);
+      if (progress) progress(info);
+      last->batch = smaller;  // if that is still infeasible, shrink further
+      continue;
+    }
+    if (r.status == LpStatus::NumericalTrouble || r.x.size() != size_t(red.lp.cols()))
+      throw SolverError(std::string("rounding: LP solve failed (") + to_string(r.status) + ")");
+    if (r.status != LpStatus::Optimal)
+      spdlog::warn("round {}: LP ended with status {}; rounding its current iterate", round, to_string(r.status));
+    for (size_t j = 0; j < red.cols.size(); ++j) x_full[red.cols[j]] = r.x[j];
+    for (size_t i = 0; i < red.rows.size(); ++i) y_full[red.rows[i]] = r.y.empty() ? 0.0 : r.y[i];
+
+    // Candidates above the threshold, largest first; if none, the single largest.
+    std::vector<int64_t> order(red.cols.size());
+    std::iota(order.begin(), order.end(), 0);
+    std::sort(order.begin(), order.end(), [&](int64_t p, int64_t q) { return r.x[p] > r.x[q]; });
+    std::vector<std::pair<int64_t, int>> batch;
+    for (int64_t k : order) {
+      if (r.x[k] <= options.threshold) break;
+      batch.push_back({red.cols[k], 1});
+    }
+    if (batch.empty()) batch.push_back({red.cols[order.front()], 1});
+
+    last = Step{fixer.state(), batch};
+    const int64_t ones_before = last->before.ones, zeros_before = last->before.zeros;
+    info.undone = shrink_and_fix(fixer, batch, last->before);
+    info.fixed_to_one = fixer.state().ones - ones_before;
+    info.fixed_to_zero = fixer.state().zeros - zeros_before;
+    info.seconds = clock.seconds();
+    result.rounds.push_back(info);
+    if (progress) progress(info);
+  }
+
+  // Every row is satisfied: the remaining free variables are 0.
+  const FixState& s = fixer.state();
+  for (int64_t j = 0; j < lp.cols(); ++j)
+    if (s.value[j] == 1) result.gamma.push_back(j);
+  if (!satisfies_exactly(lp, result.gamma))
+    throw SolverError("rounding produced a Γ that violates A x = b (a bug); nothing was written");
+  for (int64_t j : result.gamma) result.energy += energy[j];
+  if (result.rounds.empty()) {  // propagation alone decided everything (tiny problems)
+    result.first_lp = solver->solve(lp, options.lp);
+  }
+  result.lower_bound = result.first_lp.lower_bound;
+  result.gap = (result.energy - result.lower_bound) / std::max(std::abs(result.lower_bound), 1e-300);
+  return result;
+}
+
+GraphSurfaceCheck check_graph_surface(const ProductSpace& space, const std::vector<int64_t>& gamma) {
+  const Mesh& X = space.x();
+  const Mesh& Y = space.y();
+  GraphSurfaceCheck check;
+  std::vector<int> cover_x(X.num_faces(), 0), cover_y(Y.num_faces(), 0);
+  bool orientation = true;
+  auto is_rotation = [](const std::array<int, 3>& t, const std::array<int, 3>& f) {
+    for (int r = 0; r < 3; ++r)
+      if (t[0] == f[r] && t[1] == f[(r + 1) % 3] && t[2] == f[(r + 2) % 3]) return true;
+    return false;
+  };
+  // Images (as sets of vertices of the other shape) of every real face, and of every edge
+  // stretched over a patch (the product triangles degenerate on that side).
+  std::vector<std::array<int, 3>> image_x(X.num_faces()), image_y(Y.num_faces());
+  std::vector<std::vector<std::array<int, 3>>> stretched_x(X.num_edges()), stretched_y(Y.num_edges());
+  std::vector<std::vector<std::array<int, 3>>> collapsed_x(X.num_vertices()), collapsed_y(Y.num_vertices());
+  for (int64_t j : gamma) {
+    const ProductTriangle t = space[j];
+    if (t.fa >= 0) {
+      ++cover_x[t.fa];
+      orientation = orientation && is_rotation(t.a, X.faces[t.fa]);
+      image_x[t.fa] = t.b;
+    } else if (t.a[0] != t.a[1]) {
+      stretched_x[X.edge_index(t.a[0], t.a[1])].push_back(t.b);
+    } else {
+      collapsed_x[t.a[0]].push_back(t.b);
+    }
+    if (t.fb >= 0) {
+      ++cover_y[t.fb];
+      orientation = orientation && is_rotation(t.b, Y.faces[t.fb]);
+      image_y[t.fb] = t.a;
+    } else if (t.b[0] != t.b[1]) {
+      stretched_y[Y.edge_index(t.b[0], t.b[1])].push_back(t.a);
+    } else {
+      collapsed_y[t.b[0]].push_back(t.a);
+    }
+  }
+  check.covers_x = std::all_of(cover_x.begin(), cover_x.end(), [](int c) { return c == 1; });
+  check.covers_y = std::all_of(cover_y.begin(), cover_y.end(), [](int c) { return c == 1; });
+  check.orientation = orientation;
+  // Continuity (Theorem 1 b, c): for two faces sharing an edge e, their images, the patch Γ(e)
+  // that e is stretched over and the patches its end points are blown up to form one connected
+  // piece of the other shape (consecutive pieces share a vertex).
+  auto continuous = [](const Mesh& mesh, const std::vector<std::array<int, 3>>& image,
+                       const std::vector<std::vector<std::array<int, 3>>>& stretched,
+                       const std::vector<std::vector<std::array<int, 3>>>& collapsed) {
+    int64_t broken = 0;
+    std::vector<std::array<int, 2>> edge_faces(mesh.num_edges(), {-1, -1});
+    for (int f = 0; f < mesh.num_faces(); ++f)
+      for (int i = 0; i < 3; ++i) {
+        auto& ef = edge_faces[mesh.edge_index(mesh.faces[f][i], mesh.faces[f][(i + 1) % 3])];
+        ef[ef[0] < 0 ? 0 : 1] = f;
+      }
+    for (int e = 0; e < mesh.num_edges(); ++e) {
+      std::vector<std::array<int, 3>> pieces = stretched[e];
+      for (int v : mesh.edges[e]) pieces.insert(pieces.end(), collapsed[v].begin(), collapsed[v].end());
+      pieces.push_back(image[edge_faces[e][0]]);
+      pieces.push_back(image[edge_faces[e][1]]);
+      std::vector<bool> reached(pieces.size(), false);
+      std::vector<size_t> stack{pieces.size() - 1};
+      reached.back() = true;
+      size_t count = 1;
+      while (!stack.empty()) {
+        const auto& p = pieces[stack.back()];
+        stack.pop_back();
+        for (size_t q = 0; q < pieces.size(); ++q) {
+          if (reached[q]) continue;
+          const bool touch = std::any_of(p.begin(), p.end(), [&](int v) {
+            return std::find(pieces[q].begin(), pieces[q].end(), v) != pieces[q].end();
+          });
+          if (touch) {
+            reached[q] = true;
+            ++count;
+            stack.push_back(q);
+          }
+        }
+      }
+      broken += count != pieces.size();
+    }
+    return broken;
+  };
+  if (check.covers_x && check.covers_y) {
+    check.discontinuous_edges_x = continuous(X, image_x, stretched_x, collapsed_x);
+    check.discontinuous_edges_y = continuous(Y, image_y, stretched_y, collapsed_y);
+    check.continuous = check.discontinuous_edges_x == 0 && check.discontinuous_edges_y == 0;
+  }
+  return check;
+}
+
+VertexMaps vertex_maps(const ProductSpace& space, const std::vector<int64_t>& gamma) {
+  VertexMaps maps;
+  maps.x_to_y.assign(space.x().num_vertices(), -1);
+  maps.y_to_x.assign(space.y().num_vertices(), -1);
+  // Two passes: partners from triangles real on both sides first, then any.
+  for (int pass = 0; pass < 2; ++pass)
+    for (int64_t j : gamma) {
+      const ProductTriangle t = space[j];
+      if (pass == 0 && (t.fa < 0 || t.fb < 0)) continue;
+      for (int i = 0; i < 3; ++i) {
+        if (maps.x_to_y[t.a[i]] < 0) maps.x_to_y[t.a[i]] = t.b[i];
+        if (maps.y_to_x[t.b[i]] < 0) maps.y_to_x[t.b[i]] = t.a[i];
+      }
+    }
+  return maps;
+}
+
+}  // namespace shapematch

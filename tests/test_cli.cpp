@@ -1,0 +1,153 @@
+// End-to-end tests of the `shapematch` executable: exit codes, one-line errors, JSON output.
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <sys/wait.h>
+#include <vector>
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Run {
+  int code = -1;
+  std::string out;  // stdout
+  std::string err;  // stderr
+};
+
+Run run(const std::string& args) {
+  const fs::path err = fs::temp_directory_path() / "shapematch_cli_stderr.txt";
+  const std::string cmd = std::string(SHAPEMATCH_CLI) + " " + args + " 2>" + err.string();
+  Run r;
+  FILE* p = popen(cmd.c_str(), "r");
+  REQUIRE(p != nullptr);
+  std::array<char, 4096> buf{};
+  size_t k;
+  while ((k = fread(buf.data(), 1, buf.size(), p)) > 0) r.out.append(buf.data(), k);
+  const int status = pclose(p);
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  std::ifstream f(err);
+  r.err.assign(std::istreambuf_iterator<char>(f), {});
+  return r;
+}
+
+double json_number(const std::string& json, const std::string& key) {
+  const auto at = json.find("\"" + key + "\": ");
+  REQUIRE(at != std::string::npos);
+  return std::stod(json.substr(at + key.size() + 4));
+}
+
+std::string json_string(const std::string& json, const std::string& key) {
+  const auto at = json.find("\"" + key + "\": \"");
+  REQUIRE(at != std::string::npos);
+  const auto begin = at + key.size() + 5;
+  return json.substr(begin, json.find('"', begin) - begin);
+}
+
+fs::path write_temp(const std::string& name, const std::string& text) {
+  const fs::path dir = fs::temp_directory_path() / "shapematch_cli";
+  fs::create_directories(dir);
+  const fs::path p = dir / name;
+  std::ofstream(p) << text;
+  return p;
+}
+
+const std::string kTetra = "OFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n";
+
+}  // namespace
+
+TEST_CASE("cli: lp on the bundled pair is positive, on an identity pair zero") {
+  const std::string a = std::string(SHAPEMATCH_ASSETS_DIR) + "/finger_straight.off";
+  const std::string b = std::string(SHAPEMATCH_ASSETS_DIR) + "/finger_bent.off";
+  Run r = run("lp --faces 40 --solver clp-dual");
+  REQUIRE(r.code == 0);
+  CHECK(json_string(r.out, "status") == "optimal");
+  CHECK(json_number(r.out, "objective") > 1e-6);
+  CHECK(json_number(r.out, "variables") > 0);
+  CHECK(json_number(r.out, "peak_rss_mb") > 0);
+
+  r = run("lp " + a + " " + a + " --faces 40 --solver clp-dual");
+  REQUIRE(r.code == 0);
+  CHECK(std::abs(json_number(r.out, "objective")) < 1e-9);
+
+  const fs::path mps = fs::temp_directory_path() / "shapematch_cli_test.mps";
+  r = run("lp " + a + " " + b + " --faces 20 --solver pdhg-cpu --export-mps " + mps.string());
+  REQUIRE(r.code == 0);
+  CHECK(json_string(r.out, "status") == "optimal");
+  CHECK(json_number(r.out, "lower_bound") <= json_number(r.out, "objective") + 1e-12);
+  CHECK(fs::file_size(mps) > 1000);
+  fs::remove(mps);
+}
+
+TEST_CASE("cli: malformed inputs give one clear line and a non-zero exit") {
+  const fs::path good = write_temp("good.off", kTetra);
+  struct Case {
+    std::string file, text, expect;
+  };
+  const std::vector<Case> cases = {
+      {"nan.off", "OFF\n4 4 0\n0 0 0\nnan 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n", "finite"},
+      {"open.off", "OFF\n4 3 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n", "boundary"},
+      {"nonmanifold.off",
+       "OFF\n5 5 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n0 0 -1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n3 0 1 4\n", "manifold"},
+      {"empty.off", "", "empty"},
+      {"index.off", "OFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 9\n3 1 2 3\n", "range"},
+  };
+  for (const auto& c : cases) {
+    CAPTURE(c.file);
+    const fs::path bad = write_temp(c.file, c.text);
+    const Run r = run("lp " + bad.string() + " " + good.string() + " --solver clp-dual");
+    CHECK(r.code != 0);
+    CHECK(r.out.empty());  // no half-written result
+    CHECK(std::count(r.err.begin(), r.err.end(), '\n') == 1);
+    CHECK(r.err.find(bad.string()) != std::string::npos);
+    std::string lower = r.err;
+    for (auto& ch : lower) ch = static_cast<char>(std::tolower(static_cast<unsigned char>(ch)));
+    CHECK(lower.find(c.expect) != std::string::npos);
+  }
+  const Run missing = run("lp /nonexistent/x.off " + good.string());
+  CHECK(missing.code != 0);
+  CHECK(missing.err.find("/nonexistent/x.off") != std::string::npos);
+  const Run unknown = run("lp --solver magic");
+  CHECK(unknown.code != 0);
+}
+
+TEST_CASE("cli: match writes a verified, complete output directory, or nothing") {
+  const fs::path out = fs::temp_directory_path() / "shapematch_cli_match";
+  fs::remove_all(out);
+  Run r = run("match --faces 30 --backend cpu -o " + out.string());
+  REQUIRE(r.code == 0);
+  std::ifstream f(out / "report.json");
+  const std::string report((std::istreambuf_iterator<char>(f)), {});
+  CHECK(report.find("\"verified\": true") != std::string::npos);
+  CHECK(json_number(report, "energy") >= json_number(report, "lower_bound") - 1e-9);
+  CHECK(json_number(report, "rounds") >= 1);
+  const double vx = json_number(report, "vertices");  // X's first
+  auto count_lines = [](const fs::path& p) {
+    std::ifstream in(p);
+    return static_cast<double>(std::count(std::istreambuf_iterator<char>(in), {}, '\n'));
+  };
+  CHECK(count_lines(out / "map_x_to_y.txt") == vx);
+  CHECK(count_lines(out / "graph_surface.txt") == json_number(report, "graph_surface_triangles"));
+  std::ifstream png(out / "match.png", std::ios::binary);
+  char sig[8] = {};
+  png.read(sig, 8);
+  CHECK(std::string(sig + 1, 3) == "PNG");
+  CHECK(fs::file_size(out / "match.png") > 10000);
+  CHECK(fs::exists(out / "x.ply"));
+  CHECK(fs::exists(out / "y.ply"));
+
+  // A failing run leaves the previous output untouched and no temporary directory behind.
+  const fs::path bad = write_temp("open2.off", "OFF\n4 3 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n");
+  r = run("match " + bad.string() + " " + bad.string() + " -o " + out.string());
+  CHECK(r.code != 0);
+  CHECK(fs::exists(out / "report.json"));
+  for (const auto& entry : fs::directory_iterator(out.parent_path()))
+    CHECK(entry.path().filename().string().rfind("shapematch_cli_match.tmp", 0) != 0);
+  fs::remove_all(out);
+}

@@ -1,0 +1,83 @@
+#include "shapematch/errors.hpp"
+#include "shapematch/matching.hpp"
+#include "shapematch/rounding.hpp"
+#include "shapematch/shapes.hpp"
+#include "test_helpers.hpp"
+
+#include <doctest/doctest.h>
+
+using namespace shapematch;
+
+TEST_CASE("rounding: a mesh against itself rounds to the identity with zero gap") {
+  // A perturbed octahedron: the regular one has symmetries of zero energy, this one only the identity.
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<double> u(-0.15, 0.15);
+  const Mesh x = test::deformed(shapes::octahedron(),
+                                [&](const Eigen::Vector3d& p) { return Eigen::Vector3d(p.x() + u(rng), p.y() + u(rng), p.z() + u(rng)); });
+  const Geometry g = compute_geometry(x);
+  const MatchingLp m = build_matching_lp(x, g, x, g);
+  for (const std::string solver : {"pdhg-cpu", "clp-dual"}) {
+    CAPTURE(solver);
+    RoundingOptions o;
+    o.solver = solver;
+    const RoundingResult r = round_to_graph_surface(m.space, m.lp, m.energy, o);
+    CHECK(satisfies_exactly(m.lp, r.gamma));
+    CHECK(r.energy == doctest::Approx(0.0).epsilon(1e-12));
+    CHECK(r.lower_bound <= 1e-9);
+    const VertexMaps maps = vertex_maps(m.space, r.gamma);
+    for (int v = 0; v < x.num_vertices(); ++v) {
+      CHECK(maps.x_to_y[v] == v);
+      CHECK(maps.y_to_x[v] == v);
+    }
+    CHECK(check_graph_surface(m.space, r.gamma).ok());
+  }
+}
+
+TEST_CASE("rounding: a deformed pair rounds to a verified graph surface within the paper's bounds") {
+  // Same connectivity, different pose: the bundled finger's generator at low resolution.
+  const Mesh x = shapes::bent_finger(10, 5, 6), y = shapes::bent_finger(60, 5, 6);
+  const Geometry gx = compute_geometry(x), gy = compute_geometry(y);
+  const MatchingLp m = build_matching_lp(x, gx, y, gy);
+  RoundingOptions o;
+  o.solver = "pdhg-cpu";
+  std::vector<RoundingRound> seen;
+  const RoundingResult r =
+      round_to_graph_surface(m.space, m.lp, m.energy, o, [&](const RoundingRound& k) { seen.push_back(k); });
+  CHECK(seen.size() == r.rounds.size());
+  CHECK(r.rounds.size() <= 20);
+  CHECK(satisfies_exactly(m.lp, r.gamma));
+  CHECK(r.energy >= r.lower_bound - 1e-9);
+  CHECK(r.gap >= -1e-9);
+  CHECK(r.gap <= 0.5);
+  const GraphSurfaceCheck t = check_graph_surface(m.space, r.gamma);
+  CHECK(t.covers_x);
+  CHECK(t.covers_y);
+  CHECK(t.orientation);
+  CHECK(t.discontinuous_edges_x >= 0);
+  // Same connectivity, near-isometric poses: most vertices should map to themselves.
+  const VertexMaps maps = vertex_maps(m.space, r.gamma);
+  int same = 0;
+  for (int v = 0; v < x.num_vertices(); ++v) same += maps.x_to_y[v] == v;
+  MESSAGE("vertices mapped to themselves: ", same, " of ", x.num_vertices());
+  CHECK(same >= x.num_vertices() * 3 / 4);
+  MESSAGE("finger pair: ", m.lp.cols(), " variables, ", r.rounds.size(), " rounds, gap ", r.gap,
+          ", discontinuous edges ", t.discontinuous_edges_x, "/", t.discontinuous_edges_y);
+
+  // The checks can fail: drop one product triangle, or swap in a reversed face.
+  auto broken = r.gamma;
+  broken.pop_back();
+  CHECK_FALSE(satisfies_exactly(m.lp, broken));
+  CHECK_FALSE(check_graph_surface(m.space, broken).ok());
+}
+
+TEST_CASE("rounding: limits end in an error, never a wrong answer") {
+  const Mesh x = shapes::tetrahedron();
+  const Mesh y = test::deformed(x, [](const Eigen::Vector3d& p) { return Eigen::Vector3d(p.x(), 2 * p.y(), p.z()); });
+  const Geometry gx = compute_geometry(x), gy = compute_geometry(y);
+  const MatchingLp m = build_matching_lp(x, gx, y, gy);
+  RoundingOptions o;
+  o.max_rounds = 0;
+  CHECK_THROWS_AS(round_to_graph_surface(m.space, m.lp, m.energy, o), SolverError);
+  std::vector<double> wrong_size(3, 0.0);
+  CHECK_THROWS_AS(round_to_graph_surface(m.space, m.lp, wrong_size, {}), InvalidInputError);
+}
