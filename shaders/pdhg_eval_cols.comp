@@ -2,6 +2,7 @@
 // Batch statistics over columns j, in original units (core/src/pdhg_backend.hpp): per-workgroup
 // partial sums of cᵀx = c̃ᵀx̂ and of min(0, c_j − (Aᵀy)_j) with y = r·ŷ (kept by the dual kernel).
 #extension GL_EXT_buffer_reference : require
+#extension GL_KHR_shader_subgroup_arithmetic : require
 #extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
 layout(local_size_x = 256) in;
 
@@ -15,18 +16,18 @@ layout(push_constant) uniform Push {
   uint n;
 } pc;
 
-shared dvec2 sums[256];
+shared dvec2 sums[64];  // one per subgroup: subgroups of at least 4 invocations (checked on the host)
 
-// Two sums over the workgroup; every invocation must reach it (it has barriers).
+// Two sums over the workgroup, in invocation 0; every invocation must reach it (it has a barrier).
+// Subgroup sums first: lavapipe pays dearly per barrier, and this needs only one.
 dvec2 workgroup_sum(dvec2 value) {
-  const uint i = gl_LocalInvocationIndex;
-  sums[i] = value;
+  const dvec2 s = subgroupAdd(value);
+  if (subgroupElect()) sums[gl_SubgroupID] = s;
   barrier();
-  for (uint s = 128u; s > 0u; s >>= 1) {
-    if (i < s) sums[i] += sums[i + s];
-    barrier();
-  }
-  return sums[0];
+  dvec2 total = dvec2(0.0lf);
+  if (gl_LocalInvocationIndex == 0u)
+    for (uint k = 0u; k < gl_NumSubgroups; ++k) total += sums[k];
+  return total;
 }
 
 // Σ_k ±v[col_k] over entries [begin, end), in entry order like the CPU backend.

@@ -6,6 +6,7 @@
 // Buffers are reached by device address (GL_EXT_buffer_reference), so no binding limits the size
 // of A; an entry offset becomes a 64-bit address once per column.
 #extension GL_EXT_buffer_reference : require
+#extension GL_KHR_shader_subgroup_arithmetic : require
 #extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
 layout(local_size_x = 256) in;
 
@@ -20,7 +21,19 @@ layout(push_constant) uniform Push {
   uint n, last;
 } pc;
 
-shared double sums[256];
+shared double sums[64];  // one per subgroup: subgroups of at least 4 invocations (checked on the host)
+
+// Sum over the workgroup, in invocation 0; every invocation must reach it (it has a barrier).
+// Subgroup sums first: lavapipe pays dearly per barrier, and this needs only one.
+double workgroup_sum(double value) {
+  const double s = subgroupAdd(value);
+  if (subgroupElect()) sums[gl_SubgroupID] = s;
+  barrier();
+  double total = 0.0lf;
+  if (gl_LocalInvocationIndex == 0u)
+    for (uint k = 0u; k < gl_NumSubgroups; ++k) total += sums[k];
+  return total;
+}
 
 // Σ_k ±v[col_k] over entries [begin, end), in entry order like the CPU backend.
 double gather(uint64_t entry, uint begin, uint end, Doubles v) {
@@ -32,18 +45,6 @@ double gather(uint64_t entry, uint begin, uint end, Doubles v) {
     s += (k & 0x80000000u) != 0u ? -f : f;
   }
   return s;
-}
-
-// Sum over the workgroup; every invocation must reach it (it has barriers).
-double workgroup_sum(double value) {
-  const uint i = gl_LocalInvocationIndex;
-  sums[i] = value;
-  barrier();
-  for (uint s = 128u; s > 0u; s >>= 1) {
-    if (i < s) sums[i] += sums[i + s];
-    barrier();
-  }
-  return sums[0];
 }
 
 void main() {

@@ -2,6 +2,7 @@
 // Restart over rows (core/src/pdhg_backend.hpp): y⁰ ← y ← ŷ and yr = r·ŷ, with per-workgroup
 // partial sums of the anchor's displacement (ŷ − y⁰)².
 #extension GL_EXT_buffer_reference : require
+#extension GL_KHR_shader_subgroup_arithmetic : require
 layout(local_size_x = 256) in;
 
 layout(buffer_reference, std430, buffer_reference_align = 8) restrict buffer Doubles { double v[]; };
@@ -11,18 +12,18 @@ layout(push_constant) uniform Push {
   uint m;
 } pc;
 
-shared double sums[256];
+shared double sums[64];  // one per subgroup: subgroups of at least 4 invocations (checked on the host)
 
-// Sum over the workgroup; every invocation must reach it (it has barriers).
+// Sum over the workgroup, in invocation 0; every invocation must reach it (it has a barrier).
+// Subgroup sums first: lavapipe pays dearly per barrier, and this needs only one.
 double workgroup_sum(double value) {
-  const uint i = gl_LocalInvocationIndex;
-  sums[i] = value;
+  const double s = subgroupAdd(value);
+  if (subgroupElect()) sums[gl_SubgroupID] = s;
   barrier();
-  for (uint s = 128u; s > 0u; s >>= 1) {
-    if (i < s) sums[i] += sums[i + s];
-    barrier();
-  }
-  return sums[0];
+  double total = 0.0lf;
+  if (gl_LocalInvocationIndex == 0u)
+    for (uint k = 0u; k < gl_NumSubgroups; ++k) total += sums[k];
+  return total;
 }
 
 void main() {

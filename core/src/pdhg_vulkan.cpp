@@ -62,12 +62,15 @@ struct RestartRowsPush {
   uint32_t m;
 };
 
-// The kernels compute in fp64 and reach buffers by address: one clear error where a device
+// The kernels compute in fp64, reach buffers by address and reduce with subgroup sums (their
+// shared arrays hold one slot per subgroup of ≥ 4 invocations): one clear error where a device
 // cannot, before any pipeline is made.
 const vk::Context& capable(const vk::Context& context) {
-  if (!context.limits().shader_float64 || !context.limits().buffer_device_address)
-    throw DeviceError("pdhg-vulkan: " + context.info().name + " lacks shaderFloat64, shaderInt64 or "
-                      "bufferDeviceAddress (Vulkan 1.2), which the PDHG kernels need; use pdhg-cpu");
+  const vk::Limits& l = context.limits();
+  if (!l.shader_float64 || !l.buffer_device_address || !l.subgroup_arithmetic || l.subgroup_size < 4)
+    throw DeviceError("pdhg-vulkan: " + context.info().name + " lacks shaderFloat64, shaderInt64, "
+                      "bufferDeviceAddress (Vulkan 1.2) or compute subgroup arithmetic on subgroups of "
+                      "at least 4, which the PDHG kernels need; use pdhg-cpu");
   return context;
 }
 
@@ -99,12 +102,14 @@ public:
   std::string device() const override { return "vulkan: " + context_.info().name; }
 
   void load(const ScaledLp& lp, const std::vector<double>& x, const std::vector<double>& y) override {
+    problem_.reset();  // a failed load leaves nothing loaded; frees the old problem's memory first
     const SignedCsr& a = *lp.a;
     const SignedCsr& at = *lp.at;
     n_ = a.cols;
     m_ = a.rows;
-    // The shaders index with 32-bit unsigned integers and keep the sign in bit 31.
-    if (m_ >= int64_t{UINT32_MAX} || n_ >= int64_t{SignedCsr::kNegative} || at.rows != n_ || at.cols != m_ ||
+    // Indices are 31-bit in the entries (bit 31 is the sign) and in SPIR-V, which reads an
+    // array index as signed.
+    if (m_ >= int64_t{SignedCsr::kNegative} || n_ >= int64_t{SignedCsr::kNegative} || at.rows != n_ || at.cols != m_ ||
         a.row_ptr.size() != size_t(m_) + 1 || at.row_ptr.size() != size_t(n_) + 1 ||
         lp.c.size() != size_t(n_) || lp.col_scale.size() != size_t(n_) || x.size() != size_t(n_) ||
         lp.b.size() != size_t(m_) || lp.row_scale.size() != size_t(m_) || y.size() != size_t(m_))
@@ -116,7 +121,6 @@ public:
     row_groups_ = groups_in(row_grid_);
     check_memory(a, at);
 
-    problem_.reset();  // frees the previous problem's memory before allocating this one's
     const auto u32 = [&](const std::vector<uint32_t>& v) {
       return context_.upload_addressed(std::span<const uint32_t>(v));
     };

@@ -8,7 +8,7 @@ namespace shapematch {
 
 struct PdhgOptions {
   int ruiz_iterations = 10;        // Ruiz equilibration passes before Pock–Chambolle scaling
-  int power_iterations = 40;       // for the estimate of ‖Ã‖₂ that sets the step
+  int power_iterations = 100;      // for the estimate of ‖Ã‖₂ that sets the step (+1 %, see pdhg.cpp)
   double step_safety = 0.998;      // η = step_safety / ‖Ã‖₂
   double reflection = 1.0;         // γ in z⁺ = (k+1)/(k+2)((1+γ)T(z) − γz) + z⁰/(k+2)
   int check_interval = 64;         // iterations between termination/restart checks
@@ -16,6 +16,10 @@ struct PdhgOptions {
   double restart_necessary = 0.8;  // … or below this and stopped falling
   double restart_artificial = 0.36;// … or when this fraction of all iterations passed since the last restart
   double primal_weight_smoothing = 0.5;
+  // ω₀; 0 = ‖c̃‖₂/‖b̃‖₂ (PDLP's choice). Matching LPs have a dense c and a b that is nonzero only
+  // on the π rows, which puts PDLP's ω₀ ~1e5 above where ω settles (~0.01) and made the bundled
+  // pair at 100 faces diverge; 1 converges there and halved the iterations at 40 faces.
+  double initial_primal_weight = 1.0;
 };
 
 enum class PdhgBackendKind { Cpu, Vulkan };

@@ -63,6 +63,8 @@ void describe(VkPhysicalDevice physical, int index, DeviceInfo& info, Limits& li
   limits.max_memory_allocation_size = maintenance3.maxMemoryAllocationSize;
   limits.buffer_device_address = address.bufferDeviceAddress && features.features.shaderInt64;
   limits.shader_float64 = features.features.shaderFloat64;
+  limits.subgroup_arithmetic = (subgroup.supportedStages & VK_SHADER_STAGE_COMPUTE_BIT) &&
+                               (subgroup.supportedOperations & VK_SUBGROUP_FEATURE_ARITHMETIC_BIT);
 
   info.index = index;
   info.name = props.properties.deviceName;

@@ -26,6 +26,7 @@ struct Limits {
   // addressed buffers need; enabled on the device when present, as is shader_float64.
   bool buffer_device_address = false;
   bool shader_float64 = false;
+  bool subgroup_arithmetic = false;  // subgroupAdd etc. in compute shaders
 };
 
 // Instance creation and device enumeration, shared by Context and shapematch::list_devices()
