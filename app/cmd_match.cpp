@@ -24,7 +24,7 @@ struct MatchArgs {
   std::string x, y;
   std::string out = "shapematch-out";
   std::string backend = "auto";
-  int faces = 200;
+  int faces = 100;
   bool keep_scale = false;
   double bending = 1.0;
   std::vector<double> lame{1.0, 1.0};

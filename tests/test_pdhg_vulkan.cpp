@@ -21,25 +21,6 @@ using namespace shapematch;
 
 namespace {
 
-// False (the test returns) only when skipping was asked for; no device otherwise fails.
-bool vulkan_wanted() {
-  const char* skip = std::getenv("SHAPEMATCH_SKIP_VULKAN");
-  if (skip && std::string(skip) == "1") {
-    MESSAGE("SHAPEMATCH_SKIP_VULKAN=1: Vulkan test skipped");
-    return false;
-  }
-  std::string problem;
-  try {
-    if (list_devices().empty()) problem = "no Vulkan device with a compute queue";
-  } catch (const DeviceError& e) {
-    problem = e.what();
-  }
-  if (!problem.empty())
-    FAIL("Vulkan unavailable (" << problem << "). Set VK_ICD_FILENAMES="
-         "/usr/share/vulkan/icd.d/lvp_icd.x86_64.json for lavapipe, or "
-         "SHAPEMATCH_SKIP_VULKAN=1 to skip the Vulkan tests.");
-  return true;
-}
 
 // A random scaled problem with a starting point; ScaledLp points into a and at, so this stays put.
 struct RandomLp {
@@ -165,7 +146,7 @@ SolverParams tight() {
 }  // namespace
 
 TEST_CASE("pdhg-vulkan: every kernel equals the CPU backend on a small random problem") {
-  if (!vulkan_wanted()) return;
+  if (!test::vulkan_wanted()) return;
   // Sizes not multiples of the workgroup; more columns than rows and the converse.
   for (const auto& [rows, cols] : {std::pair<int64_t, int64_t>{333, 1000}, {1000, 333}}) {
     CAPTURE(rows);
@@ -181,7 +162,7 @@ TEST_CASE("pdhg-vulkan: every kernel equals the CPU backend on a small random pr
 // (more than 65535 workgroups).
 TEST_CASE("pdhg-vulkan: kernels on arrays above 128 MiB and a 2D grid equal the CPU backend" *
           doctest::test_suite("slow")) {
-  if (!vulkan_wanted()) return;
+  if (!test::vulkan_wanted()) return;
   const int64_t rows = int64_t{65535} * 256 + 1000;
   const RandomLp p(rows, 4'000'000, 5, 11);  // ~42M entries, 168 MB
   REQUIRE(p.a.entry.size() * sizeof(uint32_t) > (uint64_t{128} << 20));
@@ -189,7 +170,7 @@ TEST_CASE("pdhg-vulkan: kernels on arrays above 128 MiB and a 2D grid equal the 
 }
 
 TEST_CASE("pdhg-vulkan: a buffer beyond one allocation is a clear DeviceError") {
-  if (!vulkan_wanted()) return;
+  if (!test::vulkan_wanted()) return;
   vk::Context context;
   REQUIRE(context.limits().buffer_device_address);
   try {
@@ -202,7 +183,7 @@ TEST_CASE("pdhg-vulkan: a buffer beyond one allocation is a clear DeviceError") 
 
 // 7 column vectors of doubles alone overflow the device: refused before any allocation.
 TEST_CASE("pdhg-vulkan: a problem larger than the device is a clear DeviceError") {
-  if (!vulkan_wanted()) return;
+  if (!test::vulkan_wanted()) return;
   const auto gpu = detail::make_vulkan_backend(-1);
   const uint64_t heap = vk::Context().limits().device_local_bytes;
   if (heap > (uint64_t{4} << 30)) {
@@ -234,14 +215,14 @@ TEST_CASE("pdhg-vulkan: a problem larger than the device is a clear DeviceError"
 }
 
 TEST_CASE("pdhg-vulkan: calls before load() are refused") {
-  if (!vulkan_wanted()) return;
+  if (!test::vulkan_wanted()) return;
   const auto gpu = detail::make_vulkan_backend(-1);
   CHECK_THROWS_AS(gpu->iterate(1, 0, detail::Step{}), DeviceError);
   CHECK_THROWS_AS(gpu->restart(), DeviceError);
 }
 
 TEST_CASE("pdhg-vulkan: a matching LP agrees with Clp within 1e-4 relative") {
-  if (!vulkan_wanted()) return;
+  if (!test::vulkan_wanted()) return;
   const LpProblem lp = matching_lp();
   const LpResult exact = solve_lp(lp, "clp-dual");
   REQUIRE(exact.status == LpStatus::Optimal);
@@ -254,7 +235,7 @@ TEST_CASE("pdhg-vulkan: a matching LP agrees with Clp within 1e-4 relative") {
 }
 
 TEST_CASE("pdhg-vulkan: both backends converge to the same objective") {
-  if (!vulkan_wanted()) return;
+  if (!test::vulkan_wanted()) return;
   const LpProblem lp = matching_lp();
   const LpResult cpu = solve_lp(lp, "pdhg-cpu", tight());
   const LpResult gpu = solve_lp(lp, "pdhg-vulkan", tight());

@@ -6,6 +6,8 @@
 #include "vk/context.hpp"
 #include "vk/spmv.hpp"
 
+#include "test_helpers.hpp"
+
 #include <doctest/doctest.h>
 
 #include <cmath>
@@ -18,25 +20,6 @@ using namespace shapematch;
 
 namespace {
 
-// False (the test returns) only when skipping was asked for; no device otherwise fails.
-bool vulkan_wanted() {
-  const char* skip = std::getenv("SHAPEMATCH_SKIP_VULKAN");
-  if (skip && std::string(skip) == "1") {
-    MESSAGE("SHAPEMATCH_SKIP_VULKAN=1: Vulkan test skipped");
-    return false;
-  }
-  std::string problem;
-  try {
-    if (list_devices().empty()) problem = "no Vulkan device with a compute queue";
-  } catch (const DeviceError& e) {
-    problem = e.what();
-  }
-  if (!problem.empty())
-    FAIL("Vulkan unavailable (" << problem << "). Set VK_ICD_FILENAMES="
-         "/usr/share/vulkan/icd.d/lvp_icd.x86_64.json for lavapipe, or "
-         "SHAPEMATCH_SKIP_VULKAN=1 to skip the Vulkan tests.");
-  return true;
-}
 
 // rows x cols with 0..max_per_row entries per row at random columns and signs.
 SignedCsr random_csr(int64_t rows, int64_t cols, int max_per_row, std::mt19937& rng) {
@@ -87,7 +70,7 @@ void check_spmv(vk::SignedSpmv& gpu, const SignedCsr& a, bool integers, std::mt1
 }  // namespace
 
 TEST_CASE("Vulkan: list_devices and choose_device") {
-  if (!vulkan_wanted()) return;
+  if (!test::vulkan_wanted()) return;
   const std::vector<DeviceInfo> devices = list_devices();
   for (size_t i = 0; i < devices.size(); ++i) {
     const DeviceInfo& d = devices[i];
@@ -121,7 +104,7 @@ TEST_CASE("Vulkan: dispatch grid stays within the workgroup count limits") {
 }
 
 TEST_CASE("Vulkan: buffers round-trip and refuse sizes beyond maxStorageBufferRange") {
-  if (!vulkan_wanted()) return;
+  if (!test::vulkan_wanted()) return;
   for (auto transfers : {vk::Context::Transfers::automatic, vk::Context::Transfers::staged}) {
     CAPTURE(static_cast<int>(transfers));
     vk::Context context(-1, transfers);
@@ -141,7 +124,7 @@ TEST_CASE("Vulkan: buffers round-trip and refuse sizes beyond maxStorageBufferRa
 }
 
 TEST_CASE("Vulkan: signed SpMV equals the CPU loop") {
-  if (!vulkan_wanted()) return;
+  if (!test::vulkan_wanted()) return;
   vk::Context context;
   vk::SignedSpmv gpu(context);
   std::mt19937 rng(2024);
@@ -159,7 +142,7 @@ TEST_CASE("Vulkan: signed SpMV equals the CPU loop") {
 }
 
 TEST_CASE("Vulkan: signed SpMV with empty rows, empty matrices and more rows than one grid row") {
-  if (!vulkan_wanted()) return;
+  if (!test::vulkan_wanted()) return;
   vk::Context context;
   vk::SignedSpmv gpu(context);
   std::mt19937 rng(5);
@@ -172,7 +155,7 @@ TEST_CASE("Vulkan: signed SpMV with empty rows, empty matrices and more rows tha
 
 // Also with staging buffers, the path of discrete GPUs.
 TEST_CASE("Vulkan: A x then Aᵀ y chained in one sequence, submitted twice") {
-  if (!vulkan_wanted()) return;
+  if (!test::vulkan_wanted()) return;
   for (auto transfers : {vk::Context::Transfers::automatic, vk::Context::Transfers::staged}) {
     CAPTURE(static_cast<int>(transfers));
     vk::Context context(-1, transfers);

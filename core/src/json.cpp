@@ -4,8 +4,6 @@
 
 #include <charconv>
 #include <cmath>
-#include <filesystem>
-#include <fstream>
 
 namespace shapematch {
 namespace {
@@ -100,19 +98,6 @@ void Json::write(std::string& out, int indent, int depth) const {
     if (!o.empty()) newline(depth);
     out += '}';
   }
-}
-
-void write_file_atomic(const std::string& path, const std::string& text) {
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream f(tmp, std::ios::binary);
-    if (!f) throw IoError(path + ": cannot open for writing");
-    f << text;
-    if (!f.flush()) throw IoError(path + ": write failed");
-  }
-  std::error_code ec;
-  std::filesystem::rename(tmp, path, ec);
-  if (ec) throw IoError(path + ": " + ec.message());
 }
 
 }  // namespace shapematch

@@ -1,5 +1,7 @@
 #include "shapematch/mesh.hpp"
 
+#include "shapematch/files.hpp"
+
 #include "shapematch/errors.hpp"
 
 #include <OpenMesh/Core/IO/MeshIO.hh>
@@ -422,27 +424,10 @@ void write_mesh(const Mesh& mesh, const std::string& path, const std::vector<std
   if (colors && colors->size() != mesh.vertices.size())
     fail(path, fmt::format("{} vertex colours for {} vertices", colors->size(), mesh.vertices.size()));
 
-  // Readers never see a half-written file: write next to the target, then rename over it.
-  const std::string tmp = path + ".tmp-" + std::to_string(::getpid());
-  {
-    std::ofstream out(tmp, std::ios::binary);
-    if (!out) throw IoError(path + ": cannot write (" + std::strerror(errno) + ")");
+  write_file_atomic(path, [&](std::ostream& out) {
     if (ext == ".stl") write_stl(mesh, out);
     else write_text(mesh, out, ext, colors);
-    out.flush();
-    if (!out) {
-      std::error_code ignored;
-      fs::remove(tmp, ignored);
-      throw IoError(path + ": write failed");
-    }
-  }
-  std::error_code ec;
-  fs::rename(tmp, path, ec);
-  if (ec) {
-    std::error_code ignored;
-    fs::remove(tmp, ignored);
-    throw IoError(path + ": cannot rename into place (" + ec.message() + ")");
-  }
+  });
 }
 
 }  // namespace

@@ -1,5 +1,7 @@
 #include "shapematch/render.hpp"
 
+#include "shapematch/files.hpp"
+
 #include "shapematch/errors.hpp"
 
 #include <Eigen/Eigenvalues>
@@ -275,26 +277,7 @@ void write_png(const Image& image, const std::string& path) {
   if (!stbi_write_png_to_func(append, &png, image.width, image.height, 3, image.rgb.data(), 3 * image.width))
     throw IoError(path + ": PNG encoding failed");
 
-  // Readers never see a half-written file: write next to the target, then rename over it.
-  const std::string tmp = path + ".tmp-" + std::to_string(::getpid());
-  {
-    std::ofstream out(tmp, std::ios::binary);
-    if (!out) throw IoError(path + ": cannot write (" + std::strerror(errno) + ")");
-    out.write(png.data(), static_cast<std::streamsize>(png.size()));
-    out.flush();
-    if (!out) {
-      std::error_code ignored;
-      fs::remove(tmp, ignored);
-      throw IoError(path + ": write failed");
-    }
-  }
-  std::error_code ec;
-  fs::rename(tmp, path, ec);
-  if (ec) {
-    std::error_code ignored;
-    fs::remove(tmp, ignored);
-    throw IoError(path + ": cannot rename into place (" + ec.message() + ")");
-  }
+  write_file_atomic(path, [&](std::ostream& out) { out.write(png.data(), static_cast<std::streamsize>(png.size())); });
 }
 
 }  // namespace shapematch

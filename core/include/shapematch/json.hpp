@@ -1,6 +1,8 @@
 #pragma once
 // A minimal JSON writer for reports: insertion-ordered objects, numbers printed round-trip exact,
 // non-finite numbers as null (JSON has no NaN/inf).
+#include "shapematch/files.hpp"
+
 #include <cstdint>
 #include <string>
 #include <utility>
@@ -39,8 +41,5 @@ private:
   void write(std::string& out, int indent, int depth) const;
   std::variant<std::nullptr_t, bool, int64_t, double, std::string, Array, Object> value_;
 };
-
-// Writes text to `path` through a temporary file renamed into place (never a half-written file).
-void write_file_atomic(const std::string& path, const std::string& text);
 
 }  // namespace shapematch

@@ -1,0 +1,15 @@
+#pragma once
+// Output files are written next to their target and renamed over it, so that no reader (and no
+// failed run) ever sees a half-written file.
+#include <functional>
+#include <ostream>
+#include <string>
+
+namespace shapematch {
+
+// Calls write(stream) on a temporary file, then renames it to `path`. Throws IoError naming the
+// path; the temporary is removed on failure.
+void write_file_atomic(const std::string& path, const std::function<void(std::ostream&)>& write);
+void write_file_atomic(const std::string& path, const std::string& text);
+
+}  // namespace shapematch

@@ -1,0 +1,49 @@
+#include "shapematch/files.hpp"
+
+#include "shapematch/errors.hpp"
+
+#include <cerrno>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <unistd.h>
+
+namespace fs = std::filesystem;
+
+namespace shapematch {
+
+void write_file_atomic(const std::string& path, const std::function<void(std::ostream&)>& write) {
+  const std::string tmp = path + ".tmp-" + std::to_string(::getpid());
+  auto discard = [&] {
+    std::error_code ignored;
+    fs::remove(tmp, ignored);
+  };
+  {
+    std::ofstream out(tmp, std::ios::binary);
+    if (!out) throw IoError(path + ": cannot write (" + std::strerror(errno) + ")");
+    try {
+      write(out);
+    } catch (...) {
+      out.close();
+      discard();
+      throw;
+    }
+    out.flush();
+    if (!out) {
+      discard();
+      throw IoError(path + ": write failed");
+    }
+  }
+  std::error_code ec;
+  fs::rename(tmp, path, ec);
+  if (ec) {
+    discard();
+    throw IoError(path + ": cannot rename into place (" + ec.message() + ")");
+  }
+}
+
+void write_file_atomic(const std::string& path, const std::string& text) {
+  write_file_atomic(path, [&](std::ostream& out) { out << text; });
+}
+
+}  // namespace shapematch
