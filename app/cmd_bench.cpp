@@ -284,21 +284,21 @@ std::string csv_table(const std::vector<BenchRow>& rows, double bandwidth_gbps) 
                         r.run.iterations, csv_number(r.run.seconds), csv_number(per_iteration),
                         csv_number(r.run.peak_rss_mb, 5), csv_number(r.run.solver_rss_mb, 5),
                         csv_number(r.run.objective, 12), csv_number(r.run.lower_bound, 12),
-                        csv_number(r.rel_diff_best, 3), csv_number(r.bytes_per_iteration, 8),
+                        csv_number(r.rel_diff_best, 3), csv_number(r.bytes_per_iteration, 15),
                         csv_number(r.bytes_per_iteration / per_iteration / 1e9, 4), csv_number(per_iteration / bound, 4));
   }
   return text;
 }
 
-// Relative difference of every objective to the lowest objective a solver certified optimal at
-// this size (the rows of one size).
+// Relative difference of each optimal run's objective to the lowest one at this size (the rows
+// of one size); the objective of a run that stopped early says nothing about the solver.
 void fill_rel_diff(std::vector<BenchRow>::iterator begin, std::vector<BenchRow>::iterator end) {
   double best = kInf;
   for (auto it = begin; it != end; ++it)
     if (it->run.status == "optimal" && std::isfinite(it->run.objective)) best = std::min(best, it->run.objective);
   if (!std::isfinite(best)) return;
   for (auto it = begin; it != end; ++it)
-    if (std::isfinite(it->run.objective))
+    if (it->run.status == "optimal" && std::isfinite(it->run.objective))
       it->rel_diff_best = std::abs(it->run.objective - best) / std::max(std::abs(best), 1e-300);
 }
 
