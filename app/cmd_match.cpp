@@ -1,5 +1,6 @@
 // `shapematch match X Y`: the whole pipeline — load, LP, rounding, verification, outputs.
 #include "commands.hpp"
+#include "inputs.hpp"
 #include "shapematch/device.hpp"
 #include "shapematch/errors.hpp"
 #include "shapematch/json.hpp"
@@ -21,13 +22,9 @@ namespace shapematch::app {
 namespace {
 
 struct MatchArgs {
-  std::string x, y;
+  PairArgs pair{.faces = 100};
   std::string out = "shapematch-out";
   std::string backend = "auto";
-  int faces = 100;
-  bool keep_scale = false;
-  double bending = 1.0;
-  std::vector<double> lame{1.0, 1.0};
   double threshold = 0.5;
   int max_rounds = 50;
   double tolerance = 1e-4;
@@ -66,34 +63,24 @@ void publish(const fs::path& tmp, const fs::path& out) {
   }
   fs::rename(tmp, out, ec);
   if (ec) {
-    if (!old.empty()) fs::rename(old, out);
+    std::error_code restore;
+    if (!old.empty()) fs::rename(old, out, restore);
     throw IoError(out.string() + ": " + ec.message());
   }
-  if (!old.empty()) fs::remove_all(old);
+  if (!old.empty() && (fs::remove_all(old, ec), ec))
+    spdlog::warn("{}: could not remove the previous output ({})", old.string(), ec.message());
 }
 
 int run_match(const MatchArgs& args) {
   Stopwatch total, stage;
   Json seconds = Json::object();
-  LoadOptions load;
-  load.normalize_area = !args.keep_scale;
-  Mesh x = load_mesh(args.x, load);
-  Mesh y = load_mesh(args.y, load);
-  const int vx_input = x.num_vertices(), vy_input = y.num_vertices();
-  if (args.faces > 0) {
-    x = decimate(x, args.faces);
-    y = decimate(y, args.faces);
-  }
-  const Geometry gx = compute_geometry(x), gy = compute_geometry(y);
+  const MeshPair p = load_pair(args.pair);
+  const Mesh& x = p.x;
+  const Mesh& y = p.y;
   seconds.set("load", stage.seconds());
-  spdlog::info("X: {} ({} faces), Y: {} ({} faces)", x.name, x.num_faces(), y.name, y.num_faces());
 
   stage.reset();
-  MatchingLpOptions lp_options;
-  lp_options.energy.bending_weight = args.bending;
-  lp_options.energy.lame_lambda = args.lame.at(0);
-  lp_options.energy.lame_mu = args.lame.at(1);
-  const MatchingLp m = build_matching_lp(x, gx, y, gy, lp_options);
+  const MatchingLp m = build_matching_lp(x, p.gx, y, p.gy, matching_options(args.pair));
   seconds.set("build", stage.seconds());
   spdlog::info("LP: {} variables, {} constraints, {} nonzeros", m.lp.cols(), m.lp.rows(), m.lp.nonzeros());
 
@@ -133,7 +120,8 @@ int run_match(const MatchArgs& args) {
                100 * rr.gap, rr.rounds.size());
 
   stage.reset();
-  const fs::path out = fs::absolute(args.out);
+  fs::path out = fs::absolute(args.out).lexically_normal();
+  if (!out.has_filename()) out = out.parent_path();  // "dir/" names dir
   const fs::path tmp = out.string() + ".tmp-" + std::to_string(std::random_device{}());
   fs::create_directories(tmp);
   try {
@@ -167,16 +155,15 @@ int run_match(const MatchArgs& args) {
                       .set("undone", r.undone)
                       .set("seconds", r.seconds));
     Json report = Json::object();
-    report.set("x", Json::object()
-                        .set("file", args.x)
-                        .set("vertices_input", vx_input)
-                        .set("vertices", x.num_vertices())
-                        .set("faces", x.num_faces()));
-    report.set("y", Json::object()
-                        .set("file", args.y)
-                        .set("vertices_input", vy_input)
-                        .set("vertices", y.num_vertices())
-                        .set("faces", y.num_faces()));
+    auto shape = [](const std::string& file, int input_vertices, const Mesh& mesh) {
+      return Json::object()
+          .set("file", file)
+          .set("vertices_input", input_vertices)
+          .set("vertices", mesh.num_vertices())
+          .set("faces", mesh.num_faces());
+    };
+    report.set("x", shape(p.x_file, p.x_input_vertices, x));
+    report.set("y", shape(p.y_file, p.y_input_vertices, y));
     report.set("variables", m.lp.cols()).set("constraints", m.lp.rows()).set("nonzeros", m.lp.nonzeros());
     report.set("backend", ro.solver).set("device", rr.first_lp.device);
     report.set("energy", rr.energy).set("lower_bound", rr.lower_bound).set("gap", rr.gap);
@@ -192,13 +179,13 @@ int run_match(const MatchArgs& args) {
                                .set("discontinuous_edges_y", theorem.discontinuous_edges_y));
     report.set("graph_surface_triangles", static_cast<int64_t>(rr.gamma.size()));
     report.set("options", Json::object()
-                              .set("bending", args.bending)
-                              .set("lame_lambda", args.lame.at(0))
-                              .set("lame_mu", args.lame.at(1))
+                              .set("bending", args.pair.bending)
+                              .set("lame_lambda", args.pair.lame.at(0))
+                              .set("lame_mu", args.pair.lame.at(1))
                               .set("threshold", args.threshold)
                               .set("tolerance", args.tolerance)
-                              .set("faces", args.faces)
-                              .set("keep_scale", args.keep_scale));
+                              .set("faces", args.pair.faces)
+                              .set("keep_scale", args.pair.keep_scale));
     report.set("seconds", seconds);
     report.set("peak_rss_mb", peak_rss_mb());
     report.set("round_log", rounds);
@@ -217,33 +204,19 @@ int run_match(const MatchArgs& args) {
 
 Action add_match_command(CLI::App& app) {
   auto a = std::make_shared<MatchArgs>();
-  app.add_option("x", a->x, "first mesh (OFF, OBJ, PLY, STL); default: bundled asset");
-  app.add_option("y", a->y, "second mesh; default: bundled asset");
+  add_pair_options(app, a->pair);
   app.add_option("-o,--out", a->out, "output directory")->capture_default_str();
   app.add_option("--backend", a->backend, "LP backend")
       ->check(CLI::IsMember({"auto", "vulkan", "cpu", "clp"}))
       ->capture_default_str();
   app.add_option("--device", a->device, "Vulkan device index (see `shapematch devices`)");
-  app.add_option("--faces", a->faces, "decimate both meshes to about N faces first (0: keep)")
-      ->check(CLI::NonNegativeNumber)
-      ->capture_default_str();
-  app.add_flag("--keep-scale", a->keep_scale, "do not normalise both shapes to unit area");
-  app.add_option("--bending", a->bending, "bending weight")->capture_default_str();
-  app.add_option("--lame", a->lame, "Lamé parameters λ,μ of the membrane")->delimiter(',')->expected(2);
   app.add_option("--threshold", a->threshold, "fix LP values above this to 1")
       ->check(CLI::Range(0.0, 1.0))
       ->capture_default_str();
   app.add_option("--max-rounds", a->max_rounds, "rounding rounds before giving up")->capture_default_str();
   app.add_option("--tol", a->tolerance, "LP tolerance")->capture_default_str();
   app.add_option("--time-limit", a->time_limit, "time limit of each LP solve, seconds");
-  return [a] {
-    if (a->x.empty() != a->y.empty()) throw InvalidInputError("give both meshes X and Y, or neither");
-    if (a->x.empty()) {
-      a->x = default_mesh_x();
-      a->y = default_mesh_y();
-    }
-    return run_match(*a);
-  };
+  return [a] { return run_match(*a); };
 }
 
 }  // namespace shapematch::app

@@ -106,9 +106,12 @@ ConstraintSystem build_constraints(const ProductSpace& space) {
   at.rows = n;
   at.cols = m;
   at.row_ptr.assign(n + 1, 0);
-  for (int64_t j = 0; j < n; ++j)
-    at.row_ptr[j + 1] = at.row_ptr[j] + 3 + (fa[j] >= 0) + (fb[j] >= 0);
-  if (at.row_ptr[n] >= 0x7fffffffu) throw InvalidInputError("constraint matrix too large");
+  int64_t nonzeros = 0;  // counted in 64 bits: up to 5n may exceed the 32-bit row pointers
+  for (int64_t j = 0; j < n; ++j) {
+    nonzeros += 3 + (fa[j] >= 0) + (fb[j] >= 0);
+    if (nonzeros >= 0x7fffffff) throw InvalidInputError("constraint matrix too large: over 2^31 nonzeros");
+    at.row_ptr[j + 1] = static_cast<uint32_t>(nonzeros);
+  }
   at.entry.resize(at.row_ptr[n]);
   const uint32_t pix = static_cast<uint32_t>(cs.closedness_rows);
   const uint32_t piy = pix + static_cast<uint32_t>(X.num_faces());

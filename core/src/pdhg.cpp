@@ -124,7 +124,8 @@ LpResult PdhgSolver::solve(const LpProblem& problem, const SolverParams& params)
   compute_scaling(problem, options_.ruiz_iterations, r, d);
   // Power iteration approaches ‖Ã‖ from below (40 steps were 1 % short on the 100-face pair), so
   // add a margin; Pock–Chambolle scaling with α = 1 guarantees ‖Ã‖ ≤ 1, which caps it.
-  const double norm = std::min(1.0, 1.01 * estimate_norm(problem, r, d, options_.power_iterations));
+  double norm = std::min(1.0, 1.01 * estimate_norm(problem, r, d, options_.power_iterations));
+  if (!(norm > 1e-12)) norm = 1.0;  // no nonzeros (or no power steps): the Pock–Chambolle bound
   const double eta = options_.step_safety / norm;
 
   detail::ScaledLp lp;
@@ -180,7 +181,8 @@ LpResult PdhgSolver::solve(const LpProblem& problem, const SolverParams& params)
       result.status = LpStatus::TimeLimit;
       break;
     }
-    const int count = static_cast<int>(std::min<int64_t>(options_.check_interval, params.max_iterations - total));
+    const int count =
+        static_cast<int>(std::min<int64_t>(std::max(1, options_.check_interval), params.max_iterations - total));
     const detail::Step step{eta / omega, eta * omega, options_.reflection};
     const detail::BatchStats s = backend->iterate(count, k, step);
     total += count;

@@ -32,11 +32,11 @@ public:
     m_ = lp.a->rows;
     x_ = x;
     x0_ = x;
-    xhat_.assign(n_, 0.0);
+    xhat_ = x;  // read() before any iteration returns the start
     xr_.assign(n_, 0.0);
     y_ = y;
     y0_ = y;
-    yhat_.assign(m_, 0.0);
+    yhat_ = y;
     yr_.resize(m_);
     for (int64_t i = 0; i < m_; ++i) yr_[i] = lp.row_scale[i] * y_[i];
     partial_.assign(pool_.size() * 8, 0.0);

@@ -128,15 +128,15 @@ public:
       return context_.upload_addressed(std::span<const double>(v));
     };
     const auto scratch = [&](int64_t size) { return context_.addressed_buffer(uint64_t(size) * sizeof(double)); };
-    const std::vector<double> zeros_n(n_, 0.0), zeros_m(m_, 0.0);  // x̂, ŷ read before any iteration
     std::vector<double> yr(m_);
     for (int64_t i = 0; i < m_; ++i) yr[i] = lp.row_scale[i] * y[i];
     const uint32_t stride = std::max(col_groups_, row_groups_);
+    // x̂, ŷ start at the start point, so that read() before any iteration returns it.
     // Braced initialisation runs in member order, so the first failed allocation stops the rest.
     problem_.emplace(DeviceProblem{u32(a.row_ptr), u32(a.entry), u32(at.row_ptr), u32(at.entry),
-                                   f64(lp.c), f64(lp.col_scale), f64(x), f64(x), f64(zeros_n), scratch(n_),
+                                   f64(lp.c), f64(lp.col_scale), f64(x), f64(x), f64(x), scratch(n_),
                                    scratch(n_), f64(lp.b), f64(lp.row_scale), f64(y), f64(y), f64(yr),
-                                   f64(zeros_m), scratch(m_), scratch(int64_t(kSlots) * stride)});
+                                   f64(y), scratch(m_), scratch(int64_t(kSlots) * stride)});
     partials_.resize(size_t(kSlots) * stride);
   }
 

@@ -144,13 +144,12 @@ Reduced reduce(const LpProblem& full, const FixState& s) {
 
 // Fixes the batch (largest first); a fixing that propagation proves infeasible is undone and
 // replaced by fixing fewer (halving down to the single largest), and a single variable that
-// cannot be 1 is fixed to 0 instead: each retry strictly shrinks the search space. Returns
-// whether anything had to be undone.
-bool shrink_and_fix(Fixer& fixer, std::vector<std::pair<int64_t, int>> batch, const FixState& before) {
-  bool undone = false;
+// cannot be 1 is fixed to 0 instead: each retry strictly shrinks the search space. Returns the
+// batch actually applied (`batch` itself when nothing had to be undone).
+std::vector<std::pair<int64_t, int>> shrink_and_fix(Fixer& fixer, std::vector<std::pair<int64_t, int>> batch,
+                                                    const FixState& before) {
   while (!fixer.fix(batch)) {
     fixer.restore(before);
-    undone = true;
     if (batch.size() > 1) {
       batch.resize(batch.size() / 2);
     } else if (batch.front().second == 1) {
@@ -159,7 +158,7 @@ bool shrink_and_fix(Fixer& fixer, std::vector<std::pair<int64_t, int>> batch, co
       throw SolverError("rounding: no consistent fixing exists (the LP is infeasible)");
     }
   }
-  return undone;
+  return batch;
 }
 
 }  // namespace
@@ -213,7 +212,11 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
     info.status = r.status;
     info.iterations = r.iterations;
     info.objective = r.objective + lp.objective_scale * red.fixed_cost;
-    if (round == 1) result.first_lp = r;
+    if (round == 1) {  // in the units of the full LP: add what propagation fixed to 1 before it
+      result.first_lp = r;
+      result.first_lp.objective += lp.objective_scale * red.fixed_cost;
+      result.first_lp.lower_bound += lp.objective_scale * red.fixed_cost;
+    }
 
     if (r.status == LpStatus::Infeasible) {
       // The last fixing left an infeasible LP that propagation could not see: undo it and fix less.
@@ -224,7 +227,7 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
       if (smaller.size() > 1) smaller.resize(smaller.size() / 2);
       else if (smaller.front().second == 1) smaller.front().second = 0;  // the single variable cannot be 1
       else throw SolverError("rounding: no consistent fixing exists (the LP is infeasible)");
-      shrink_and_fix(fixer, smaller, last->before);
+      smaller = shrink_and_fix(fixer, smaller, last->before);
       info.fixed_to_one = fixer.state().ones - last->before.ones;
       info.fixed_to_zero = fixer.state().zeros - last->before.zeros;
       info.seconds = clock.seconds();
@@ -251,9 +254,10 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
     }
     if (batch.empty()) batch.push_back({red.cols[order.front()], 1});
 
-    last = Step{fixer.state(), batch};
+    last = Step{fixer.state(), {}};
     const int64_t ones_before = last->before.ones, zeros_before = last->before.zeros;
-    info.undone = shrink_and_fix(fixer, batch, last->before);
+    last->batch = shrink_and_fix(fixer, batch, last->before);
+    info.undone = last->batch != batch;
     info.fixed_to_one = fixer.state().ones - ones_before;
     info.fixed_to_zero = fixer.state().zeros - zeros_before;
     info.seconds = clock.seconds();

@@ -1,0 +1,35 @@
+#pragma once
+// What `lp` and `match` share: the mesh pair, its preprocessing and the energy options.
+#include "shapematch/geometry.hpp"
+#include "shapematch/matching.hpp"
+
+#include <CLI/CLI.hpp>
+#include <string>
+#include <vector>
+
+namespace shapematch::app {
+
+struct PairArgs {
+  std::string x, y;  // empty: the bundled pair
+  int faces = 0;     // decimate both to about this many faces; 0 keeps them
+  bool keep_scale = false;
+  double bending = 1.0;
+  std::vector<double> lame{1.0, 1.0};
+};
+
+// Registers x, y, --faces, --keep-scale, --bending and --lame.
+void add_pair_options(CLI::App& app, PairArgs& args);
+
+struct MeshPair {
+  Mesh x, y;
+  Geometry gx, gy;
+  int x_input_vertices = 0, y_input_vertices = 0;
+  std::string x_file, y_file;
+};
+
+// Loads (the bundled pair when none is given), validates, decimates and computes geometry.
+MeshPair load_pair(const PairArgs& args);
+
+MatchingLpOptions matching_options(const PairArgs& args);
+
+}  // namespace shapematch::app
