@@ -1,0 +1,63 @@
+// Real meshes from ../shared/datasets (never copied into the repository). Skips cleanly when the
+// folder is absent, as on a machine without the evaluation data.
+#include "shapematch/errors.hpp"
+#include "shapematch/matching.hpp"
+
+#include <doctest/doctest.h>
+
+#include <filesystem>
+
+using namespace shapematch;
+namespace fs = std::filesystem;
+
+namespace {
+
+bool have(const fs::path& p) {
+  if (fs::exists(p)) return true;
+  MESSAGE("dataset file absent, skipped: " << p.string());
+  return false;
+}
+
+const fs::path kData = SHAPEMATCH_DATASETS_DIR;
+
+}  // namespace
+
+TEST_CASE("datasets: real meshes load, validate and decimate; open ones are rejected by name") {
+  const fs::path faust = kData / "faust_r_bcicp/off/tr_reg_016.off";
+  const fs::path cat = kData / "tosca_r_bcicp/isometric/off/cat0.off";
+  const fs::path horse = kData / "deformation_transfer/horse-poses/1.obj";
+  for (const fs::path& p : {faust, cat}) {
+    if (!have(p)) continue;
+    MeshReport report;
+    const Mesh m = load_mesh(p.string(), {}, &report);
+    CHECK(report.genus == 0);
+    CHECK(surface_area(m) == doctest::Approx(1.0));
+    const Mesh small = decimate(m, 40);
+    CHECK(small.num_faces() <= 44);
+    CHECK(validate_mesh(small) == 0);
+  }
+  if (have(horse)) {
+    try {
+      load_mesh(horse.string());
+      FAIL("the horse has a hoof slit (19 boundary edges) and must be rejected");
+    } catch (const InvalidInputError& e) {
+      CHECK(std::string(e.what()).find(horse.string()) != std::string::npos);
+      CHECK(std::string(e.what()).find("boundary") != std::string::npos);
+    }
+  }
+}
+
+TEST_CASE("datasets: the LP of a decimated FAUST_r pair is built and bounded") {
+  const fs::path a = kData / "faust_r_bcicp/off/tr_reg_016.off", b = kData / "faust_r_bcicp/off/tr_reg_020.off";
+  if (!have(a) || !have(b)) return;
+  const Mesh x = decimate(load_mesh(a.string()), 20), y = decimate(load_mesh(b.string()), 20);
+  const Geometry gx = compute_geometry(x), gy = compute_geometry(y);
+  const MatchingLp m = build_matching_lp(x, gx, y, gy);
+  CHECK(m.lp.cols() == ProductSpace::full_size(x, y));
+  const LpResult exact = solve_lp(m.lp, "clp-dual");
+  REQUIRE(exact.status == LpStatus::Optimal);
+  const LpResult r = solve_lp(m.lp, "pdhg-cpu");
+  REQUIRE(r.status == LpStatus::Optimal);
+  CHECK(r.lower_bound <= exact.objective * (1 + 1e-9));
+  CHECK(std::abs(r.objective - exact.objective) <= 1e-3 * exact.objective);
+}
