@@ -1,6 +1,7 @@
 // `shapematch match X Y`: the whole pipeline — load, LP, rounding, verification, outputs.
 #include "commands.hpp"
 #include "inputs.hpp"
+#include "shapematch/coarse_to_fine.hpp"
 #include "shapematch/device.hpp"
 #include "shapematch/errors.hpp"
 #include "shapematch/json.hpp"
@@ -30,6 +31,8 @@ struct MatchArgs {
   double tolerance = 1e-4;
   double time_limit = std::numeric_limits<double>::infinity();
   int device = -1;
+  HierarchyOptions hierarchy;
+  int ring = 1, max_ring = 3;
 };
 
 // auto: a GPU if there is one, else the native solver (lavapipe is for testing, not speed).
@@ -75,28 +78,34 @@ int run_match(const MatchArgs& args) {
   Stopwatch total, stage;
   Json seconds = Json::object();
   const MeshPair p = load_pair(args.pair);
-  const Mesh& x = p.x;
-  const Mesh& y = p.y;
-  seconds.set("load", stage.seconds());
 
-  stage.reset();
-  const MatchingLp m = build_matching_lp(x, p.gx, y, p.gy, matching_options(args.pair));
-  seconds.set("build", stage.seconds());
-  spdlog::info("LP: {} variables, {} constraints, {} nonzeros", m.lp.cols(), m.lp.rows(), m.lp.nonzeros());
-
-  stage.reset();
-  RoundingOptions ro;
+  CoarseToFineOptions co;
+  co.hierarchy = args.hierarchy;
+  co.ring = args.ring;
+  co.max_ring = std::max(args.max_ring, args.ring);
+  co.matching = matching_options(args.pair);
+  RoundingOptions& ro = co.rounding;
   ro.solver = solver_for(args);
   ro.threshold = args.threshold;
   ro.max_rounds = args.max_rounds;
   ro.lp.tolerance = args.tolerance;
   ro.lp.time_limit = args.time_limit;
   ro.lp.device = args.device;
-  const RoundingResult rr = round_to_graph_surface(m.space, m.lp, m.energy, ro, [](const RoundingRound& r) {
-    spdlog::info("round {:>2}: {:>9} variables, LP {} in {} it, objective {:.6g}, fixed {} to 1 and {} to 0{} ({:.2f} s)",
-                 r.round, r.variables, to_string(r.status), r.iterations, r.objective, r.fixed_to_one,
-                 r.fixed_to_zero, r.undone ? " (undone: fixed fewer)" : "", r.seconds);
+  const CoarseToFineMatcher matcher(p.x, p.y, co);
+  seconds.set("load", stage.seconds());
+  // The finest level is the preprocessed input itself, vertex for vertex.
+  const Mesh& x = matcher.x_levels().levels.back().mesh;
+  const Mesh& y = matcher.y_levels().levels.back().mesh;
+
+  stage.reset();
+  const CoarseToFineResult c2f = matcher.run([&](const LevelReport& level, const RoundingRound& r) {
+    spdlog::info("{}round {:>2}: {:>9} variables, LP {} in {} it, objective {:.6g}, fixed {} to 1 and {} to 0{} ({:.2f} s)",
+                 matcher.x_levels().size() > 1 ? fmt::format("level {} ", level.level + 1) : std::string(), r.round,
+                 r.variables, to_string(r.status), r.iterations, r.objective, r.fixed_to_one, r.fixed_to_zero,
+                 r.undone ? " (undone: fixed fewer)" : "", r.seconds);
   });
+  const MatchingLp& m = c2f.finest;
+  const RoundingResult& rr = c2f.rounding;
   seconds.set("solve_and_round", stage.seconds());
 
   stage.reset();
@@ -126,6 +135,8 @@ int run_match(const MatchArgs& args) {
   try {
     write_file_atomic((tmp / "map_x_to_y.txt").string(), lines(maps.x_to_y));
     write_file_atomic((tmp / "map_y_to_x.txt").string(), lines(maps.y_to_x));
+    write_file_atomic((tmp / "x_vertex_ids.txt").string(), lines(p.x_ids));
+    write_file_atomic((tmp / "y_vertex_ids.txt").string(), lines(p.y_ids));
     std::ostringstream gs;
     for (int64_t j : rr.gamma) {
       const ProductTriangle t = m.space[j];
@@ -184,10 +195,32 @@ int run_match(const MatchArgs& args) {
                               .set("threshold", args.threshold)
                               .set("tolerance", args.tolerance)
                               .set("faces", args.pair.faces)
-                              .set("keep_scale", args.pair.keep_scale));
+                              .set("keep_scale", args.pair.keep_scale)
+                              .set("levels", matcher.x_levels().size())
+                              .set("coarsest_faces", args.hierarchy.coarsest_faces)
+                              .set("ring", args.ring));
     report.set("seconds", seconds);
     report.set("peak_rss_mb", peak_rss_mb());
     report.set("round_log", rounds);
+    Json levels = Json::array();
+    for (const LevelReport& l : c2f.levels)
+      levels.push(Json::object()
+                      .set("level", l.level)
+                      .set("faces_x", l.faces_x)
+                      .set("faces_y", l.faces_y)
+                      .set("variables", l.variables)
+                      .set("full_variables", l.full_variables)
+                      .set("constraints", l.constraints)
+                      .set("ring", l.ring)
+                      .set("widenings", l.widenings)
+                      .set("rounds", l.rounds)
+                      .set("iterations", l.iterations)
+                      .set("lower_bound", l.lower_bound)
+                      .set("energy", l.energy)
+                      .set("gap", l.gap)
+                      .set("seconds", l.seconds)
+                      .set("peak_rss_mb", l.peak_rss_mb));
+    report.set("levels", levels);
     write_file_atomic((tmp / "report.json").string(), report.dump() + "\n");
     publish(tmp, out);
   } catch (...) {
@@ -215,6 +248,18 @@ Action add_match_command(CLI::App& app) {
   app.add_option("--max-rounds", a->max_rounds, "rounding rounds before giving up")->capture_default_str();
   app.add_option("--tol", a->tolerance, "LP tolerance")->capture_default_str();
   app.add_option("--time-limit", a->time_limit, "time limit of each LP solve, seconds");
+  app.add_option("--levels", a->hierarchy.levels, "coarse-to-fine levels including the finest (0: from --coarsest-faces)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  app.add_option("--coarsest-faces", a->hierarchy.coarsest_faces, "faces of the coarsest level")
+      ->check(CLI::Range(4, 1 << 30))
+      ->capture_default_str();
+  app.add_option("--ring", a->ring, "neighbourhood rings of the reduced product space (eq. 17)")
+      ->check(CLI::Range(0, 8))
+      ->capture_default_str();
+  app.add_option("--max-ring", a->max_ring, "widen the ring up to this when a reduced LP is infeasible")
+      ->check(CLI::Range(0, 8))
+      ->capture_default_str();
   return [a] { return run_match(*a); };
 }
 

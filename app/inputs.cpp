@@ -29,10 +29,8 @@ MeshPair load_pair(const PairArgs& args) {
   p.y = load_mesh(p.y_file, load);
   p.x_input_vertices = p.x.num_vertices();
   p.y_input_vertices = p.y.num_vertices();
-  if (args.faces > 0) {
-    p.x = decimate(p.x, args.faces);
-    p.y = decimate(p.y, args.faces);
-  }
+  p.x = decimate(p.x, args.faces > 0 ? args.faces : p.x.num_faces(), &p.x_ids);
+  p.y = decimate(p.y, args.faces > 0 ? args.faces : p.y.num_faces(), &p.y_ids);
   p.gx = compute_geometry(p.x);
   p.gy = compute_geometry(p.y);
   spdlog::info("X: {} ({} faces), Y: {} ({} faces)", p.x.name, p.x.num_faces(), p.y.name, p.y.num_faces());

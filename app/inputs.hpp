@@ -24,6 +24,7 @@ struct MeshPair {
   Mesh x, y;
   Geometry gx, gy;
   int x_input_vertices = 0, y_input_vertices = 0;
+  std::vector<int> x_ids, y_ids;  // each vertex's index in its input file (decimation keeps a subset)
   std::string x_file, y_file;
 };
 

@@ -1,5 +1,7 @@
 #include "shapematch/energy.hpp"
 
+#include "shapematch/errors.hpp"
+
 #include "parallel.hpp"
 
 #include <Eigen/Dense>
@@ -64,6 +66,8 @@ EnergyModel::EnergyModel(const Mesh& x, const Geometry& gx, const Mesh& y, const
     : x_(x), gx_(gx), y_(y), gy_(gy), options_(options) {}
 
 void EnergyModel::set_features(Eigen::MatrixXd fx, Eigen::MatrixXd fy) {
+  if (fx.size() > 0 && (fx.rows() != x_.num_vertices() || fy.rows() != y_.num_vertices() || fx.cols() != fy.cols()))
+    throw InvalidInputError("features: need one row per vertex on each shape and the same number of columns");
   fx_ = std::move(fx);
   fy_ = std::move(fy);
 }

@@ -8,13 +8,18 @@ namespace shapematch {
 
 MatchingLp build_matching_lp(const Mesh& x, const Geometry& gx, const Mesh& y, const Geometry& gy,
                              const MatchingLpOptions& options) {
-  MatchingLp out{ProductSpace::full(x, y), {}, {}, 0};
+  EnergyModel model(x, gx, y, gy, options.energy);
+  if (options.features_x.size() > 0) model.set_features(options.features_x, options.features_y);
+  return build_matching_lp(ProductSpace::full(x, y), model, options.scale_costs);
+}
+
+MatchingLp build_matching_lp(ProductSpace space, const EnergyModel& model, bool scale_costs) {
+  MatchingLp out{std::move(space), {}, {}, 0};
   ConstraintSystem cs = build_constraints(out.space);
-  const EnergyModel model(x, gx, y, gy, options.energy);
   out.energy = energy_vector(out.space, model);
 
   double scale = 1.0;
-  if (options.scale_costs && !out.energy.empty()) {
+  if (scale_costs && !out.energy.empty()) {
     const double mean = std::accumulate(out.energy.begin(), out.energy.end(), 0.0) / double(out.energy.size());
     if (mean > 0) scale = mean;
   }

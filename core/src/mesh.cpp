@@ -632,13 +632,24 @@ void normalize_area(Mesh& mesh, double target_area) {
   for (auto& p : mesh.vertices) p = (p - centroid) * scale;
 }
 
-Mesh decimate(const Mesh& mesh, int target_faces) {
+Mesh decimate(const Mesh& mesh, int target_faces, std::vector<int>* kept_vertices) {
   if (target_faces < 1) fail(mesh.name, fmt::format("decimation target must be positive, got {}", target_faces));
-  if (mesh.num_faces() <= target_faces) return mesh;
+  if (mesh.num_faces() <= target_faces) {
+    if (kept_vertices) {
+      kept_vertices->resize(mesh.vertices.size());
+      std::iota(kept_vertices->begin(), kept_vertices->end(), 0);
+    }
+    return mesh;
+  }
 
   OmMesh om;
   om.reserve(mesh.vertices.size(), 3 * mesh.faces.size() / 2, mesh.faces.size());
-  for (const auto& p : mesh.vertices) om.add_vertex(OmMesh::Point(p.x(), p.y(), p.z()));
+  OpenMesh::VPropHandleT<int> input_index;
+  om.add_property(input_index);
+  for (const auto& p : mesh.vertices) {
+    const auto v = om.add_vertex(OmMesh::Point(p.x(), p.y(), p.z()));
+    om.property(input_index, v) = v.idx();
+  }
   for (const auto& f : mesh.faces) {
     const OpenMesh::VertexHandle a(f[0]), b(f[1]), c(f[2]);
     if (!om.add_face(a, b, c).is_valid()) fail(mesh.name, "cannot be decimated: not a valid manifold mesh");
@@ -655,7 +666,11 @@ Mesh decimate(const Mesh& mesh, int target_faces) {
   decimater.module(normal_flipping).set_max_normal_deviation(60.0);
   decimater.initialize();
   decimater.decimate_to_faces(0, target_faces);
+  // Garbage collection moves handles around, so each vertex carries its input index through it.
   om.garbage_collection();
+  std::vector<int> kept;
+  kept.reserve(om.n_vertices());
+  for (const auto v : om.vertices()) kept.push_back(om.property(input_index, v));
 
   std::vector<Eigen::Vector3d> vertices;
   vertices.reserve(om.n_vertices());
@@ -682,6 +697,7 @@ Mesh decimate(const Mesh& mesh, int target_faces) {
   const Eigen::Vector3d centroid_out = area_weighted_centroid(result, area_out);
   const double scale = std::sqrt(area_in / area_out);
   for (auto& p : result.vertices) p = centroid_in + (p - centroid_out) * scale;
+  if (kept_vertices) *kept_vertices = std::move(kept);
   return result;
 }
 

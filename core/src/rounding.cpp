@@ -183,7 +183,7 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
   auto solver = make_solver(options.solver);
   RoundingResult result;
   Fixer fixer(lp);
-  if (!fixer.propagate_all()) throw SolverError("rounding: the matching LP is infeasible before any fixing");
+  if (!fixer.propagate_all()) throw InfeasibleError("rounding: the matching LP is infeasible (found before any fixing)");
 
   std::vector<double> x_full(lp.cols(), 0.0), y_full(lp.rows(), 0.0);
   struct Step {
@@ -220,7 +220,7 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
 
     if (r.status == LpStatus::Infeasible) {
       // The last fixing left an infeasible LP that propagation could not see: undo it and fix less.
-      if (!last) throw SolverError("rounding: the matching LP is infeasible");
+      if (!last) throw InfeasibleError("rounding: the matching LP is infeasible");
       fixer.restore(last->before);
       info.undone = true;
       auto smaller = last->batch;

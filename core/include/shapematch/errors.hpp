@@ -29,6 +29,13 @@ public:
   using Error::Error;
 };
 
+// A whole problem turned out to have no solution (e.g. a coarse-to-fine search space too narrow
+// to hold any matching); callers may widen the problem and retry.
+class InfeasibleError : public SolverError {
+public:
+  using SolverError::SolverError;
+};
+
 // No usable Vulkan device, out of device memory, a failed Vulkan call.
 class DeviceError : public Error {
 public:

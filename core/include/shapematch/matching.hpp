@@ -10,6 +10,8 @@ struct MatchingLpOptions {
   EnergyOptions energy;
   // Costs are divided by their mean over the variables so the LP is well conditioned.
   bool scale_costs = true;
+  // Per-vertex descriptors of X and Y (rows = vertices) for the feature term; empty: none.
+  Eigen::MatrixXd features_x, features_y;
 };
 
 struct MatchingLp {
@@ -19,7 +21,10 @@ struct MatchingLp {
   int64_t closedness_rows = 0;
 };
 
+// Over the full product space.
 MatchingLp build_matching_lp(const Mesh& x, const Geometry& gx, const Mesh& y, const Geometry& gy,
                              const MatchingLpOptions& options = {});
+// Over any space (the reduced spaces of coarse to fine), with a ready energy model.
+MatchingLp build_matching_lp(ProductSpace space, const EnergyModel& model, bool scale_costs = true);
 
 }  // namespace shapematch

@@ -71,7 +71,10 @@ void normalize_area(Mesh& mesh, double target_area = 1.0);
 
 // Quadric edge-collapse decimation (OpenMesh) to about `target_faces` faces, keeping the mesh
 // closed, manifold and consistently oriented. Returns the mesh unchanged if already smaller.
-Mesh decimate(const Mesh& mesh, int target_faces);
+// Collapses keep surviving vertices where they are (up to the area-preserving rescale), so the
+// result's vertices are a subset of the input's: `kept_vertices`, if given, receives for every
+// output vertex its index in `mesh` (ground truth and user features are indexed that way).
+Mesh decimate(const Mesh& mesh, int target_faces, std::vector<int>* kept_vertices = nullptr);
 
 // Writes OFF, OBJ, PLY or binary STL (by extension) through a temporary file renamed into place.
 // STL stores single-precision coordinates; the other formats round-trip doubles exactly.

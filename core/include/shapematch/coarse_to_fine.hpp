@@ -1,0 +1,68 @@
+#pragma once
+// Coarse-to-fine matching (§5, DESIGN.md §7): solve and round at the coarsest level, then at
+// each finer level only over the product triangles near the coarser level's Γ (eq. 17).
+#include "shapematch/hierarchy.hpp"
+#include "shapematch/matching.hpp"
+#include "shapematch/rounding.hpp"
+
+#include <functional>
+
+namespace shapematch {
+
+struct CoarseToFineOptions {
+  HierarchyOptions hierarchy;
+  int ring = 1;      // N(f) = faces within this many rings of f's vertices (eq. 17)
+  int max_ring = 3;  // widen up to this when a reduced LP is infeasible
+  MatchingLpOptions matching;
+  RoundingOptions rounding;
+};
+
+// The reduced product space of eq. (17): every product triangle (f_a, f_b) of the fine meshes
+// such that some (f'_a, f'_b) of the coarse Γ has χ(f_a) ∈ N(f'_a) and ψ(f_b) ∈ N(f'_b).
+// Degenerate fine elements (vertices, edges) inherit the parents of their incident faces.
+// Enumerated directly: memory is linear in the number of product triangles kept.
+std::vector<ProductTriangle> reduced_product_space(const MeshLevel& fine_x, const MeshLevel& fine_y,
+                                                   const Mesh& coarse_x, const Mesh& coarse_y,
+                                                   const std::vector<ProductTriangle>& coarse_gamma, int ring);
+
+struct LevelReport {
+  int level = 0;  // 0 = coarsest
+  int faces_x = 0, faces_y = 0;
+  int64_t variables = 0;       // product triangles kept
+  int64_t full_variables = 0;  // the full product space at this level, for comparison
+  int64_t constraints = 0;
+  int ring = -1;               // ring of the reduced space (-1: full space)
+  int widenings = 0;           // times the ring was widened after an infeasible reduced LP
+  int rounds = 0;
+  int64_t iterations = 0;      // LP iterations over all rounds
+  double lower_bound = 0.0, energy = 0.0, gap = 0.0;
+  double seconds = 0.0;
+  double peak_rss_mb = 0.0;
+};
+
+struct CoarseToFineResult {
+  std::vector<LevelReport> levels;
+  MatchingLp finest;        // the finest level's LP; its space refers to the matcher's meshes
+  RoundingResult rounding;  // the finest level's rounding
+};
+
+// Stateful: owns both hierarchies, so the result's space stays valid while the matcher lives.
+class CoarseToFineMatcher {
+public:
+  CoarseToFineMatcher(const Mesh& x, const Mesh& y, CoarseToFineOptions options = {});
+  // Per-vertex descriptors of the input meshes (rows = input vertices) for the feature term.
+  void set_features(Eigen::MatrixXd fx, Eigen::MatrixXd fy);
+
+  const MeshHierarchy& x_levels() const { return hx_; }
+  const MeshHierarchy& y_levels() const { return hy_; }
+
+  using Progress = std::function<void(const LevelReport& level, const RoundingRound& round)>;
+  CoarseToFineResult run(const Progress& progress = {}) const;
+
+private:
+  CoarseToFineOptions options_;
+  MeshHierarchy hx_, hy_;
+  Eigen::MatrixXd fx_, fy_;
+};
+
+}  // namespace shapematch

@@ -1,0 +1,51 @@
+#pragma once
+// Coarse-to-fine mesh hierarchies (§5, DESIGN.md §7): successive quadric decimation with a
+// child→parent face map between consecutive levels.
+#include "shapematch/geometry.hpp"
+#include "shapematch/mesh.hpp"
+
+#include <vector>
+
+namespace shapematch {
+
+struct HierarchyOptions {
+  int levels = 0;            // including the input itself; 0 = as many as `ratio` needs
+  int coarsest_faces = 250;  // faces of the coarsest level (about)
+  double ratio = 4.0;        // faces shrink by about this factor per level (when levels == 0)
+};
+
+struct MeshLevel {
+  Mesh mesh;
+  Geometry geometry;
+  std::vector<int> input_vertex;  // each vertex's index in the input mesh (decimation keeps a subset)
+  std::vector<int> parent_face;   // each face's parent in the next coarser level; empty at the coarsest
+};
+
+// levels[0] is the coarsest, levels.back() the input mesh itself (unchanged).
+struct MeshHierarchy {
+  std::vector<MeshLevel> levels;
+  int size() const { return static_cast<int>(levels.size()); }
+};
+
+// Face counts from `coarsest_faces` up to `input_faces`, geometric, `levels` entries (the last
+// is input_faces). With levels == 0 the count follows from the ratio.
+std::vector<int> level_face_counts(int input_faces, const HierarchyOptions& options);
+
+// Decimates level by level from the input (each level from the next finer one, so that vertex
+// subsets nest) and links every face to a parent.
+MeshHierarchy build_hierarchy(const Mesh& input, const std::vector<int>& face_counts);
+
+// The parent of every fine face: the coarse face nearest to its centroid among those whose
+// normal does not point away from the fine face's (so thin parts do not take parents from the
+// opposite side); the nearest of all if none qualifies.
+std::vector<int> parent_faces(const Mesh& fine, const Mesh& coarse);
+
+// The faces within `ring` rings of an element given by its vertices: ring 0 gives the faces
+// containing all of them (a face itself, an edge's two faces, a vertex's star), ring 1 the faces
+// touching any of them, ring k the faces touching the vertices of ring k−1. `vertex_faces` is
+// the vertex→incident-faces table.
+std::vector<int> ring_faces(const Mesh& mesh, const std::vector<std::vector<int>>& vertex_faces,
+                            const std::vector<int>& vertices, int ring);
+std::vector<std::vector<int>> vertex_face_table(const Mesh& mesh);
+
+}  // namespace shapematch

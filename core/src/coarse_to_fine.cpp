@@ -1,0 +1,200 @@
+#include "shapematch/coarse_to_fine.hpp"
+
+#include "shapematch/errors.hpp"
+#include "shapematch/system.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+
+namespace shapematch {
+namespace {
+
+std::array<int, 3> rotated(const std::array<int, 3>& f, int r) { return {f[r % 3], f[(r + 1) % 3], f[(r + 2) % 3]}; }
+
+void sort_unique(std::vector<int>& v) {
+  std::sort(v.begin(), v.end());
+  v.erase(std::unique(v.begin(), v.end()), v.end());
+}
+
+Eigen::MatrixXd rows_of(const Eigen::MatrixXd& m, const std::vector<int>& rows) {
+  if (m.size() == 0) return {};
+  Eigen::MatrixXd out(static_cast<Eigen::Index>(rows.size()), m.cols());
+  for (size_t i = 0; i < rows.size(); ++i) out.row(static_cast<Eigen::Index>(i)) = m.row(rows[i]);
+  return out;
+}
+
+}  // namespace
+
+std::vector<ProductTriangle> reduced_product_space(const MeshLevel& fine_x, const MeshLevel& fine_y,
+                                                   const Mesh& coarse_x, const Mesh& coarse_y,
+                                                   const std::vector<ProductTriangle>& coarse_gamma, int ring) {
+  const Mesh& X = fine_x.mesh;
+  const Mesh& Y = fine_y.mesh;
+  if (fine_x.parent_face.size() != size_t(X.num_faces()) || fine_y.parent_face.size() != size_t(Y.num_faces()))
+    throw InvalidInputError("reduced product space: the fine levels have no parent map");
+
+  // S(c) for every coarse X face c: the coarse Y faces ψ(f_b) may take when χ(f_a) = c, i.e. the
+  // union of N(f'_b) over the coarse product triangles with c ∈ N(f'_a). Exactly eq. (17).
+  const auto vfx = vertex_face_table(coarse_x), vfy = vertex_face_table(coarse_y);
+  std::vector<std::vector<int>> allowed(coarse_x.num_faces());
+  for (const ProductTriangle& g : coarse_gamma) {
+    const std::vector<int> na = ring_faces(coarse_x, vfx, {g.a.begin(), g.a.end()}, ring);
+    const std::vector<int> nb = ring_faces(coarse_y, vfy, {g.b.begin(), g.b.end()}, ring);
+    for (int c : na) allowed[c].insert(allowed[c].end(), nb.begin(), nb.end());
+  }
+  for (auto& s : allowed) sort_unique(s);
+
+  // Fine Y faces, vertices and directed edges under each coarse X face's allowance.
+  std::vector<std::vector<int>> children_y(coarse_y.num_faces());
+  for (int f = 0; f < Y.num_faces(); ++f) children_y[fine_y.parent_face[f]].push_back(f);
+  std::vector<std::vector<int>> faces_y(coarse_x.num_faces()), verts_y(coarse_x.num_faces()),
+      dedges_y(coarse_x.num_faces());
+  for (int c = 0; c < coarse_x.num_faces(); ++c) {
+    for (int d : allowed[c]) faces_y[c].insert(faces_y[c].end(), children_y[d].begin(), children_y[d].end());
+    sort_unique(faces_y[c]);
+    for (int f : faces_y[c])
+      for (int i = 0; i < 3; ++i) {
+        const int u = Y.faces[f][i], w = Y.faces[f][(i + 1) % 3];
+        verts_y[c].push_back(u);
+        dedges_y[c].push_back(Y.directed_edge_index(u, w));
+        dedges_y[c].push_back(Y.directed_edge_index(w, u));
+      }
+    sort_unique(verts_y[c]);
+    sort_unique(dedges_y[c]);
+  }
+
+  std::vector<ProductTriangle> out;
+  // Real faces of X: TT, TV, TE.
+  for (int fa = 0; fa < X.num_faces(); ++fa) {
+    const int c = fine_x.parent_face[fa];
+    for (int r = 0; r < 3; ++r)
+      for (int fb : faces_y[c]) out.push_back({rotated(X.faces[fa], r), Y.faces[fb], fa, fb});
+    for (int w : verts_y[c]) out.push_back({X.faces[fa], {w, w, w}, fa, -1});
+    for (int r = 0; r < 3; ++r)
+      for (int d : dedges_y[c]) {
+        const auto e = Y.directed_edge(d);
+        out.push_back({rotated(X.faces[fa], r), {e[0], e[1], e[1]}, fa, -1});
+      }
+  }
+  // Degenerate elements of X inherit their incident faces' allowances: VT and ET.
+  const auto vf_fine = vertex_face_table(X);
+  std::vector<int> ys;
+  for (int v = 0; v < X.num_vertices(); ++v) {
+    ys.clear();
+    for (int f : vf_fine[v]) {
+      const auto& s = faces_y[fine_x.parent_face[f]];
+      ys.insert(ys.end(), s.begin(), s.end());
+    }
+    sort_unique(ys);
+    for (int fb : ys) out.push_back({{v, v, v}, Y.faces[fb], -1, fb});
+  }
+  for (int e = 0; e < X.num_edges(); ++e) {
+    const int u = X.edges[e][0], w = X.edges[e][1];
+    ys.clear();
+    for (int f : vf_fine[u]) {
+      const auto& t = X.faces[f];
+      if (std::find(t.begin(), t.end(), w) == t.end()) continue;  // not one of the edge's two faces
+      const auto& s = faces_y[fine_x.parent_face[f]];
+      ys.insert(ys.end(), s.begin(), s.end());
+    }
+    sort_unique(ys);
+    for (const auto& [p, q] : {std::pair{u, w}, std::pair{w, u}})
+      for (int r = 0; r < 3; ++r)
+        for (int fb : ys) out.push_back({{p, q, q}, rotated(Y.faces[fb], r), -1, fb});
+  }
+  return out;
+}
+
+CoarseToFineMatcher::CoarseToFineMatcher(const Mesh& x, const Mesh& y, CoarseToFineOptions options)
+    : options_(std::move(options)) {
+  if (options_.ring < 0 || options_.max_ring < options_.ring)
+    throw InvalidInputError("coarse to fine: need 0 ≤ --ring ≤ max ring");
+  // Both shapes get the same number of levels, each its own face counts.
+  HierarchyOptions ho = options_.hierarchy;
+  if (ho.levels == 0) {
+    ho.levels = std::max(level_face_counts(x.num_faces(), ho).size(), level_face_counts(y.num_faces(), ho).size());
+  }
+  hx_ = build_hierarchy(x, level_face_counts(x.num_faces(), ho));
+  hy_ = build_hierarchy(y, level_face_counts(y.num_faces(), ho));
+  if (hx_.size() != hy_.size()) {  // one shape is already at or below the coarsest size
+    const int n = std::max(hx_.size(), hy_.size());
+    ho.levels = n;
+    ho.coarsest_faces = std::min({ho.coarsest_faces, x.num_faces(), y.num_faces()});
+    hx_ = build_hierarchy(x, level_face_counts(x.num_faces(), ho));
+    hy_ = build_hierarchy(y, level_face_counts(y.num_faces(), ho));
+  }
+}
+
+void CoarseToFineMatcher::set_features(Eigen::MatrixXd fx, Eigen::MatrixXd fy) {
+  if (fx.rows() != hx_.levels.back().mesh.num_vertices() || fy.rows() != hy_.levels.back().mesh.num_vertices() ||
+      fx.cols() != fy.cols())
+    throw InvalidInputError("features: need one row per input vertex and the same number of columns on both shapes");
+  fx_ = std::move(fx);
+  fy_ = std::move(fy);
+}
+
+CoarseToFineResult CoarseToFineMatcher::run(const Progress& progress) const {
+  CoarseToFineResult result;
+  std::vector<ProductTriangle> coarse_gamma;
+  for (int l = 0; l < hx_.size(); ++l) {
+    const MeshLevel& lx = hx_.levels[l];
+    const MeshLevel& ly = hy_.levels[l];
+    Stopwatch clock;
+    LevelReport rep;
+    rep.level = l;
+    rep.faces_x = lx.mesh.num_faces();
+    rep.faces_y = ly.mesh.num_faces();
+    rep.full_variables = ProductSpace::full_size(lx.mesh, ly.mesh);
+
+    EnergyModel model(lx.mesh, lx.geometry, ly.mesh, ly.geometry, options_.matching.energy);
+    if (fx_.size() > 0) model.set_features(rows_of(fx_, lx.input_vertex), rows_of(fy_, ly.input_vertex));
+
+    for (int ring = options_.ring;; ++ring) {
+      MatchingLp m;
+      if (l == 0) {
+        m = build_matching_lp(ProductSpace::full(lx.mesh, ly.mesh), model, options_.matching.scale_costs);
+      } else {
+        rep.ring = ring;
+        m = build_matching_lp(
+            ProductSpace::from_list(lx.mesh, ly.mesh,
+                                    reduced_product_space(lx, ly, hx_.levels[l - 1].mesh, hy_.levels[l - 1].mesh,
+                                                          coarse_gamma, ring)),
+            model, options_.matching.scale_costs);
+      }
+      rep.variables = m.lp.cols();
+      rep.constraints = m.lp.rows();
+      spdlog::info("level {}/{}: {} × {} faces, {} variables ({:.2g} % of the full space){}", l + 1, hx_.size(),
+                   rep.faces_x, rep.faces_y, rep.variables, 100.0 * double(rep.variables) / double(rep.full_variables),
+                   l > 0 ? fmt::format(", ring {}", ring) : std::string());
+      try {
+        RoundingResult rr = round_to_graph_surface(m.space, m.lp, m.energy, options_.rounding,
+                                                   [&](const RoundingRound& r) {
+                                                     if (progress) progress(rep, r);
+                                                   });
+        rep.rounds = static_cast<int>(rr.rounds.size());
+        for (const auto& r : rr.rounds) rep.iterations += r.iterations;
+        rep.lower_bound = rr.lower_bound;
+        rep.energy = rr.energy;
+        rep.gap = rr.gap;
+        coarse_gamma.clear();
+        for (int64_t j : rr.gamma) coarse_gamma.push_back(m.space[j]);
+        if (l + 1 == hx_.size()) {
+          result.finest = std::move(m);
+          result.rounding = std::move(rr);
+        }
+        break;
+      } catch (const InfeasibleError&) {
+        if (l == 0 || ring >= options_.max_ring) throw;
+        ++rep.widenings;
+        spdlog::warn("level {}: the reduced LP at ring {} is infeasible; widening to ring {}", l + 1, ring, ring + 1);
+      }
+    }
+    rep.seconds = clock.seconds();
+    rep.peak_rss_mb = peak_rss_mb();
+    result.levels.push_back(rep);
+  }
+  return result;
+}
+
+}  // namespace shapematch

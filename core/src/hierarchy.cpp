@@ -1,0 +1,123 @@
+#include "shapematch/hierarchy.hpp"
+
+#include "parallel.hpp"
+#include "shapematch/errors.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace shapematch {
+
+std::vector<int> level_face_counts(int input_faces, const HierarchyOptions& o) {
+  if (input_faces < 1) throw InvalidInputError("hierarchy: the mesh has no faces");
+  if (o.coarsest_faces < 4) throw InvalidInputError("hierarchy: --coarsest-faces must be at least 4");
+  if (o.levels < 0) throw InvalidInputError("hierarchy: --levels must not be negative");
+  const int coarsest = std::min(o.coarsest_faces, input_faces);
+  int levels = o.levels;
+  if (levels == 0) {
+    if (!(o.ratio > 1.0)) throw InvalidInputError("hierarchy: the level ratio must exceed 1");
+    levels = 1 + static_cast<int>(std::ceil(std::log(double(input_faces) / coarsest) / std::log(o.ratio) - 1e-9));
+    levels = std::max(levels, 1);
+  }
+  if (levels == 1 || coarsest == input_faces) return {input_faces};
+  std::vector<int> counts(levels);
+  for (int l = 0; l < levels; ++l)
+    counts[l] = static_cast<int>(std::lround(coarsest * std::pow(double(input_faces) / coarsest, double(l) / (levels - 1))));
+  counts.back() = input_faces;
+  return counts;
+}
+
+std::vector<std::vector<int>> vertex_face_table(const Mesh& mesh) {
+  std::vector<std::vector<int>> vf(mesh.num_vertices());
+  for (int f = 0; f < mesh.num_faces(); ++f)
+    for (int v : mesh.faces[f]) vf[v].push_back(f);
+  return vf;
+}
+
+std::vector<int> ring_faces(const Mesh& mesh, const std::vector<std::vector<int>>& vertex_faces,
+                            const std::vector<int>& vertices, int ring) {
+  std::vector<int> verts(vertices);
+  std::sort(verts.begin(), verts.end());
+  verts.erase(std::unique(verts.begin(), verts.end()), verts.end());
+  std::vector<int> faces;
+  if (ring <= 0) {
+    // The faces containing every vertex of the set: a face itself, an edge's two faces, a
+    // vertex's star.
+    if (!verts.empty())
+      for (int f : vertex_faces[verts.front()]) {
+        const auto& t = mesh.faces[f];
+        if (std::all_of(verts.begin(), verts.end(), [&](int u) { return std::find(t.begin(), t.end(), u) != t.end(); }))
+          faces.push_back(f);
+      }
+  } else {
+    for (int k = 0; k < ring; ++k) {
+      faces.clear();
+      for (int v : verts) faces.insert(faces.end(), vertex_faces[v].begin(), vertex_faces[v].end());
+      std::sort(faces.begin(), faces.end());
+      faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
+      if (k + 1 == ring) break;
+      for (int f : faces) verts.insert(verts.end(), mesh.faces[f].begin(), mesh.faces[f].end());
+      std::sort(verts.begin(), verts.end());
+      verts.erase(std::unique(verts.begin(), verts.end()), verts.end());
+    }
+  }
+  std::sort(faces.begin(), faces.end());
+  faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
+  return faces;
+}
+
+std::vector<int> parent_faces(const Mesh& fine, const Mesh& coarse) {
+  auto centroid = [](const Mesh& m, int f) {
+    const auto& t = m.faces[f];
+    return Eigen::Vector3d((m.vertices[t[0]] + m.vertices[t[1]] + m.vertices[t[2]]) / 3.0);
+  };
+  auto normal = [](const Mesh& m, int f) {
+    const auto& t = m.faces[f];
+    return Eigen::Vector3d((m.vertices[t[1]] - m.vertices[t[0]]).cross(m.vertices[t[2]] - m.vertices[t[0]]));
+  };
+  std::vector<Eigen::Vector3d> cc(coarse.num_faces()), cn(coarse.num_faces());
+  for (int g = 0; g < coarse.num_faces(); ++g) {
+    cc[g] = centroid(coarse, g);
+    cn[g] = normal(coarse, g);
+  }
+  // Brute force: |F_fine|·|F_coarse| is at most a few times 10^7 between consecutive levels.
+  std::vector<int> parent(fine.num_faces());
+  detail::parallel_for(fine.num_faces(), 0, [&](int64_t f) {
+    const Eigen::Vector3d c = centroid(fine, static_cast<int>(f)), n = normal(fine, static_cast<int>(f));
+    double best = std::numeric_limits<double>::infinity(), best_any = best;
+    int arg = -1, arg_any = -1;
+    for (int g = 0; g < coarse.num_faces(); ++g) {
+      const double d = (cc[g] - c).squaredNorm();
+      if (d < best_any) best_any = d, arg_any = g;
+      if (d < best && cn[g].dot(n) > 0) best = d, arg = g;
+    }
+    parent[f] = arg >= 0 ? arg : arg_any;
+  });
+  return parent;
+}
+
+MeshHierarchy build_hierarchy(const Mesh& input, const std::vector<int>& face_counts) {
+  if (face_counts.empty()) throw InvalidInputError("hierarchy: no levels");
+  MeshHierarchy h;
+  h.levels.resize(face_counts.size());
+  MeshLevel& top = h.levels.back();
+  top.mesh = input;
+  top.input_vertex.resize(input.num_vertices());
+  for (int v = 0; v < input.num_vertices(); ++v) top.input_vertex[v] = v;
+  for (int l = static_cast<int>(face_counts.size()) - 2; l >= 0; --l) {
+    MeshLevel& finer = h.levels[l + 1];
+    MeshLevel& level = h.levels[l];
+    std::vector<int> kept;
+    level.mesh = decimate(finer.mesh, face_counts[l], &kept);
+    level.input_vertex.resize(kept.size());
+    for (size_t v = 0; v < kept.size(); ++v) level.input_vertex[v] = finer.input_vertex[kept[v]];
+    finer.parent_face = parent_faces(finer.mesh, level.mesh);
+  }
+  for (auto& level : h.levels) level.geometry = compute_geometry(level.mesh);
+  return h;
+}
+
+}  // namespace shapematch

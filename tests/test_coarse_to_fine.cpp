@@ -1,0 +1,110 @@
+#include "shapematch/coarse_to_fine.hpp"
+#include "shapematch/errors.hpp"
+#include "shapematch/shapes.hpp"
+#include "test_helpers.hpp"
+
+#include <doctest/doctest.h>
+
+#include <set>
+
+using namespace shapematch;
+
+namespace {
+Mesh lumpy_sphere(int subdivisions, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-0.1, 0.1);
+  return test::deformed(shapes::icosphere(subdivisions), [&](const Eigen::Vector3d& p) {
+    return Eigen::Vector3d(1.3 * p.x() + u(rng), p.y() + u(rng), 0.8 * p.z() + u(rng));
+  });
+}
+
+std::set<int64_t> full_indices(const ProductSpace& full, const std::vector<ProductTriangle>& list) {
+  std::set<int64_t> s;
+  for (const auto& t : list) s.insert(full.index_in_full(t));
+  return s;
+}
+}  // namespace
+
+TEST_CASE("coarse to fine: the reduced space is a duplicate-free subset that grows with the ring") {
+  const Mesh m = lumpy_sphere(2, 3);  // 320 faces
+  const MeshHierarchy h = build_hierarchy(m, {20, 80});
+  const MeshLevel& fine = h.levels[1];
+  const Mesh& coarse = h.levels[0].mesh;
+  const ProductSpace full = ProductSpace::full(fine.mesh, fine.mesh);
+  std::vector<std::set<int64_t>> spaces;
+  for (int ring : {0, 1, 2}) {
+    const auto list = reduced_product_space(fine, fine, coarse, coarse, identity_matching(coarse), ring);
+    const auto s = full_indices(full, list);  // throws if any entry is not canonical
+    CHECK(s.size() == list.size());
+    if (ring < 2) CHECK(int64_t(list.size()) < full.size());
+    if (!spaces.empty()) CHECK(std::includes(s.begin(), s.end(), spaces.back().begin(), spaces.back().end()));
+    spaces.push_back(s);
+  }
+  CHECK(spaces[0].size() < spaces[1].size());
+  // A coarse Γ that is everything gives the full space.
+  std::vector<ProductTriangle> everything;
+  const ProductSpace coarse_full = ProductSpace::full(coarse, coarse);
+  for (int64_t j = 0; j < coarse_full.size(); ++j) everything.push_back(coarse_full[j]);
+  CHECK(int64_t(reduced_product_space(fine, fine, coarse, coarse, everything, 0).size()) == full.size());
+}
+
+TEST_CASE("coarse to fine: the fine identity survives the reduction of a coarse identity") {
+  const Mesh m = lumpy_sphere(2, 4);
+  const MeshHierarchy h = build_hierarchy(m, {20, 80, 320});
+  for (int l = 1; l < h.size(); ++l) {
+    const auto list = reduced_product_space(h.levels[l], h.levels[l], h.levels[l - 1].mesh, h.levels[l - 1].mesh,
+                                            identity_matching(h.levels[l - 1].mesh), 0);
+    const ProductSpace full = ProductSpace::full(h.levels[l].mesh, h.levels[l].mesh);
+    const auto s = full_indices(full, list);
+    for (const auto& t : identity_matching(h.levels[l].mesh)) CHECK(s.count(full.index_in_full(t)) == 1);
+  }
+}
+
+TEST_CASE("coarse to fine: a shape against itself is matched to the identity at every level") {
+  const Mesh m = lumpy_sphere(2, 5);
+  CoarseToFineOptions o;
+  o.hierarchy.levels = 3;
+  o.hierarchy.coarsest_faces = 20;
+  o.ring = 0;
+  o.rounding.solver = "clp-dual";
+  const CoarseToFineMatcher matcher(m, m, o);
+  REQUIRE(matcher.x_levels().size() == 3);
+  const CoarseToFineResult r = matcher.run();
+  REQUIRE(r.levels.size() == 3);
+  for (const auto& l : r.levels) {
+    CAPTURE(l.level);
+    CHECK(l.energy == doctest::Approx(0.0).epsilon(1e-9));
+    CHECK(l.variables <= l.full_variables);
+  }
+  CHECK(r.levels[2].variables < r.levels[2].full_variables / 4);
+  const VertexMaps maps = vertex_maps(r.finest.space, r.rounding.gamma);
+  for (int v = 0; v < m.num_vertices(); ++v) CHECK(maps.x_to_y[v] == v);
+  CHECK(check_graph_surface(r.finest.space, r.rounding.gamma).ok());
+}
+
+TEST_CASE("coarse to fine: a deformed pair with different triangulations ends verified") {
+  const Mesh x = shapes::bent_finger(10, 8, 8), y = shapes::bent_finger(60, 8, 8);
+  CoarseToFineOptions o;
+  o.hierarchy.levels = 2;
+  o.hierarchy.coarsest_faces = 24;
+  o.rounding.solver = "pdhg-cpu";
+  const CoarseToFineMatcher matcher(decimate(x, 90), decimate(y, 100), o);
+  const CoarseToFineResult r = matcher.run();
+  REQUIRE(r.levels.size() == 2);
+  const GraphSurfaceCheck c = check_graph_surface(r.finest.space, r.rounding.gamma);
+  CHECK(c.covers_x);
+  CHECK(c.covers_y);
+  CHECK(c.orientation);
+  CHECK(satisfies_exactly(r.finest.lp, r.rounding.gamma));
+  for (const auto& l : r.levels) {
+    CHECK(l.lower_bound <= l.energy + 1e-9);
+    CHECK(l.rounds >= 1);
+  }
+}
+
+TEST_CASE("coarse to fine: features must have one row per input vertex") {
+  const Mesh m = lumpy_sphere(1, 6);
+  CoarseToFineMatcher matcher(m, m, {});
+  CHECK_THROWS_AS(matcher.set_features(Eigen::MatrixXd::Zero(3, 2), Eigen::MatrixXd::Zero(3, 2)), InvalidInputError);
+  CHECK_NOTHROW(matcher.set_features(Eigen::MatrixXd::Zero(m.num_vertices(), 2), Eigen::MatrixXd::Zero(m.num_vertices(), 2)));
+}

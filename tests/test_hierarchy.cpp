@@ -1,0 +1,103 @@
+#include "shapematch/hierarchy.hpp"
+#include "shapematch/shapes.hpp"
+#include "test_helpers.hpp"
+
+#include <doctest/doctest.h>
+
+#include <set>
+
+using namespace shapematch;
+
+namespace {
+Mesh lumpy_sphere(int subdivisions, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-0.08, 0.08);
+  return test::deformed(shapes::icosphere(subdivisions), [&](const Eigen::Vector3d& p) {
+    return Eigen::Vector3d(1.3 * p.x() + u(rng), p.y() + u(rng), 0.8 * p.z() + u(rng));
+  });
+}
+}  // namespace
+
+TEST_CASE("hierarchy: face counts are geometric from the coarsest level to the input") {
+  HierarchyOptions o;
+  o.coarsest_faces = 250;
+  const auto c = level_face_counts(10000, o);
+  REQUIRE(c.size() == 4);  // 250·4³ = 16000 ≥ 10000: three steps of about 3.4×
+  CHECK(c.front() == 250);
+  CHECK(c.back() == 10000);
+  for (size_t i = 1; i < c.size(); ++i) CHECK(double(c[i]) / c[i - 1] == doctest::Approx(std::cbrt(40.0)).epsilon(0.01));
+  CHECK(level_face_counts(200, o) == std::vector<int>{200});
+  o.levels = 2;
+  CHECK(level_face_counts(1000, o) == std::vector<int>{250, 1000});
+  o.coarsest_faces = 2;
+  CHECK_THROWS_AS(level_face_counts(1000, o), InvalidInputError);
+}
+
+TEST_CASE("hierarchy: decimation keeps a subset of the input vertices and says which") {
+  const Mesh m = lumpy_sphere(3, 1);
+  std::vector<int> kept;
+  const Mesh d = decimate(m, 300, &kept);
+  REQUIRE(kept.size() == size_t(d.num_vertices()));
+  CHECK(std::set<int>(kept.begin(), kept.end()).size() == kept.size());
+  // Kept vertices stay where they were up to the decimator's area-preserving similarity.
+  const double s = (d.vertices[1] - d.vertices[0]).norm() / (m.vertices[kept[1]] - m.vertices[kept[0]]).norm();
+  CHECK(s == doctest::Approx(1.0).epsilon(0.1));
+  for (int v = 2; v < d.num_vertices(); ++v) {
+    const Eigen::Vector3d a = d.vertices[v] - d.vertices[0], b = m.vertices[kept[v]] - m.vertices[kept[0]];
+    CHECK((a - s * b).norm() < 1e-9);
+  }
+  std::vector<int> same;
+  decimate(m, m.num_faces(), &same);
+  CHECK(same.size() == size_t(m.num_vertices()));
+  CHECK(same.back() == m.num_vertices() - 1);
+}
+
+TEST_CASE("hierarchy: every level is a valid mesh, vertex ids nest and parents are near") {
+  const Mesh m = lumpy_sphere(3, 2);  // 1280 faces
+  const MeshHierarchy h = build_hierarchy(m, {80, 320, 1280});
+  REQUIRE(h.size() == 3);
+  CHECK(h.levels.back().mesh.vertices == m.vertices);
+  CHECK(h.levels.front().parent_face.empty());
+  for (int l = 0; l < h.size(); ++l) {
+    const MeshLevel& level = h.levels[l];
+    CAPTURE(l);
+    CHECK_NOTHROW(validate_mesh(level.mesh));
+    CHECK(std::abs(level.mesh.num_faces() - std::vector<int>{80, 320, 1280}[l]) <= 2);
+    CHECK(level.geometry.face_area.size() == size_t(level.mesh.num_faces()));
+    REQUIRE(level.input_vertex.size() == size_t(level.mesh.num_vertices()));
+    if (l == 0) continue;
+    // Coarser vertices are a subset of finer ones, in input indices.
+    const std::set<int> finer(level.input_vertex.begin(), level.input_vertex.end());
+    for (int v : h.levels[l - 1].input_vertex) CHECK(finer.count(v) == 1);
+    // Every parent is close (a coarse edge here is about 0.5; a wrong map gives distances near 2).
+    REQUIRE(level.parent_face.size() == size_t(level.mesh.num_faces()));
+    const Mesh& coarse = h.levels[l - 1].mesh;
+    std::vector<int> children(coarse.num_faces(), 0);
+    for (int f = 0; f < level.mesh.num_faces(); ++f) {
+      const int p = level.parent_face[f];
+      REQUIRE(p >= 0);
+      REQUIRE(p < coarse.num_faces());
+      ++children[p];
+      auto centroid = [](const Mesh& mm, int ff) {
+        return Eigen::Vector3d((mm.vertices[mm.faces[ff][0]] + mm.vertices[mm.faces[ff][1]] + mm.vertices[mm.faces[ff][2]]) / 3);
+      };
+      CHECK((centroid(level.mesh, f) - centroid(coarse, p)).norm() < 1.0);
+    }
+    const int childless = static_cast<int>(std::count(children.begin(), children.end(), 0));
+    CHECK(childless <= coarse.num_faces() / 10);
+  }
+}
+
+TEST_CASE("hierarchy: rings grow from the element itself outwards") {
+  const Mesh m = shapes::icosphere(1);  // 80 faces, valence 5 and 6
+  const auto vf = vertex_face_table(m);
+  const auto& f = m.faces[7];
+  CHECK(ring_faces(m, vf, {f[0], f[1], f[2]}, 0) == std::vector<int>{7});
+  CHECK(ring_faces(m, vf, {f[0], f[1], f[1]}, 0).size() == 2);          // an edge: its two faces
+  CHECK(ring_faces(m, vf, {f[0], f[0], f[0]}, 0).size() == vf[f[0]].size());  // a vertex: its star
+  const auto r1 = ring_faces(m, vf, {f[0], f[1], f[2]}, 1), r2 = ring_faces(m, vf, {f[0], f[1], f[2]}, 2);
+  CHECK(r1.size() >= 12);
+  CHECK(r1.size() <= 13);
+  CHECK(r2.size() > r1.size());
+  CHECK(std::includes(r2.begin(), r2.end(), r1.begin(), r1.end()));
+}
