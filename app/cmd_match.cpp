@@ -83,7 +83,7 @@ int run_match(const MatchArgs& args) {
   co.hierarchy = args.hierarchy;
   co.ring = args.ring;
   co.max_ring = std::max(args.max_ring, args.ring);
-  co.matching = matching_options(args.pair);
+  co.matching = matching_options(args.pair, p);
   RoundingOptions& ro = co.rounding;
   ro.solver = solver_for(args);
   ro.threshold = args.threshold;
@@ -148,6 +148,7 @@ int run_match(const MatchArgs& args) {
     save_mesh(x, (tmp / "x.ply").string(), colors_x);
     save_mesh(y, (tmp / "y.ply").string(), colors_y);
     write_png(render_side_by_side(x, colors_x, y, colors_y, RenderOptions{}), (tmp / "match.png").string());
+    seconds.set("features", p.features_seconds);
     seconds.set("output", stage.seconds());
     seconds.set("total", total.seconds());
 
@@ -196,6 +197,8 @@ int run_match(const MatchArgs& args) {
                               .set("tolerance", args.tolerance)
                               .set("faces", args.pair.faces)
                               .set("keep_scale", args.pair.keep_scale)
+                              .set("features", p.features)
+                              .set("feature_weight", args.pair.feature_weight)
                               .set("levels", matcher.x_levels().size())
                               .set("coarsest_faces", args.hierarchy.coarsest_faces)
                               .set("ring", args.ring));

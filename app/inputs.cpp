@@ -1,7 +1,9 @@
 #include "inputs.hpp"
 
 #include "commands.hpp"
+#include "shapematch/descriptors.hpp"
 #include "shapematch/errors.hpp"
+#include "shapematch/system.hpp"
 
 #include <spdlog/spdlog.h>
 
@@ -16,6 +18,24 @@ void add_pair_options(CLI::App& app, PairArgs& args) {
   app.add_flag("--keep-scale", args.keep_scale, "do not normalise both shapes to unit area");
   app.add_option("--bending", args.bending, "bending weight")->capture_default_str();
   app.add_option("--lame", args.lame, "Lamé parameters λ,μ of the membrane")->delimiter(',')->expected(2);
+  app.add_option("--feature-weight", args.feature_weight, "weight μ of the feature term (0: none)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  app.add_option("--degenerate-penalty", args.degenerate_penalty,
+                 "extra cost per unit area of every degenerate product triangle")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  app.add_option("--membrane", args.membrane, "membrane energy: svk (the paper) or compressive")
+      ->check(CLI::IsMember({"svk", "compressive"}))
+      ->capture_default_str();
+  app.add_option("--features-x", args.features_x, "per-vertex descriptors of X (text rows or .npy)");
+  app.add_option("--features-y", args.features_y, "per-vertex descriptors of Y (text rows or .npy)");
+  app.add_option("--wks", args.wks, "Wave Kernel Signature as the features: on, off, auto (on unless --features-x/y)")
+      ->check(CLI::IsMember({"on", "off", "auto"}))
+      ->capture_default_str();
+  app.add_option("--wks-eigenpairs", args.wks_eigenpairs, "Laplace eigenpairs of the WKS")
+      ->check(CLI::Range(2, 2000))
+      ->capture_default_str();
 }
 
 MeshPair load_pair(const PairArgs& args) {
@@ -27,18 +47,50 @@ MeshPair load_pair(const PairArgs& args) {
   load.normalize_area = !args.keep_scale;
   p.x = load_mesh(p.x_file, load);
   p.y = load_mesh(p.y_file, load);
+  if (args.features_x.empty() != args.features_y.empty())
+    throw InvalidInputError("give both --features-x and --features-y, or neither");
+  const bool user = !args.features_x.empty();
+  if (user && args.wks == "on") throw InvalidInputError("--wks on and --features-x/y exclude each other");
+  Stopwatch clock;
+  if (args.feature_weight > 0 && user) {
+    p.features_x = load_features(args.features_x, p.x.num_vertices());
+    p.features_y = load_features(args.features_y, p.y.num_vertices());
+    if (p.features_x.cols() != p.features_y.cols())
+      throw InvalidInputError(fmt::format("{} has {} columns but {} has {}", args.features_x, p.features_x.cols(),
+                                          args.features_y, p.features_y.cols()));
+    p.features = "user";
+  } else if (args.feature_weight > 0 && args.wks != "off") {
+    // On the input meshes, before any decimation: the spectrum of the finer mesh is the better one.
+    WksOptions wo;
+    wo.eigenpairs = args.wks_eigenpairs;
+    p.features_x = wave_kernel_signature(p.x, wo);
+    p.features_y = wave_kernel_signature(p.y, wo);
+    p.features = "wks";
+  } else {
+    p.features = "none";
+  }
+  p.features_seconds = clock.seconds();
   p.x_input_vertices = p.x.num_vertices();
   p.y_input_vertices = p.y.num_vertices();
   p.x = decimate(p.x, args.faces > 0 ? args.faces : p.x.num_faces(), &p.x_ids);
   p.y = decimate(p.y, args.faces > 0 ? args.faces : p.y.num_faces(), &p.y_ids);
+  if (p.features_x.size() > 0) {
+    p.features_x = select_rows(p.features_x, p.x_ids);
+    p.features_y = select_rows(p.features_y, p.y_ids);
+  }
   p.gx = compute_geometry(p.x);
   p.gy = compute_geometry(p.y);
   spdlog::info("X: {} ({} faces), Y: {} ({} faces)", p.x.name, p.x.num_faces(), p.y.name, p.y.num_faces());
   return p;
 }
 
-MatchingLpOptions matching_options(const PairArgs& args) {
+MatchingLpOptions matching_options(const PairArgs& args, const MeshPair& pair) {
   MatchingLpOptions o;
+  o.energy.degenerate_penalty = args.degenerate_penalty;
+  o.energy.membrane = args.membrane == "svk" ? MembraneModel::StVenantKirchhoff : MembraneModel::Compressive;
+  o.energy.feature_weight = pair.features_x.size() > 0 ? args.feature_weight : 0.0;
+  o.features_x = pair.features_x;
+  o.features_y = pair.features_y;
   o.energy.bending_weight = args.bending;
   o.energy.lame_lambda = args.lame.at(0);
   o.energy.lame_mu = args.lame.at(1);

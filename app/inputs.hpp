@@ -15,6 +15,13 @@ struct PairArgs {
   bool keep_scale = false;
   double bending = 1.0;
   std::vector<double> lame{1.0, 1.0};
+  // The feature term (DESIGN.md §5): user descriptors, or the Wave Kernel Signature.
+  std::string features_x, features_y;
+  std::string wks = "auto";  // on, off, auto (on unless user features are given)
+  double feature_weight = 0.0;
+  double degenerate_penalty = 0.0;
+  std::string membrane = "svk";
+  int wks_eigenpairs = 100;
 };
 
 // Registers x, y, --faces, --keep-scale, --bending and --lame.
@@ -25,12 +32,15 @@ struct MeshPair {
   Geometry gx, gy;
   int x_input_vertices = 0, y_input_vertices = 0;
   std::vector<int> x_ids, y_ids;  // each vertex's index in its input file (decimation keeps a subset)
+  Eigen::MatrixXd features_x, features_y;  // one row per vertex of x and y; empty without a feature term
+  std::string features;                    // "wks", "user" or "none"
+  double features_seconds = 0.0;
   std::string x_file, y_file;
 };
 
 // Loads (the bundled pair when none is given), validates, decimates and computes geometry.
 MeshPair load_pair(const PairArgs& args);
 
-MatchingLpOptions matching_options(const PairArgs& args);
+MatchingLpOptions matching_options(const PairArgs& args, const MeshPair& pair);
 
 }  // namespace shapematch::app

@@ -124,6 +124,8 @@ CoarseToFineMatcher::CoarseToFineMatcher(const Mesh& x, const Mesh& y, CoarseToF
     hx_ = build_hierarchy(x, level_face_counts(x.num_faces(), ho));
     hy_ = build_hierarchy(y, level_face_counts(y.num_faces(), ho));
   }
+  if (options_.matching.features_x.size() > 0 || options_.matching.features_y.size() > 0)
+    set_features(std::move(options_.matching.features_x), std::move(options_.matching.features_y));
 }
 
 void CoarseToFineMatcher::set_features(Eigen::MatrixXd fx, Eigen::MatrixXd fy) {

@@ -44,6 +44,17 @@ double membrane_energy(const Triangle3& s, const Triangle3& t, double lambda, do
   return area(s) * (0.5 * lambda * tr * tr + mu * (e * e).trace());
 }
 
+double compressive_membrane_energy(const Triangle3& s, const Triangle3& t, double lambda, double mu) {
+  if (degenerate(s)) return 0.0;
+  // Squared principal stretches: the eigenvalues of C = G_s⁻¹G_t (similar to a symmetric PSD matrix).
+  const Eigen::Matrix2d c = gram(s).inverse() * gram(t);
+  const double half_tr = 0.5 * c.trace(), det = c.determinant();
+  const double root = std::sqrt(std::max(0.0, half_tr * half_tr - det));
+  const double e1 = 0.5 * (std::min(1.0, std::max(0.0, half_tr + root)) - 1.0);
+  const double e2 = 0.5 * (std::min(1.0, std::max(0.0, half_tr - root)) - 1.0);
+  return area(s) * (0.5 * lambda * (e1 + e2) * (e1 + e2) + mu * (e1 * e1 + e2 * e2));
+}
+
 double membrane_energy_springs(const Triangle3& s, const Triangle3& t, double lambda, double mu) {
   if (degenerate(s)) return 0.0;
   const double a = area(s);
@@ -76,10 +87,11 @@ double EnergyModel::membrane(const ProductTriangle& p) const {
   const Triangle3 s{x_.vertices[p.a[0]], x_.vertices[p.a[1]], x_.vertices[p.a[2]]};
   const Triangle3 t{y_.vertices[p.b[0]], y_.vertices[p.b[1]], y_.vertices[p.b[2]]};
   const double l = options_.lame_lambda, m = options_.lame_mu;
+  const auto w = options_.membrane == MembraneModel::StVenantKirchhoff ? membrane_energy : compressive_membrane_energy;
   // Symmetrised (DESIGN.md §5): a degenerate side has no area, so the other direction counts twice.
-  if (p.fa >= 0 && p.fb >= 0) return membrane_energy(s, t, l, m) + membrane_energy(t, s, l, m);
-  if (p.fa >= 0) return 2.0 * membrane_energy(s, t, l, m);
-  return 2.0 * membrane_energy(t, s, l, m);
+  if (p.fa >= 0 && p.fb >= 0) return w(s, t, l, m) + w(t, s, l, m);
+  if (p.fa >= 0) return 2.0 * w(s, t, l, m);
+  return 2.0 * w(t, s, l, m);
 }
 
 double EnergyModel::bending(const ProductTriangle& p) const {
@@ -109,6 +121,8 @@ double EnergyModel::operator()(const ProductTriangle& p) const {
   double e = membrane(p);
   if (options_.bending_weight != 0.0) e += options_.bending_weight * bending(p);
   if (options_.feature_weight != 0.0) e += options_.feature_weight * feature(p);
+  if (options_.degenerate_penalty != 0.0 && (p.fa < 0 || p.fb < 0))
+    e += options_.degenerate_penalty * (p.fa >= 0 ? gx_.face_area[p.fa] : gy_.face_area[p.fb]);
   return e;
 }
 

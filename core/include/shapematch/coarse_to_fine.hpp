@@ -13,7 +13,7 @@ struct CoarseToFineOptions {
   HierarchyOptions hierarchy;
   int ring = 1;      // N(f) = faces within this many rings of f's vertices (eq. 17)
   int max_ring = 3;  // widen up to this when a reduced LP is infeasible
-  MatchingLpOptions matching;
+  MatchingLpOptions matching;  // its features (if any) have one row per vertex of the input meshes
   RoundingOptions rounding;
 };
 

@@ -5,11 +5,22 @@
 
 namespace shapematch {
 
+// St. Venant–Kirchhoff (the paper) is quartic in stretch but bounded in compression, so with the
+// symmetrisation a shape squashed onto curves of the other costs less than any stretched
+// matching; `Compressive` keeps only the compressive principal strains of each direction, so
+// that stretch in X→Y is charged once, as compression in Y→X (docs/architecture.md).
+enum class MembraneModel { StVenantKirchhoff, Compressive };
+
 struct EnergyOptions {
+  MembraneModel membrane = MembraneModel::StVenantKirchhoff;
   double lame_lambda = 1.0;   // Lamé λ of the membrane (St. Venant–Kirchhoff)
   double lame_mu = 1.0;       // Lamé μ
   double bending_weight = 1.0;
   double feature_weight = 0.0;
+  // κ·(area of the real face) added to every degenerate product triangle (not in the paper):
+  // the St. Venant–Kirchhoff membrane charges a face squashed to a segment only 0.75 of its area,
+  // so without it the LP prefers folding both shapes onto curves (docs/architecture.md).
+  double degenerate_penalty = 0.0;
 };
 
 using Triangle3 = std::array<Eigen::Vector3d, 3>;
@@ -17,6 +28,8 @@ using Triangle3 = std::array<Eigen::Vector3d, 3>;
 // W(s→t) = A_s((λ/2)(tr E)² + μ tr(E²)), E = (G_s⁻¹G_t − I)/2: the membrane energy of mapping the
 // source triangle onto the target, vertices matched in order. 0 if the source is degenerate.
 double membrane_energy(const Triangle3& source, const Triangle3& target, double lambda, double mu);
+// The same with the principal squared stretches clamped to ≤ 1: only compression costs.
+double compressive_membrane_energy(const Triangle3& source, const Triangle3& target, double lambda, double mu);
 // The same quantity in Delingette's biquadratic spring form (an independent formula for tests).
 double membrane_energy_springs(const Triangle3& source, const Triangle3& target, double lambda, double mu);
 

@@ -1,0 +1,357 @@
+// `shapematch eval DIR`: a `match` output directory against ground truth (DESIGN.md §9).
+#include "commands.hpp"
+#include "shapematch/errors.hpp"
+#include "shapematch/evaluation.hpp"
+#include "shapematch/files.hpp"
+#include "shapematch/json.hpp"
+#include "shapematch/system.hpp"
+
+#include <spdlog/fmt/fmt.h>
+#include <spdlog/spdlog.h>
+
+#include <cctype>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <random>
+#include <sstream>
+#include <string_view>
+
+namespace fs = std::filesystem;
+
+namespace shapematch::app {
+namespace {
+
+struct EvalArgs {
+  std::string dir;
+  std::string gt = "identity";
+  std::string gt_x, gt_y, gt_map;
+  std::string y_mesh;  // overrides report.json's y.file
+  std::string pck_csv, pck_png;
+  int threads = 0;
+};
+
+// Just enough JSON to read report.json back: the values are kept as a tree and looked up by key.
+struct JsonNode {
+  enum class Kind { Null, Bool, Number, String, Array, Object } kind = Kind::Null;
+  double number = 0;
+  std::string text;
+  std::vector<std::pair<std::string, JsonNode>> members;  // object members; array items have no key
+
+  const JsonNode* get(const std::string& key) const {
+    if (kind != Kind::Object) return nullptr;
+    for (const auto& [k, v] : members)
+      if (k == key) return &v;
+    return nullptr;
+  }
+};
+
+class JsonParser {
+public:
+  JsonParser(std::string text, std::string path) : text_(std::move(text)), path_(std::move(path)) {}
+
+  JsonNode parse() {
+    JsonNode root = value(0);
+    skip_space();
+    if (pos_ != text_.size()) fail("unexpected text after the JSON value");
+    return root;
+  }
+
+private:
+  [[noreturn]] void fail(const std::string& problem) const {
+    throw InvalidInputError(path_ + ": not valid JSON at byte " + std::to_string(pos_) + ": " + problem);
+  }
+  void skip_space() {
+    while (pos_ < text_.size() && std::string_view(" \t\r\n").find(text_[pos_]) != std::string_view::npos) ++pos_;
+  }
+  bool eat(char c) {
+    skip_space();
+    if (pos_ < text_.size() && text_[pos_] == c) return ++pos_, true;
+    return false;
+  }
+  void expect(char c) {
+    if (!eat(c)) fail(std::string("expected '") + c + "'");
+  }
+
+  JsonNode value(int depth) {
+    if (depth > 64) fail("nested too deeply");
+    skip_space();
+    if (pos_ >= text_.size()) fail("unexpected end");
+    JsonNode node;
+    const char c = text_[pos_];
+    if (c == '{' || c == '[') {
+      const bool object = c == '{';
+      node.kind = object ? JsonNode::Kind::Object : JsonNode::Kind::Array;
+      ++pos_;
+      if (eat(object ? '}' : ']')) return node;
+      do {
+        std::string key;
+        if (object) {
+          skip_space();
+          key = string();
+          expect(':');
+        }
+        node.members.emplace_back(std::move(key), value(depth + 1));
+      } while (eat(','));
+      expect(object ? '}' : ']');
+    } else if (c == '"') {
+      node.kind = JsonNode::Kind::String;
+      node.text = string();
+    } else if (literal("true")) {
+      node.kind = JsonNode::Kind::Bool;
+      node.number = 1;
+    } else if (literal("false")) {
+      node.kind = JsonNode::Kind::Bool;
+    } else if (literal("null")) {
+      node.kind = JsonNode::Kind::Null;
+    } else {
+      const size_t begin = pos_;
+      while (pos_ < text_.size() && std::string_view("+-0123456789.eE").find(text_[pos_]) != std::string_view::npos)
+        ++pos_;
+      const std::string token = text_.substr(begin, pos_ - begin);
+      char* end = nullptr;
+      node.kind = JsonNode::Kind::Number;
+      node.number = token.empty() ? 0 : std::strtod(token.c_str(), &end);
+      if (token.empty() || end != token.c_str() + token.size()) fail("expected a value");
+    }
+    return node;
+  }
+
+  bool literal(const char* word) {
+    const std::string_view w(word);
+    if (text_.compare(pos_, w.size(), w) != 0) return false;
+    pos_ += w.size();
+    return true;
+  }
+
+  std::string string() {
+    if (pos_ >= text_.size() || text_[pos_] != '"') fail("expected a string");
+    ++pos_;
+    std::string out;
+    while (true) {
+      if (pos_ >= text_.size()) fail("unterminated string");
+      const char c = text_[pos_++];
+      if (c == '"') return out;
+      if (c != '\\') {
+        out += c;
+        continue;
+      }
+      if (pos_ >= text_.size()) fail("unterminated string");
+      const char e = text_[pos_++];
+      switch (e) {
+        case '"': case '\\': case '/': out += e; break;
+        case 'b': out += '\b'; break;
+        case 'f': out += '\f'; break;
+        case 'n': out += '\n'; break;
+        case 'r': out += '\r'; break;
+        case 't': out += '\t'; break;
+        case 'u': {
+          if (pos_ + 4 > text_.size()) fail("short \\u escape");
+          unsigned code = 0;
+          for (int i = 0; i < 4; ++i) {
+            const unsigned char h = static_cast<unsigned char>(text_[pos_++]);
+            if (!std::isxdigit(h)) fail("bad \\u escape");
+            code = code * 16 + (std::isdigit(h) ? h - '0' : std::tolower(h) - 'a' + 10);
+          }
+          // UTF-8; the writer escapes only control characters, so surrogate pairs are not joined.
+          if (code < 0x80) {
+            out += static_cast<char>(code);
+          } else if (code < 0x800) {
+            out += static_cast<char>(0xC0 | (code >> 6));
+            out += static_cast<char>(0x80 | (code & 0x3F));
+          } else {
+            out += static_cast<char>(0xE0 | (code >> 12));
+            out += static_cast<char>(0x80 | ((code >> 6) & 0x3F));
+            out += static_cast<char>(0x80 | (code & 0x3F));
+          }
+          break;
+        }
+        default: fail("bad escape");
+      }
+    }
+  }
+
+  std::string text_, path_;
+  size_t pos_ = 0;
+};
+
+std::string read_text(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw IoError(path.string() + ": cannot open");
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+std::string shell_quote(const std::string& s) {
+  std::string q = "'";
+  for (char ch : s) q += ch == '\'' ? std::string("'\\''") : std::string(1, ch);
+  return q + "'";
+}
+
+// For each vertex of the matched mesh (x.ply or y.ply), its index in the input mesh.
+std::vector<int> input_ids(const fs::path& dir, const std::string& side, int matched, int input) {
+  const fs::path path = dir / (side + "_vertex_ids.txt");
+  if (!fs::exists(path)) {
+    // Written by match since it decimates; without it the meshes must be the inputs themselves.
+    if (matched != input)
+      throw InvalidInputError(fmt::format("{}: {}.ply has {} vertices but the input had {}, and there is no {} to "
+                                          "relate them (written by newer versions of `shapematch match`)",
+                                          dir.string(), side, matched, input, path.filename().string()));
+    std::vector<int> ids(matched);
+    for (int v = 0; v < matched; ++v) ids[v] = v;
+    return ids;
+  }
+  std::vector<int> ids = read_vertex_list(path.string(), false, input);
+  if (static_cast<int>(ids.size()) != matched)
+    throw InvalidInputError(fmt::format("{}: {} lines, but {}.ply has {} vertices", path.string(), ids.size(), side,
+                                        matched));
+  std::vector<char> seen(input, 0);
+  for (size_t v = 0; v < ids.size(); ++v) {
+    if (seen[ids[v]])
+      throw InvalidInputError(fmt::format("{}: line {}: input vertex {} is listed twice", path.string(), v + 1, ids[v]));
+    seen[ids[v]] = 1;
+  }
+  return ids;
+}
+
+// Runs tools/plot_pck.py with Debian's Python (which has matplotlib); a missing matplotlib is a
+// warning, not a failed evaluation.
+void plot(const std::string& csv_path, const std::string& png_path, const std::string& label) {
+  const fs::path script = fs::path(SHAPEMATCH_ASSETS_DIR).parent_path() / "tools" / "plot_pck.py";
+  const std::string python = "/usr/bin/python3";
+  if (std::system((python + " -c 'import matplotlib' >/dev/null 2>&1").c_str()) != 0) {
+    spdlog::warn("{} cannot import matplotlib (apt install python3-matplotlib); no plot written", python);
+    return;
+  }
+  const std::string cmd = python + " " + shell_quote(script.string()) + " " + shell_quote(csv_path) + " " +
+                          shell_quote(png_path) + " " + shell_quote(label) + " >&2";
+  if (std::system(cmd.c_str()) != 0) spdlog::warn("plotting failed ({})", cmd);
+}
+
+int run_eval(const EvalArgs& args) {
+  Stopwatch total;
+  const fs::path dir(args.dir);
+  if (!fs::is_directory(dir)) throw IoError(args.dir + ": not a directory (expected an output of `shapematch match`)");
+  const fs::path report_path = dir / "report.json";
+  const JsonNode report = JsonParser(read_text(report_path), report_path.string()).parse();
+  auto field = [&](const std::string& side, const std::string& key, JsonNode::Kind kind) -> const JsonNode& {
+    const JsonNode* s = report.get(side);
+    const JsonNode* v = s ? s->get(key) : nullptr;
+    if (!v || v->kind != kind)
+      throw InvalidInputError(report_path.string() + ": no " + side + "." + key + " of the expected type");
+    return *v;
+  };
+  const int x_input = static_cast<int>(field("x", "vertices_input", JsonNode::Kind::Number).number);
+  const int y_input = static_cast<int>(field("y", "vertices_input", JsonNode::Kind::Number).number);
+
+  // The meshes as matched: their own scale, the indices of the maps refer to them.
+  LoadOptions as_matched;
+  as_matched.normalize_area = false;
+  const Mesh xm = load_mesh((dir / "x.ply").string(), as_matched);
+  const Mesh ym = load_mesh((dir / "y.ply").string(), as_matched);
+  const fs::path map_path = dir / "map_x_to_y.txt";
+  const std::vector<int> map = read_vertex_list(map_path.string(), false, ym.num_vertices());
+  if (static_cast<int>(map.size()) != xm.num_vertices())
+    throw InvalidInputError(fmt::format("{}: {} lines, but x.ply has {} vertices", map_path.string(), map.size(),
+                                        xm.num_vertices()));
+  const std::vector<int> x_ids = input_ids(dir, "x", xm.num_vertices(), x_input);
+  const std::vector<int> y_ids = input_ids(dir, "y", ym.num_vertices(), y_input);
+
+  // Errors are measured on the full-resolution Y; its scale cancels in d / √area.
+  const std::string y_file = args.y_mesh.empty() ? field("y", "file", JsonNode::Kind::String).text : args.y_mesh;
+  if (!fs::exists(y_file))
+    throw IoError(y_file + ": cannot open (Y of " + report_path.string() +
+                  "; run eval where match ran, or give --y-mesh)");
+  const Mesh y_full = load_mesh(y_file);
+  if (y_full.num_vertices() != y_input)
+    throw InvalidInputError(fmt::format("{}: {} vertices, but Y had {} when it was matched", y_file,
+                                        y_full.num_vertices(), y_input));
+
+  GroundTruth truth;
+  std::string truth_name;
+  if (!args.gt_map.empty()) {
+    truth = read_map_ground_truth(args.gt_map, x_input, y_input);
+    truth_name = args.gt_map;
+  } else if (!args.gt_x.empty()) {
+    truth = read_vts_ground_truth(args.gt_x, args.gt_y, x_input, y_input);
+    truth_name = args.gt_x + " <-> " + args.gt_y;
+  } else {
+    truth = identity_ground_truth(x_input, y_input);
+    truth_name = "identity";
+  }
+
+  // φ on the input vertices of X; those that decimation removed have no image.
+  std::vector<int> phi(x_input, -1);
+  for (int v = 0; v < xm.num_vertices(); ++v) phi[x_ids[v]] = y_ids[map[v]];
+  EvaluationOptions options;
+  options.threads = args.threads;
+  const GeodesicErrors errors = geodesic_errors(y_full, phi, truth, options);
+  const OrientationFlips flips = count_orientation_flips(xm, ym, map);
+
+  std::string csv = "threshold,fraction\n";
+  Json pck = Json::array();
+  for (const auto& [t, fraction] : errors.pck) {
+    pck.push(Json(Json::Array{Json(t), Json(fraction)}));
+    csv += fmt::format("{},{}\n", t, fraction);
+  }
+  if (!args.pck_csv.empty()) write_file_atomic(args.pck_csv, csv);
+  if (!args.pck_png.empty()) {
+    // The plot reads a CSV: the one asked for, or a temporary one.
+    std::string csv_path = args.pck_csv;
+    if (csv_path.empty()) {
+      csv_path = (fs::temp_directory_path() / ("shapematch-pck-" + std::to_string(std::random_device{}()) + ".csv"))
+                     .string();
+      write_file_atomic(csv_path, csv);
+    }
+    plot(csv_path, args.pck_png, fs::path(args.dir).lexically_normal().filename().string());
+    if (args.pck_csv.empty()) fs::remove(csv_path);
+  }
+
+  Json out = Json::object();
+  out.set("dir", args.dir)
+      .set("ground_truth", truth_name)
+      .set("ground_truth_pairs", static_cast<int64_t>(truth.size()))
+      .set("points", errors.points)
+      .set("mean_geodesic_error", errors.mean)
+      .set("median_geodesic_error", errors.median)
+      .set("auc", errors.auc)
+      .set("pck", pck)
+      .set("faces", flips.faces)
+      .set("orientation_flips", flips.flips)
+      .set("degenerate_faces", flips.degenerate)
+      .set("geodesic_solves", errors.geodesic_solves)
+      .set("seconds", total.seconds());
+  std::cout << out.dump() << "\n";
+  spdlog::info("mean geodesic error {:.4f} (median {:.4f}) over {} points, AUC {:.3f}; {} of {} faces flipped, {} "
+               "degenerate",
+               errors.mean, errors.median, errors.points, errors.auc, flips.flips, flips.faces, flips.degenerate);
+  return 0;
+}
+
+}  // namespace
+
+Action add_eval_command(CLI::App& app) {
+  auto a = std::make_shared<EvalArgs>();
+  app.add_option("dir", a->dir, "output directory of `shapematch match`")->required();
+  auto* gt = app.add_option("--gt", a->gt, "ground truth: vertex i of X <-> vertex i of Y")
+                 ->check(CLI::IsMember({"identity"}))
+                 ->capture_default_str();
+  auto* gx = app.add_option("--gt-x", a->gt_x, "1-based .vts file of X (FAUST_r/TOSCA_r): line k <-> line k of --gt-y");
+  auto* gy = app.add_option("--gt-y", a->gt_y, "1-based .vts file of Y");
+  auto* gm = app.add_option("--gt-map", a->gt_map,
+                            "two 1-based columns per line, X vertex then Y vertex (TOPKIDS kidXX_ref.txt: X = kidXX, "
+                            "Y = kid00)");
+  gx->needs(gy);
+  gy->needs(gx);
+  gt->excludes(gx)->excludes(gy)->excludes(gm);
+  gm->excludes(gx)->excludes(gy);
+  app.add_option("--y-mesh", a->y_mesh, "full-resolution Y (default: the y.file of report.json)");
+  app.add_option("--pck-csv", a->pck_csv, "write the PCK curve as CSV (threshold,fraction)");
+  app.add_option("--pck-png", a->pck_png, "plot the PCK curve (needs python3-matplotlib)");
+  app.add_option("--threads", a->threads, "geodesic solves in parallel (0: all cores)")->capture_default_str();
+  return [a] { return run_eval(*a); };
+}
+
+}  // namespace shapematch::app

@@ -1,0 +1,71 @@
+#pragma once
+// Evaluation of a vertex map against ground truth (DESIGN.md §9): geodesic errors on the
+// full-resolution Y normalised by √area(Y), the PCK curve, and orientation flips.
+#include "shapematch/mesh.hpp"
+
+#include <array>
+#include <string>
+#include <vector>
+
+namespace shapematch {
+
+// One ground-truth correspondence between the full-resolution inputs, 0-based: vertex x of X
+// corresponds to vertex y of Y.
+struct GroundTruthPair {
+  int x = 0;
+  int y = 0;
+};
+using GroundTruth = std::vector<GroundTruthPair>;
+
+// Vertex i ↔ vertex i (shared connectivity); the vertex counts must be equal.
+GroundTruth identity_ground_truth(int x_vertices, int y_vertices);
+// FAUST_r / TOSCA_r `.vts` files: one 1-based vertex per line, line k of `x_path` (a vertex of X)
+// ↔ line k of `y_path` (a vertex of Y).
+GroundTruth read_vts_ground_truth(const std::string& x_path, const std::string& y_path, int x_vertices,
+                                  int y_vertices);
+// Two 1-based columns per line, "x_vertex y_vertex": column 1 is a vertex of X, column 2 of Y.
+// TOPKIDS kidXX_ref.txt maps kidXX → kid00, so X = kidXX and Y = kid00.
+GroundTruth read_map_ground_truth(const std::string& path, int x_vertices, int y_vertices);
+
+// One vertex index per line (map_x_to_y.txt, x_vertex_ids.txt; `.vts` with one_based), each in
+// [0, num_vertices) after subtracting the base; returned 0-based. Throws IoError or
+// InvalidInputError "<path>: line N: <problem>".
+std::vector<int> read_vertex_list(const std::string& path, bool one_based, int num_vertices);
+
+struct EvaluationOptions {
+  double pck_max = 0.25;   // PCK thresholds 0, pck_step, …, pck_max (in units of √area(Y))
+  double pck_step = 0.01;
+  int threads = 0;         // geodesic solves in parallel; 0: all hardware threads
+};
+
+struct GeodesicErrors {
+  std::vector<double> errors;  // d_Y(φ(x_k), y_k) / √area(Y) per evaluated pair, in ground-truth order
+  int points = 0;              // ground-truth pairs whose x has an image under φ
+  double mean = 0, median = 0;
+  std::vector<std::array<double, 2>> pck;  // (threshold t, fraction of points with error ≤ t)
+  double auc = 0;                          // area under the PCK curve over [0, pck_max], divided by pck_max
+  int geodesic_solves = 0;                 // distinct source vertices marched from
+};
+
+// `phi[i]` is the vertex of Y that vertex i of X maps to, or -1 where the map says nothing (such
+// ground-truth pairs are left out). Distances are solved once per distinct vertex on whichever
+// side (predicted or true) has fewer, and not at all for exact hits. Throws InvalidInputError if
+// no pair can be evaluated or an index is out of range.
+GeodesicErrors geodesic_errors(const Mesh& y, const std::vector<int>& phi, const GroundTruth& truth,
+                               const EvaluationOptions& options = {});
+
+// The PCK curve of `errors` at thresholds 0, step, …, max, and its normalised area (trapezoids).
+std::vector<std::array<double, 2>> pck_curve(const std::vector<double>& errors, double max, double step);
+double pck_auc(const std::vector<std::array<double, 2>>& pck);
+
+struct OrientationFlips {
+  int faces = 0;       // faces of X
+  int flips = 0;       // image triangle on Y faces against the mean of Y's normals at its corners
+  int degenerate = 0;  // image with a repeated (or collinear) vertex: neither flipped nor kept
+};
+
+// Carries every face of X through `map_x_to_y` (one vertex of Y per vertex of X) and compares the
+// image triangle's normal with the area-weighted vertex normals of Y at its three corners.
+OrientationFlips count_orientation_flips(const Mesh& x, const Mesh& y, const std::vector<int>& map_x_to_y);
+
+}  // namespace shapematch

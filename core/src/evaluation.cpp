@@ -1,0 +1,249 @@
+#include "shapematch/evaluation.hpp"
+
+#include "shapematch/errors.hpp"
+#include "shapematch/geodesic.hpp"
+#include "shapematch/geometry.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <charconv>
+#include <cmath>
+#include <exception>
+#include <fstream>
+#include <mutex>
+#include <sstream>
+#include <thread>
+
+namespace shapematch {
+namespace {
+
+// The lines of a text file without their line ends; trailing blank lines dropped.
+std::vector<std::string> read_lines(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw IoError(path + ": cannot open");
+  std::vector<std::string> lines;
+  for (std::string line; std::getline(in, line);) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    lines.push_back(std::move(line));
+  }
+  if (in.bad()) throw IoError(path + ": read error");
+  while (!lines.empty() && lines.back().find_first_not_of(" \t") == std::string::npos) lines.pop_back();
+  if (lines.empty()) throw InvalidInputError(path + ": no vertex indices (empty file)");
+  return lines;
+}
+
+std::vector<std::string> split(const std::string& line) {
+  std::istringstream s(line);
+  std::vector<std::string> tokens;
+  for (std::string t; s >> t;) tokens.push_back(t);
+  return tokens;
+}
+
+std::string where(const std::string& path, size_t line) { return path + ": line " + std::to_string(line + 1) + ": "; }
+
+// A vertex index as written (base 0 or 1) → 0-based, checked against the mesh size.
+int parse_vertex(const std::string& token, int base, int num_vertices, const std::string& path, size_t line) {
+  long long value = 0;
+  const auto [end, ec] = std::from_chars(token.data(), token.data() + token.size(), value);
+  if (ec != std::errc() || end != token.data() + token.size())
+    throw InvalidInputError(where(path, line) + "'" + token + "' is not a vertex index");
+  if (value < base || value - base >= num_vertices)
+    throw InvalidInputError(where(path, line) + "vertex " + token + " is not in " + std::to_string(base) + ".." +
+                            std::to_string(num_vertices - 1 + base) + " (the mesh has " +
+                            std::to_string(num_vertices) + " vertices)");
+  return static_cast<int>(value - base);
+}
+
+// Rows of `columns` indices each; a blank line inside the file would shift the "line k ↔ line k"
+// pairing, so it is an error rather than skipped.
+std::vector<std::vector<int>> read_rows(const std::string& path, int columns, int base,
+                                        const std::vector<int>& num_vertices) {
+  const std::vector<std::string> lines = read_lines(path);
+  std::vector<std::vector<int>> rows;
+  rows.reserve(lines.size());
+  for (size_t i = 0; i < lines.size(); ++i) {
+    const std::vector<std::string> tokens = split(lines[i]);
+    if (static_cast<int>(tokens.size()) != columns)
+      throw InvalidInputError(where(path, i) + "expected " + std::to_string(columns) + " vertex ind" +
+                              (columns == 1 ? "ex" : "ices") + ", got " + std::to_string(tokens.size()));
+    std::vector<int> row;
+    for (int c = 0; c < columns; ++c) row.push_back(parse_vertex(tokens[c], base, num_vertices[c], path, i));
+    rows.push_back(std::move(row));
+  }
+  return rows;
+}
+
+}  // namespace
+
+std::vector<int> read_vertex_list(const std::string& path, bool one_based, int num_vertices) {
+  std::vector<int> list;
+  for (const auto& row : read_rows(path, 1, one_based ? 1 : 0, {num_vertices})) list.push_back(row[0]);
+  return list;
+}
+
+GroundTruth identity_ground_truth(int x_vertices, int y_vertices) {
+  if (x_vertices != y_vertices)
+    throw InvalidInputError("identity ground truth: X has " + std::to_string(x_vertices) + " vertices and Y has " +
+                            std::to_string(y_vertices) + "; vertex i <-> vertex i needs equal counts");
+  GroundTruth gt(x_vertices);
+  for (int i = 0; i < x_vertices; ++i) gt[i] = {i, i};
+  return gt;
+}
+
+GroundTruth read_vts_ground_truth(const std::string& x_path, const std::string& y_path, int x_vertices,
+                                  int y_vertices) {
+  const std::vector<int> xs = read_vertex_list(x_path, true, x_vertices);
+  const std::vector<int> ys = read_vertex_list(y_path, true, y_vertices);
+  if (xs.size() != ys.size())
+    throw InvalidInputError(y_path + ": " + std::to_string(ys.size()) + " lines, but " + x_path + " has " +
+                            std::to_string(xs.size()) + " (line k of one corresponds to line k of the other)");
+  GroundTruth gt(xs.size());
+  for (size_t k = 0; k < xs.size(); ++k) gt[k] = {xs[k], ys[k]};
+  return gt;
+}
+
+GroundTruth read_map_ground_truth(const std::string& path, int x_vertices, int y_vertices) {
+  GroundTruth gt;
+  for (const auto& row : read_rows(path, 2, 1, {x_vertices, y_vertices})) gt.push_back({row[0], row[1]});
+  return gt;
+}
+
+std::vector<std::array<double, 2>> pck_curve(const std::vector<double>& errors, double max, double step) {
+  if (!(step > 0) || !(max >= 0) || !std::isfinite(max))
+    throw InvalidInputError("PCK: need a positive step and a finite, non-negative maximum threshold");
+  std::vector<double> sorted = errors;
+  std::sort(sorted.begin(), sorted.end());
+  const int steps = static_cast<int>(std::floor(max / step + 1e-9));
+  std::vector<std::array<double, 2>> pck;
+  for (int i = 0; i <= steps; ++i) {
+    // i·step rather than a running sum, so that thresholds print as 0.07, not 0.06999…
+    const double t = i * step;
+    const auto below = std::upper_bound(sorted.begin(), sorted.end(), t) - sorted.begin();
+    pck.push_back({t, sorted.empty() ? 0.0 : static_cast<double>(below) / static_cast<double>(sorted.size())});
+  }
+  return pck;
+}
+
+double pck_auc(const std::vector<std::array<double, 2>>& pck) {
+  if (pck.empty()) return 0;
+  const double width = pck.back()[0] - pck.front()[0];
+  if (!(width > 0)) return pck.front()[1];
+  double area = 0;
+  for (size_t i = 1; i < pck.size(); ++i) area += (pck[i][0] - pck[i - 1][0]) * (pck[i][1] + pck[i - 1][1]) / 2;
+  return area / width;
+}
+
+GeodesicErrors geodesic_errors(const Mesh& y, const std::vector<int>& phi, const GroundTruth& truth,
+                               const EvaluationOptions& options) {
+  const int ny = y.num_vertices();
+  GeodesicErrors r;
+  struct Pending {
+    int source, target;
+    size_t point;
+  };
+  std::vector<Pending> pending;  // pairs whose prediction misses the truth
+  std::vector<char> is_pred(ny, 0), is_true(ny, 0);
+  int distinct_pred = 0, distinct_true = 0;
+  for (const GroundTruthPair& p : truth) {
+    if (p.x < 0 || p.x >= static_cast<int>(phi.size()) || p.y < 0 || p.y >= ny)
+      throw InvalidInputError("evaluation: ground-truth pair (" + std::to_string(p.x) + ", " + std::to_string(p.y) +
+                              ") is outside the map (" + std::to_string(phi.size()) + " X vertices) or Y (" +
+                              std::to_string(ny) + " vertices)");
+    const int predicted = phi[p.x];
+    if (predicted < 0) continue;
+    if (predicted >= ny)
+      throw InvalidInputError("evaluation: the map sends X vertex " + std::to_string(p.x) + " to " +
+                              std::to_string(predicted) + ", but Y has " + std::to_string(ny) + " vertices");
+    const size_t point = r.errors.size();
+    r.errors.push_back(0.0);
+    if (predicted == p.y) continue;  // exactly zero: no solve needed
+    pending.push_back({predicted, p.y, point});
+    if (!is_pred[predicted]) is_pred[predicted] = 1, ++distinct_pred;
+    if (!is_true[p.y]) is_true[p.y] = 1, ++distinct_true;
+  }
+  r.points = static_cast<int>(r.errors.size());
+  if (r.points == 0)
+    throw InvalidInputError("evaluation: none of the " + std::to_string(truth.size()) +
+                            " ground-truth pairs has an X vertex with an image under the map");
+
+  if (!pending.empty()) {
+    // March from whichever side has fewer distinct vertices (distances are nearly symmetric).
+    if (distinct_true < distinct_pred)
+      for (Pending& p : pending) std::swap(p.source, p.target);
+    std::sort(pending.begin(), pending.end(), [](const Pending& a, const Pending& b) { return a.source < b.source; });
+    std::vector<size_t> group_begin;
+    for (size_t i = 0; i < pending.size(); ++i)
+      if (i == 0 || pending[i].source != pending[i - 1].source) group_begin.push_back(i);
+    group_begin.push_back(pending.size());
+    const size_t groups = group_begin.size() - 1;
+    r.geodesic_solves = static_cast<int>(groups);
+
+    const GeodesicDistance geodesic(y);
+    const double scale = 1.0 / std::sqrt(surface_area(y));
+    std::atomic<size_t> next{0};
+    std::exception_ptr failure;  // the first exception of any worker, rethrown on this thread
+    std::mutex failure_mutex;
+    auto work = [&] {
+      try {
+        std::vector<int> targets;
+        for (size_t g; (g = next++) < groups;) {
+          targets.clear();
+          for (size_t i = group_begin[g]; i < group_begin[g + 1]; ++i) targets.push_back(pending[i].target);
+          const std::vector<double> d = geodesic.to_vertices(pending[group_begin[g]].source, targets);
+          for (size_t i = group_begin[g]; i < group_begin[g + 1]; ++i)
+            r.errors[pending[i].point] = d[i - group_begin[g]] * scale;
+        }
+      } catch (...) {
+        next = groups;
+        const std::lock_guard lock(failure_mutex);
+        if (!failure) failure = std::current_exception();
+      }
+    };
+    int threads = options.threads > 0 ? options.threads : static_cast<int>(std::thread::hardware_concurrency());
+    threads = static_cast<int>(std::clamp<size_t>(threads, 1, groups));
+    std::vector<std::thread> pool;
+    for (int t = 1; t < threads; ++t) pool.emplace_back(work);
+    work();
+    for (auto& t : pool) t.join();
+    if (failure) std::rethrow_exception(failure);
+  }
+
+  double sum = 0;
+  for (double e : r.errors) sum += e;
+  r.mean = sum / r.points;
+  std::vector<double> sorted = r.errors;
+  const size_t half = sorted.size() / 2;
+  std::nth_element(sorted.begin(), sorted.begin() + half, sorted.end());
+  r.median = sorted[half];
+  if (sorted.size() % 2 == 0) r.median = (r.median + *std::max_element(sorted.begin(), sorted.begin() + half)) / 2;
+  r.pck = pck_curve(r.errors, options.pck_max, options.pck_step);
+  r.auc = pck_auc(r.pck);
+  return r;
+}
+
+OrientationFlips count_orientation_flips(const Mesh& x, const Mesh& y, const std::vector<int>& map_x_to_y) {
+  if (static_cast<int>(map_x_to_y.size()) != x.num_vertices())
+    throw InvalidInputError("orientation flips: the map has " + std::to_string(map_x_to_y.size()) +
+                            " entries, X has " + std::to_string(x.num_vertices()) + " vertices");
+  for (int v : map_x_to_y)
+    if (v < 0 || v >= y.num_vertices())
+      throw InvalidInputError("orientation flips: the map sends a vertex to " + std::to_string(v) + ", but Y has " +
+                              std::to_string(y.num_vertices()) + " vertices");
+  const Geometry gy = compute_geometry(y);
+  OrientationFlips r;
+  r.faces = x.num_faces();
+  for (const auto& f : x.faces) {
+    const int a = map_x_to_y[f[0]], b = map_x_to_y[f[1]], c = map_x_to_y[f[2]];
+    const Eigen::Vector3d ab = y.vertices[b] - y.vertices[a], ac = y.vertices[c] - y.vertices[a];
+    const Eigen::Vector3d normal = ab.cross(ac);
+    // Collinear images count with the collapsed ones: they have no orientation to compare.
+    if (a == b || b == c || c == a || normal.norm() <= 1e-12 * (ab.squaredNorm() + ac.squaredNorm())) {
+      ++r.degenerate;
+      continue;
+    }
+    if (normal.dot(gy.vertex_normal[a] + gy.vertex_normal[b] + gy.vertex_normal[c]) < 0) ++r.flips;
+  }
+  return r;
+}
+
+}  // namespace shapematch

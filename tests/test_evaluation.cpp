@@ -1,0 +1,443 @@
+#include "shapematch/evaluation.hpp"
+#include "shapematch/errors.hpp"
+#include "shapematch/geodesic.hpp"
+#include "shapematch/json.hpp"
+#include "shapematch/shapes.hpp"
+
+#include "test_helpers.hpp"
+
+#include <doctest/doctest.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <numbers>
+#include <numeric>
+#include <random>
+#include <sys/wait.h>
+
+using namespace shapematch;
+namespace fs = std::filesystem;
+
+namespace {
+
+// A fresh directory per test case: ctest runs the cases as parallel processes.
+fs::path scratch(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / ("shapematch_eval_" + name);
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
+fs::path write(const fs::path& path, const std::string& text) {
+  std::ofstream(path, std::ios::binary) << text;
+  return path;
+}
+
+std::vector<int> identity_map(int n) {
+  std::vector<int> m(n);
+  std::iota(m.begin(), m.end(), 0);
+  return m;
+}
+
+// The vertex of `m` nearest to p (tests only: linear search).
+int nearest(const Mesh& m, const Eigen::Vector3d& p) {
+  int best = 0;
+  for (int v = 1; v < m.num_vertices(); ++v)
+    if ((m.vertices[v] - p).squaredNorm() < (m.vertices[best] - p).squaredNorm()) best = v;
+  return best;
+}
+
+// The mirror image of a mesh in the plane x = 0, faces reversed so that they face outwards again.
+Mesh mirrored(const Mesh& m) {
+  std::vector<Eigen::Vector3d> v;
+  for (const auto& p : m.vertices) v.emplace_back(-p.x(), p.y(), p.z());
+  std::vector<std::array<int, 3>> f;
+  for (const auto& t : m.faces) f.push_back({t[0], t[2], t[1]});
+  return make_mesh(v, f, "mirrored");
+}
+
+template <class F>
+std::string error_of(F&& f) {
+  try {
+    f();
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+struct Run {
+  int code = -1;
+  std::string out, err;
+};
+
+Run run_cli(const std::string& args, const fs::path& dir) {
+  const fs::path err = dir / "stderr.txt";
+  const std::string cmd = std::string(SHAPEMATCH_CLI) + " " + args + " 2>" + err.string();
+  Run r;
+  FILE* p = popen(cmd.c_str(), "r");
+  REQUIRE(p != nullptr);
+  std::array<char, 4096> buf{};
+  size_t k;
+  while ((k = fread(buf.data(), 1, buf.size(), p)) > 0) r.out.append(buf.data(), k);
+  const int status = pclose(p);
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  std::ifstream f(err);
+  r.err.assign(std::istreambuf_iterator<char>(f), {});
+  return r;
+}
+
+double json_number(const std::string& json, const std::string& key) {
+  const auto at = json.find("\"" + key + "\": ");
+  REQUIRE_MESSAGE(at != std::string::npos, key << " missing in " << json);
+  return std::stod(json.substr(at + key.size() + 4));
+}
+
+int count_lines(const fs::path& p) {
+  std::ifstream in(p);
+  return static_cast<int>(std::count(std::istreambuf_iterator<char>(in), {}, '\n'));
+}
+
+}  // namespace
+
+TEST_CASE("evaluation: the identity map has error 0, AUC 1 and no flips, also onto a rotated copy") {
+  std::mt19937 rng(4);
+  const Mesh x = shapes::bent_finger(10, 12, 8);
+  const Mesh y = test::deformed(shapes::bent_finger(70, 12, 8), [&, r = test::random_rotation(rng)](const auto& p) {
+    return Eigen::Vector3d(r * p);
+  });
+  const GeodesicErrors e = geodesic_errors(y, identity_map(x.num_vertices()),
+                                           identity_ground_truth(x.num_vertices(), y.num_vertices()));
+  CHECK(e.points == x.num_vertices());
+  CHECK(e.mean == 0.0);
+  CHECK(e.median == 0.0);
+  CHECK(e.auc == 1.0);
+  CHECK(e.geodesic_solves == 0);
+  REQUIRE(e.pck.size() == 26);
+  CHECK(e.pck.front()[0] == 0.0);
+  CHECK(e.pck.back()[0] == 0.25);
+  for (const auto& [t, fraction] : e.pck) CHECK(fraction == 1.0);
+  const OrientationFlips f = count_orientation_flips(x, y, identity_map(x.num_vertices()));
+  CHECK(f.faces == x.num_faces());
+  CHECK(f.flips == 0);
+  CHECK(f.degenerate == 0);
+}
+
+TEST_CASE("evaluation: the antipodal map on a sphere has error sqrt(pi)/2 and reverses every face") {
+  // d(p, -p) = π r and area 4π r², so the normalised error is π r / √(4π r²) = √π / 2 for any r.
+  const Mesh s = shapes::icosphere(4, 3.0);
+  std::vector<int> antipode(s.num_vertices());
+  for (int v = 0; v < s.num_vertices(); ++v) {
+    antipode[v] = nearest(s, -s.vertices[v]);
+    REQUIRE((s.vertices[antipode[v]] + s.vertices[v]).norm() < 1e-9);  // the icosphere is centrally symmetric
+  }
+  // Every 8th vertex. The antipode is the march's worst case (all geodesics meet there): measured
+  // 1.2 % short at 2562 vertices (2.0 % at 642).
+  GroundTruth some;
+  for (int v = 0; v < s.num_vertices(); v += 8) some.push_back({v, v});
+  EvaluationOptions two_threads;
+  two_threads.threads = 2;
+  const GeodesicErrors e = geodesic_errors(s, antipode, some, two_threads);
+  const double expected = std::sqrt(std::numbers::pi) / 2;
+  MESSAGE("antipodal map: mean " << e.mean << ", expected " << expected);
+  CHECK(std::abs(e.mean - expected) < 0.02 * expected);
+  CHECK(std::abs(e.median - expected) < 0.02 * expected);
+  CHECK(e.auc == 0.0);
+  CHECK(e.points == static_cast<int>(some.size()));
+  CHECK(e.geodesic_solves == static_cast<int>(some.size()));
+  // p ↦ -p reverses orientation on the sphere.
+  const OrientationFlips f = count_orientation_flips(s, s, antipode);
+  CHECK(f.flips == s.num_faces());
+  CHECK(f.degenerate == 0);
+}
+
+TEST_CASE("evaluation: mirror maps flip (nearly) every face, a collapse is degenerate, not flipped") {
+  // The finger has no mirror symmetry: its mirror image is another shape, matched vertex to vertex.
+  const Mesh x = shapes::bent_finger(40, 12, 8);
+  const OrientationFlips f = count_orientation_flips(x, mirrored(x), identity_map(x.num_vertices()));
+  CHECK(f.flips == x.num_faces());
+  CHECK(f.degenerate == 0);
+
+  // A lopsided sphere reflected in z = 0 and snapped to its nearest vertex: not a symmetry, so
+  // some faces collapse, and the rest are mirrored.
+  const Mesh s = test::deformed(shapes::icosphere(3), [](const auto& p) {
+    return Eigen::Vector3d(p.x() + 0.3 * p.y() * p.y(), p.y(), p.z() + 0.2 * p.z() * p.z());
+  });
+  std::vector<int> reflect(s.num_vertices());
+  for (int v = 0; v < s.num_vertices(); ++v)
+    reflect[v] = nearest(s, Eigen::Vector3d(s.vertices[v].x(), s.vertices[v].y(), -s.vertices[v].z()));
+  const OrientationFlips g = count_orientation_flips(s, s, reflect);
+  MESSAGE("snapped reflection: " << g.flips << " flipped, " << g.degenerate << " degenerate of " << g.faces);
+  CHECK(g.flips + g.degenerate == s.num_faces());
+  CHECK(g.flips > 0.8 * s.num_faces());
+
+  const OrientationFlips c = count_orientation_flips(x, x, std::vector<int>(x.num_vertices(), 3));
+  CHECK(c.flips == 0);
+  CHECK(c.degenerate == x.num_faces());
+  CHECK_THROWS_AS(count_orientation_flips(x, x, {0, 1}), InvalidInputError);
+  CHECK_THROWS_AS(count_orientation_flips(x, s, std::vector<int>(x.num_vertices(), s.num_vertices())),
+                  InvalidInputError);
+}
+
+TEST_CASE("evaluation: errors agree with direct geodesic distances, marched from either side") {
+  const Mesh y = shapes::bent_finger(70, 10, 8);
+  const int n = y.num_vertices();
+  const GeodesicDistance geo(y);
+  const double scale = 1 / std::sqrt(surface_area(y));
+  std::mt19937 rng(9);
+
+  // Few distinct predictions: marched from the predictions.
+  std::vector<int> phi(n);
+  for (int& p : phi) p = static_cast<int>(rng() % 3);
+  const GroundTruth identity = identity_ground_truth(n, n);
+  GeodesicErrors e = geodesic_errors(y, phi, identity);
+  CHECK(e.geodesic_solves == 3);
+  REQUIRE(e.errors.size() == static_cast<size_t>(n));
+  for (int k = 0; k < n; ++k) CHECK(e.errors[k] == doctest::Approx(geo.from_vertex(phi[k])[k] * scale).epsilon(1e-12));
+
+  // Few distinct true vertices: marched from them.
+  GroundTruth few;
+  for (int k = 0; k < n; ++k) few.push_back({k, 5 + k % 2});
+  for (int& p : phi) p = static_cast<int>(rng() % n);
+  e = geodesic_errors(y, phi, few);
+  CHECK(e.geodesic_solves == 2);
+  for (int k = 0; k < n; ++k) {
+    const double expected = phi[k] == few[k].y ? 0.0 : geo.from_vertex(few[k].y)[phi[k]] * scale;
+    CHECK(e.errors[k] == doctest::Approx(expected).epsilon(1e-12));
+  }
+  std::vector<double> sorted = e.errors;
+  std::sort(sorted.begin(), sorted.end());
+  const double median = n % 2 ? sorted[n / 2] : (sorted[n / 2 - 1] + sorted[n / 2]) / 2;
+  CHECK(e.median == doctest::Approx(median));
+  CHECK(e.mean == doctest::Approx(std::accumulate(sorted.begin(), sorted.end(), 0.0) / n));
+
+  // X vertices without an image (decimated away) are left out; nothing left is an error.
+  std::vector<int> partial(n, -1);
+  partial[4] = 4;
+  partial[7] = 9;
+  e = geodesic_errors(y, partial, identity);
+  CHECK(e.points == 2);
+  CHECK(e.errors[0] == 0.0);
+  CHECK(e.errors[1] > 0.0);
+  CHECK_THROWS_AS(geodesic_errors(y, std::vector<int>(n, -1), identity), InvalidInputError);
+  CHECK_THROWS_AS(geodesic_errors(y, std::vector<int>(n, n), identity), InvalidInputError);
+  CHECK_THROWS_AS(geodesic_errors(y, std::vector<int>(n - 1, 0), identity), InvalidInputError);
+}
+
+TEST_CASE("evaluation: PCK curve and its area") {
+  const auto pck = pck_curve({0.0, 0.005, 0.045, 0.3}, 0.25, 0.01);
+  REQUIRE(pck.size() == 26);
+  CHECK(pck[0][1] == 0.25);
+  CHECK(pck[1][1] == 0.5);
+  CHECK(pck[4][1] == 0.5);
+  CHECK(pck[5][1] == 0.75);
+  CHECK(pck[25][1] == 0.75);
+  // Trapezoids: 0.00375 + 3 · 0.005 + 0.00625 + 0.2 · 0.75 = 0.175 over a width of 0.25.
+  CHECK(pck_auc(pck) == doctest::Approx(0.7));
+  CHECK_THROWS_AS(pck_curve({0.1}, 0.25, 0.0), InvalidInputError);
+}
+
+TEST_CASE("evaluation: ground-truth readers parse the data set formats and reject malformed files") {
+  const fs::path dir = scratch("readers");
+  const std::string a = write(dir / "a.vts", "3\n1\r\n2\n\n").string();  // CRLF and a trailing blank line
+  const std::string b = write(dir / "b.vts", "1\n2\n3\n").string();
+  const GroundTruth vts = read_vts_ground_truth(a, b, 3, 5);
+  REQUIRE(vts.size() == 3);
+  CHECK(vts[0].x == 2);
+  CHECK(vts[0].y == 0);
+  CHECK(vts[2].x == 1);
+  CHECK(vts[2].y == 2);
+
+  // TOPKIDS layout: padded columns, X (kidXX) first, then Y (kid00).
+  const std::string m = write(dir / "kid_ref.txt", "     1      3 \n     2      2 \n").string();
+  const GroundTruth map = read_map_ground_truth(m, 2, 3);
+  REQUIRE(map.size() == 2);
+  CHECK(map[0].x == 0);
+  CHECK(map[0].y == 2);
+  CHECK(map[1].x == 1);
+  CHECK(map[1].y == 1);
+
+  const std::vector<int> zero_based = read_vertex_list(write(dir / "ids.txt", "0\n4\n").string(), false, 5);
+  CHECK(zero_based == std::vector<int>{0, 4});
+
+  CHECK(identity_ground_truth(4, 4).size() == 4);
+  CHECK_THROWS_AS(identity_ground_truth(4, 5), InvalidInputError);
+
+  struct Bad {
+    std::string name, text, expect;
+  };
+  const std::vector<Bad> bad_vts = {
+      {"zero.vts", "1\n0\n2\n", "line 2: vertex 0 is not in 1..3"},
+      {"big.vts", "1\n2\n4\n", "line 3: vertex 4 is not in 1..3"},
+      {"word.vts", "1\nabc\n2\n", "line 2: 'abc' is not a vertex index"},
+      {"two.vts", "1\n2 3\n1\n", "line 2: expected 1 vertex index, got 2"},
+      {"gap.vts", "1\n\n2\n", "line 2: expected 1 vertex index, got 0"},
+      {"neg.vts", "-1\n1\n1\n", "line 1: vertex -1 is not in 1..3"},
+      {"huge.vts", "99999999999999999999\n1\n1\n", "is not a vertex index"},
+      {"empty.vts", "\n\n", "empty file"},
+      {"short.vts", "1\n2\n", "2 lines, but"},
+  };
+  for (const Bad& c : bad_vts) {
+    CAPTURE(c.name);
+    const std::string path = write(dir / c.name, c.text).string();
+    // The malformed file is Y here, except for the line-count mismatch, which names Y too.
+    const std::string what = error_of([&] { read_vts_ground_truth(b, path, 3, 3); });
+    CHECK(what.rfind(path + ": ", 0) == 0);
+    CHECK(what.find(c.expect) != std::string::npos);
+    CHECK(what.find('\n') == std::string::npos);
+    CHECK_THROWS_AS(read_vts_ground_truth(b, path, 3, 3), InvalidInputError);
+  }
+  const std::vector<Bad> bad_maps = {
+      {"one.txt", "1 1\n2\n", "line 2: expected 2 vertex indices, got 1"},
+      {"ycol.txt", "1 1\n2 4\n", "line 2: vertex 4 is not in 1..3"},
+      {"xcol.txt", "3 1\n", "line 1: vertex 3 is not in 1..2"},
+  };
+  for (const Bad& c : bad_maps) {
+    CAPTURE(c.name);
+    const std::string path = write(dir / c.name, c.text).string();
+    const std::string what = error_of([&] { read_map_ground_truth(path, 2, 3); });
+    CHECK(what.rfind(path + ": ", 0) == 0);
+    CHECK(what.find(c.expect) != std::string::npos);
+  }
+  CHECK_THROWS_AS(read_vts_ground_truth((dir / "missing.vts").string(), b, 3, 3), IoError);
+  CHECK(error_of([&] { read_vertex_list((dir / "missing.vts").string(), true, 3); }).find("missing.vts") !=
+        std::string::npos);
+  fs::remove_all(dir);
+}
+
+TEST_CASE("evaluation: shapematch eval reads a match directory through the vertex id files") {
+  // A match directory made by hand: x.ply and y.ply hold the input vertices in a shuffled order,
+  // as decimation would (a subset, renumbered), and the map is the true correspondence.
+  const fs::path dir = scratch("cli_ids");
+  const fs::path out = dir / "match";
+  fs::create_directories(out);
+  const Mesh x = shapes::bent_finger(10, 10, 8), y = shapes::bent_finger(70, 10, 8);
+  const int n = x.num_vertices();
+  save_mesh(x, (dir / "x_in.off").string());
+  save_mesh(y, (dir / "y_in.off").string());
+  std::mt19937 rng(2);
+  auto shuffled = [&](const Mesh& m, std::vector<int>& ids, std::vector<int>& position) {
+    ids = identity_map(n);
+    std::shuffle(ids.begin(), ids.end(), rng);
+    position.assign(n, 0);
+    for (int v = 0; v < n; ++v) position[ids[v]] = v;
+    std::vector<Eigen::Vector3d> vertices;
+    for (int v = 0; v < n; ++v) vertices.push_back(m.vertices[ids[v]]);
+    std::vector<std::array<int, 3>> faces;
+    for (const auto& f : m.faces) faces.push_back({position[f[0]], position[f[1]], position[f[2]]});
+    return make_mesh(vertices, faces);
+  };
+  std::vector<int> x_ids, x_pos, y_ids, y_pos;
+  save_mesh(shuffled(x, x_ids, x_pos), (out / "x.ply").string());
+  save_mesh(shuffled(y, y_ids, y_pos), (out / "y.ply").string());
+  std::string map, xs, ys, vts;
+  for (int v = 0; v < n; ++v) {
+    map += std::to_string(y_pos[x_ids[v]]) + "\n";
+    xs += std::to_string(x_ids[v]) + "\n";
+    ys += std::to_string(y_ids[v]) + "\n";
+    vts += std::to_string(v + 1) + "\n";
+  }
+  write(out / "map_x_to_y.txt", map);
+  write(out / "x_vertex_ids.txt", xs);
+  write(out / "y_vertex_ids.txt", ys);
+  auto side = [&](const fs::path& file) {
+    return Json::object().set("file", file.string()).set("vertices_input", n).set("vertices", n);
+  };
+  write(out / "report.json", Json::object()
+                                 .set("x", side(dir / "x_in.off"))
+                                 .set("y", side(dir / "y_in.off"))
+                                 .set("options", Json::object().set("keep_scale", false))
+                                 .dump());
+
+  Run r = run_cli("eval " + out.string() + " --pck-csv " + (dir / "pck.csv").string(), dir);
+  REQUIRE_MESSAGE(r.code == 0, r.err);
+  CHECK(json_number(r.out, "points") == n);
+  CHECK(json_number(r.out, "mean_geodesic_error") == 0.0);
+  CHECK(json_number(r.out, "auc") == 1.0);
+  CHECK(json_number(r.out, "orientation_flips") == 0);
+  CHECK(json_number(r.out, "degenerate_faces") == 0);
+  CHECK(json_number(r.out, "faces") == x.num_faces());
+  CHECK(json_number(r.out, "seconds") >= 0);
+  CHECK(r.out.find("\"pck\": [") != std::string::npos);
+  CHECK(count_lines(dir / "pck.csv") == 27);
+
+  // The same through the .vts and two-column readers.
+  write(dir / "a.vts", vts);
+  r = run_cli("eval " + out.string() + " --gt-x " + (dir / "a.vts").string() + " --gt-y " + (dir / "a.vts").string(),
+              dir);
+  REQUIRE_MESSAGE(r.code == 0, r.err);
+  CHECK(json_number(r.out, "mean_geodesic_error") == 0.0);
+  std::string two_columns;
+  for (int v = 0; v < n; v += 2) two_columns += std::to_string(v + 1) + " " + std::to_string(v + 1) + "\n";
+  write(dir / "map.txt", two_columns);
+  r = run_cli("eval " + out.string() + " --gt-map " + (dir / "map.txt").string(), dir);
+  REQUIRE_MESSAGE(r.code == 0, r.err);
+  CHECK(json_number(r.out, "points") == (n + 1) / 2);
+  CHECK(json_number(r.out, "mean_geodesic_error") == 0.0);
+
+  // A PNG when Debian's matplotlib is there (a warning otherwise).
+  if (std::system("/usr/bin/python3 -c 'import matplotlib' >/dev/null 2>&1") == 0) {
+    r = run_cli("eval " + out.string() + " --pck-png " + (dir / "pck.png").string(), dir);
+    REQUIRE_MESSAGE(r.code == 0, r.err);
+    CHECK(fs::file_size(dir / "pck.png") > 5000);
+  }
+
+  // Options that contradict each other are refused.
+  r = run_cli("eval " + out.string() + " --gt identity --gt-map " + (dir / "map.txt").string(), dir);
+  CHECK(r.code != 0);
+  r = run_cli("eval " + out.string() + " --gt-x " + (dir / "a.vts").string(), dir);
+  CHECK(r.code != 0);
+
+  // Malformed inputs: exit 1 and one line naming the file.
+  write(dir / "bad.vts", "1\n2\nx\n");
+  r = run_cli("eval " + out.string() + " --gt-x " + (dir / "a.vts").string() + " --gt-y " + (dir / "bad.vts").string(),
+              dir);
+  CHECK(r.code == 1);
+  CHECK(r.err.find((dir / "bad.vts").string() + ": line 3") != std::string::npos);
+  write(out / "y_vertex_ids.txt", "0\n");
+  r = run_cli("eval " + out.string(), dir);
+  CHECK(r.code == 1);
+  CHECK(r.err.find("y_vertex_ids.txt: 1 lines, but y.ply has") != std::string::npos);
+
+  // Without the id files the matched meshes are taken as the inputs themselves: the shuffle then
+  // shows up as error (and the same vertex counts make that allowed).
+  fs::remove(out / "x_vertex_ids.txt");
+  fs::remove(out / "y_vertex_ids.txt");
+  r = run_cli("eval " + out.string(), dir);
+  REQUIRE_MESSAGE(r.code == 0, r.err);
+  CHECK(json_number(r.out, "mean_geodesic_error") > 0.1);
+
+  write(out / "report.json", "{\"x\": {\"file\": 3}");
+  r = run_cli("eval " + out.string(), dir);
+  CHECK(r.code == 1);
+  CHECK(r.err.find("report.json: not valid JSON") != std::string::npos);
+  r = run_cli("eval " + (dir / "nothing").string(), dir);
+  CHECK(r.code == 1);
+  CHECK(r.err.find("not a directory") != std::string::npos);
+  fs::remove_all(dir);
+}
+
+TEST_CASE("evaluation: shapematch eval on a real match output of a shared-connectivity pair") {
+  // 60 faces, no decimation: the LP recovers the identity (a few seconds on one core), so the
+  // evaluation must report zero error and no flips whether or not match wrote vertex id files.
+  const fs::path dir = scratch("cli_match");
+  save_mesh(shapes::bent_finger(10, 6, 5), (dir / "a.off").string());
+  save_mesh(shapes::bent_finger(70, 6, 5), (dir / "b.off").string());
+  const fs::path out = dir / "match";
+  Run r = run_cli("match " + (dir / "a.off").string() + " " + (dir / "b.off").string() + " --backend cpu -o " +
+                      out.string(),
+                  dir);
+  REQUIRE_MESSAGE(r.code == 0, r.err);
+  r = run_cli("eval " + out.string(), dir);
+  REQUIRE_MESSAGE(r.code == 0, r.err);
+  CHECK(json_number(r.out, "points") == 32);
+  CHECK(json_number(r.out, "mean_geodesic_error") == 0.0);
+  CHECK(json_number(r.out, "orientation_flips") == 0);
+  CHECK(json_number(r.out, "degenerate_faces") == 0);
+  fs::remove_all(dir);
+}
