@@ -1,7 +1,9 @@
-// End-to-end test of `shapematch bench lp`: the CSV has its columns and one row per solver and
-// size, the solvers agree, and the plot is made where Debian's Python has matplotlib.
+// End-to-end tests of `shapematch bench`. bench lp: the CSV has its columns and one row per solver
+// and size, the solvers agree, and the plot is made where Debian's Python has matplotlib. bench
+// match: whole match runs per size or per pair of a pairs file, where a failed pair is a row.
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -16,11 +18,16 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// Exit code; stderr goes to `err`.
-int run_cli(const std::string& args, const fs::path& err) {
-  const std::string cmd = std::string(SHAPEMATCH_CLI) + " " + args + " >/dev/null 2>" + err.string();
+// Exit code; stderr goes to `err`, stdout to `out` when given.
+int run_cli(const std::string& args, const fs::path& err, const fs::path& out = "/dev/null") {
+  const std::string cmd = std::string(SHAPEMATCH_CLI) + " " + args + " >" + out.string() + " 2>" + err.string();
   const int status = std::system(cmd.c_str());
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+std::string read_text(const fs::path& path) {
+  std::ifstream f(path);
+  return std::string(std::istreambuf_iterator<char>(f), {});
 }
 
 // One CSV record; quoted fields may hold commas (the device "cpu (Clp, 1 thread)").
@@ -43,6 +50,38 @@ std::vector<std::string> split_csv(const std::string& line) {
   return fields;
 }
 
+struct Csv {
+  std::vector<std::string> header;
+  std::vector<std::map<std::string, std::string>> rows;
+};
+
+Csv read_csv(const fs::path& path) {
+  std::ifstream f(path);
+  REQUIRE(f.good());
+  Csv csv;
+  std::string line;
+  std::getline(f, line);
+  csv.header = split_csv(line);
+  while (std::getline(f, line)) {
+    const std::vector<std::string> fields = split_csv(line);
+    REQUIRE(fields.size() == csv.header.size());
+    std::map<std::string, std::string> row;
+    for (size_t i = 0; i < fields.size(); ++i) row[csv.header[i]] = fields[i];
+    csv.rows.push_back(row);
+  }
+  return csv;
+}
+
+// The plot exists where Debian's Python has matplotlib; otherwise the log says why not.
+void check_plot(const fs::path& png, const fs::path& err) {
+  if (std::system("/usr/bin/python3 -c 'import matplotlib' >/dev/null 2>&1") == 0)
+    CHECK(fs::file_size(png) > 1000);
+  else
+    CHECK(read_text(err).find("matplotlib") != std::string::npos);
+}
+
+const std::string kAssets = SHAPEMATCH_ASSETS_DIR;
+
 }  // namespace
 
 TEST_CASE("cli: bench lp writes one CSV row per solver and size, and the solvers agree") {
@@ -51,24 +90,12 @@ TEST_CASE("cli: bench lp writes one CSV row per solver and size, and the solvers
   const fs::path err = fs::temp_directory_path() / "shapematch_bench_stderr.txt";
   REQUIRE(run_cli("bench lp --faces 12,20 --solvers pdhg-cpu,clp-dual --out " + dir.string(), err) == 0);
 
-  std::ifstream f(dir / "bench_lp.csv");
-  REQUIRE(f.good());
-  std::string line;
-  std::getline(f, line);
-  const std::vector<std::string> header = split_csv(line);
+  const auto [header, rows] = read_csv(dir / "bench_lp.csv");
   const std::vector<std::string> expected = {
       "faces_x", "faces_y", "variables", "constraints", "nonzeros", "solver", "device", "status", "iterations", "seconds",
       "seconds_per_iteration", "peak_rss_mb", "solver_rss_mb", "objective", "lower_bound", "rel_diff_best",
       "bytes_per_iteration", "achieved_gbps", "bandwidth_ratio"};
   REQUIRE(header == expected);
-  std::vector<std::map<std::string, std::string>> rows;
-  while (std::getline(f, line)) {
-    const std::vector<std::string> fields = split_csv(line);
-    REQUIRE(fields.size() == header.size());
-    std::map<std::string, std::string> row;
-    for (size_t i = 0; i < header.size(); ++i) row[header[i]] = fields[i];
-    rows.push_back(row);
-  }
   REQUIRE(rows.size() == 4);
 
   std::map<std::string, double> objective_at;  // by variables, the first solver's objective
@@ -88,12 +115,165 @@ TEST_CASE("cli: bench lp writes one CSV row per solver and size, and the solvers
     if (!first) CHECK(std::abs(std::stod(row.at("objective")) - it->second) <= 1e-3 * std::abs(it->second));
   }
   CHECK(objective_at.size() == 2);  // two sizes
+  check_plot(dir / "bench_lp.png", err);
+  fs::remove_all(dir);
+}
 
-  std::ifstream log(err);
-  const std::string errors(std::istreambuf_iterator<char>(log), {});
-  if (std::system("/usr/bin/python3 -c 'import matplotlib' >/dev/null 2>&1") == 0)
-    CHECK(fs::file_size(dir / "bench_lp.png") > 1000);
-  else
-    CHECK(errors.find("matplotlib") != std::string::npos);
+TEST_CASE("cli: bench match (scaling) writes one row per size with the child's own time and memory") {
+  const fs::path dir = fs::temp_directory_path() / "shapematch_bench_match_test";
+  fs::remove_all(dir);
+  const fs::path err = fs::temp_directory_path() / "shapematch_bench_match_stderr.txt";
+  const fs::path out = fs::temp_directory_path() / "shapematch_bench_match_stdout.txt";
+  // Given out of order: the rows come ascending.
+  REQUIRE(run_cli("bench match --faces 30,20 --out " + dir.string() + " -- --backend cpu", err, out) == 0);
+
+  const auto [header, rows] = read_csv(dir / "bench_match.csv");
+  const std::vector<std::string> expected = {"faces_requested", "faces_x", "faces_y", "levels", "variables", "rounds",
+                                             "energy", "lower_bound", "gap", "seconds", "peak_rss_mb", "status"};
+  REQUIRE(header == expected);
+  REQUIRE(rows.size() == 2);
+  for (size_t i = 0; i < rows.size(); ++i) {
+    const auto& row = rows[i];
+    CAPTURE(row.at("faces_requested"));
+    CHECK(row.at("status") == "ok");
+    CHECK(row.at("faces_requested") == (i == 0 ? "20" : "30"));
+    // The bundled pair decimates to exactly the count asked for.
+    CHECK(row.at("faces_x") == row.at("faces_requested"));
+    CHECK(row.at("faces_y") == row.at("faces_requested"));
+    CHECK(std::stoi(row.at("levels")) >= 1);
+    // At most the full product space of two closed genus-0 meshes of n faces (V = n/2 + 2,
+    // E = 3n/2): 3n² + 2Vn + 12En = 22n² + 4n.
+    const long n = std::stol(row.at("faces_x"));
+    CHECK(std::stol(row.at("variables")) > 0);
+    CHECK(std::stol(row.at("variables")) <= 22 * n * n + 4 * n);
+    CHECK(std::stoi(row.at("rounds")) >= 1);
+    const double energy = std::stod(row.at("energy")), bound = std::stod(row.at("lower_bound"));
+    CHECK(energy > 0);
+    CHECK(bound <= energy * (1 + 1e-9));
+    CHECK(std::stod(row.at("gap")) >= -1e-9);
+    CHECK(std::stod(row.at("gap")) < 1);
+    CHECK(std::stod(row.at("seconds")) > 0);
+    CHECK(std::stod(row.at("seconds")) < 60);
+    // A whole process with its meshes and LP: more than a few MiB, far less than a GiB.
+    CHECK(std::stod(row.at("peak_rss_mb")) > 5);
+    CHECK(std::stod(row.at("peak_rss_mb")) < 1024);
+  }
+  CHECK(fs::exists(dir / "runs" / "faces_20" / "report.json"));
+  CHECK(read_text(out).find("| faces_requested |") != std::string::npos);
+  check_plot(dir / "bench_match.png", err);
+  fs::remove_all(dir);
+}
+
+TEST_CASE("cli: bench match kills a run at the time limit and skips the larger sizes") {
+  const fs::path dir = fs::temp_directory_path() / "shapematch_bench_match_timeout_test";
+  fs::remove_all(dir);
+  const fs::path err = dir.string() + "_stderr.txt";
+  // A 1000-face match takes far longer than this limit on any machine.
+  REQUIRE(run_cli("bench match --faces 1000,full --time-limit 0.2 --out " + dir.string() + " -- --backend cpu", err) == 0);
+  const auto [header, rows] = read_csv(dir / "bench_match.csv");
+  REQUIRE(rows.size() == 2);
+  CHECK(rows[0].at("status") == "timed out");
+  CHECK(std::stod(rows[0].at("seconds")) >= 0.2);
+  CHECK(std::stod(rows[0].at("seconds")) < 5);
+  CHECK(rows[0].at("energy").empty());
+  CHECK(rows[1].at("faces_requested") == "full");
+  CHECK(rows[1].at("status").rfind("skipped", 0) == 0);
+  fs::remove_all(dir);
+}
+
+TEST_CASE("cli: bench match --pairs matches and evaluates each pair and adds a row of medians") {
+  const fs::path dir = fs::temp_directory_path() / "shapematch_bench_pairs_test";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const fs::path err = dir.string() + "_stderr.txt";
+  // Relative to the pairs file, which lives elsewhere than the meshes.
+  const fs::path assets = fs::relative(kAssets, dir);
+  const std::string x = (assets / "finger_straight.off").string(), y = (assets / "finger_bent.off").string();
+  std::ofstream(dir / "pairs.txt") << "# the bundled pair shares its connectivity: identity is the truth\n"
+                                   << x << " " << y << "\n\n"
+                                   << x << " " << y << " identity\n";
+  REQUIRE(run_cli("bench match --pairs " + (dir / "pairs.txt").string() + " --faces 20 --out " + (dir / "out").string() +
+                      " -- --backend cpu",
+                  err) == 0);
+
+  const auto [header, rows] = read_csv(dir / "out" / "bench_pairs.csv");
+  const std::vector<std::string> expected = {"pair", "faces_x", "faces_y", "seconds", "peak_rss_mb", "energy",
+                                             "lower_bound", "gap", "rounds", "mean_geodesic_error",
+                                             "median_geodesic_error", "orientation_flips", "status"};
+  REQUIRE(header == expected);
+  REQUIRE(rows.size() == 3);
+  std::vector<double> seconds;
+  for (size_t i = 0; i < 2; ++i) {
+    const auto& row = rows[i];
+    CAPTURE(i);
+    CHECK(row.at("pair") == "finger_straight-finger_bent");
+    CHECK(row.at("status") == "ok");
+    CHECK(row.at("faces_x") == "20");
+    CHECK(std::stod(row.at("lower_bound")) <= std::stod(row.at("energy")) * (1 + 1e-9));
+    CHECK(std::stoi(row.at("rounds")) >= 1);
+    // Normalised by √area: a wrong map errs by a fraction of the shape's size, never by more than
+    // its diameter.
+    const double mean = std::stod(row.at("mean_geodesic_error")), median = std::stod(row.at("median_geodesic_error"));
+    CHECK(mean >= 0);
+    CHECK(mean < 3);
+    CHECK(median >= 0);
+    CHECK(std::stoi(row.at("orientation_flips")) >= 0);
+    seconds.push_back(std::stod(row.at("seconds")));
+  }
+  const auto& median = rows[2];
+  CHECK(median.at("pair") == "median");
+  CHECK(median.at("status") == "2 of 2 ok");
+  CHECK(std::stod(median.at("seconds")) == doctest::Approx((seconds[0] + seconds[1]) / 2).epsilon(1e-4));
+  CHECK(std::stod(median.at("mean_geodesic_error")) == doctest::Approx(std::stod(rows[0].at("mean_geodesic_error"))));
+  CHECK(!median.at("gap").empty());
+  CHECK(median.at("energy").empty());
+
+  const std::string md = read_text(dir / "out" / "bench_pairs.md");
+  CHECK(md.rfind("| pair ", 0) == 0);
+  CHECK(md.find("| **median** ") != std::string::npos);
+  CHECK(md.find("2 of 2 ok") != std::string::npos);
+  fs::remove_all(dir);
+}
+
+TEST_CASE("cli: bench match --pairs records a pair that fails as a row and goes on") {
+  const fs::path dir = fs::temp_directory_path() / "shapematch_bench_pairs_fail_test";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const fs::path err = dir.string() + "_stderr.txt";
+  const std::string x = kAssets + "/finger_straight.off", y = kAssets + "/finger_bent.off";
+  std::ofstream(dir / "pairs.txt") << "missing.off " << y << "\n"
+                                   << x << " " << y << " no_such_x.vts no_such_y.vts\n";
+  REQUIRE(run_cli("bench match --pairs " + (dir / "pairs.txt").string() + " --faces 12 --out " + (dir / "out").string() +
+                      " -- --backend cpu",
+                  err) == 0);
+  const auto [header, rows] = read_csv(dir / "out" / "bench_pairs.csv");
+  REQUIRE(rows.size() == 3);
+  CHECK(rows[0].at("pair") == "missing-finger_bent");
+  // The child's one-line error, naming the file.
+  CHECK(rows[0].at("status").rfind("failed: ", 0) == 0);
+  CHECK(rows[0].at("status").find("missing.off") != std::string::npos);
+  CHECK(rows[0].at("energy").empty());
+  // The match ran; its ground truth is what is missing.
+  CHECK(rows[1].at("status").rfind("eval failed: ", 0) == 0);
+  CHECK(rows[1].at("status").find("no_such_x.vts") != std::string::npos);
+  CHECK(!rows[1].at("energy").empty());
+  CHECK(rows[1].at("mean_geodesic_error").empty());
+  CHECK(rows[2].at("status") == "0 of 2 ok");
+  CHECK(rows[2].at("seconds").empty());
+  fs::remove_all(dir);
+}
+
+TEST_CASE("cli: bench match --pairs rejects a malformed pairs file before running anything") {
+  const fs::path dir = fs::temp_directory_path() / "shapematch_bench_pairs_bad_test";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const fs::path err = dir.string() + "_stderr.txt";
+  std::ofstream(dir / "pairs.txt") << "a.off b.off\n# comment\nonly_one.off\n";
+  CHECK(run_cli("bench match --pairs " + (dir / "pairs.txt").string() + " --out " + (dir / "out").string(), err) == 1);
+  const std::string message = read_text(err);
+  CHECK(std::count(message.begin(), message.end(), '\n') == 1);
+  CHECK(message.rfind("shapematch: error: ", 0) == 0);
+  CHECK(message.find("pairs.txt:3:") != std::string::npos);
+  CHECK(!fs::exists(dir / "out"));
   fs::remove_all(dir);
 }

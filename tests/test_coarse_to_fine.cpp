@@ -86,9 +86,10 @@ TEST_CASE("coarse to fine: a deformed pair with different triangulations ends ve
   const Mesh x = shapes::bent_finger(10, 8, 8), y = shapes::bent_finger(60, 8, 8);
   CoarseToFineOptions o;
   o.hierarchy.levels = 2;
-  o.hierarchy.coarsest_faces = 24;
+  o.hierarchy.coarsest_faces = 16;
+  o.matching.energy.membrane = MembraneModel::Compressive;
   o.rounding.solver = "pdhg-cpu";
-  const CoarseToFineMatcher matcher(decimate(x, 90), decimate(y, 100), o);
+  const CoarseToFineMatcher matcher(decimate(x, 50), decimate(y, 60), o);
   const CoarseToFineResult r = matcher.run();
   REQUIRE(r.levels.size() == 2);
   const GraphSurfaceCheck c = check_graph_surface(r.finest.space, r.rounding.gamma);

@@ -98,3 +98,55 @@ TEST_CASE("energy: the identity matching costs nothing; swapping X and Y preserv
   for (const auto& t : identity_matching(x)) id_energy += xy(t);
   CHECK(id_energy > 0.0);
 }
+
+TEST_CASE("energy: the compressive membrane charges compression like SVK and stretch not at all") {
+  // Biaxial scaling by (s1, s2) of a planar triangle along the frame axes has principal squared
+  // stretches s1², s2²; the compressive energy keeps e_i = (min(s_i², 1) − 1)/2.
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(0.2, 1.8), angle(0, 3.14159);
+  for (int k = 0; k < 200; ++k) {
+    Triangle3 src = random_triangle(rng);
+    for (auto& p : src) p.z() = 0.0;
+    const double s1 = u(rng), s2 = u(rng), lambda = 0.5 + (k % 3), mu = 0.4 + (k % 4);
+    const Eigen::Matrix3d r = test::random_rotation(rng);
+    const double th = angle(rng);
+    const Eigen::Matrix2d frame = Eigen::Rotation2Dd(th).toRotationMatrix();
+    Eigen::Matrix2d stretch = frame * Eigen::Vector2d(s1, s2).asDiagonal() * frame.transpose();
+    Triangle3 dst;
+    for (int i = 0; i < 3; ++i) {
+      const Eigen::Vector2d q = stretch * src[i].head<2>();
+      dst[i] = r * Eigen::Vector3d(q.x(), q.y(), 0.0);
+    }
+    const double area = 0.5 * (src[1] - src[0]).cross(src[2] - src[0]).norm();
+    const double e1 = 0.5 * (std::min(s1 * s1, 1.0) - 1), e2 = 0.5 * (std::min(s2 * s2, 1.0) - 1);
+    const double expected = area * (0.5 * lambda * (e1 + e2) * (e1 + e2) + mu * (e1 * e1 + e2 * e2));
+    CHECK(compressive_membrane_energy(src, dst, lambda, mu) == doctest::Approx(expected).epsilon(1e-9));
+    if (s1 <= 1 && s2 <= 1)  // pure compression: exactly St. Venant–Kirchhoff
+      CHECK(compressive_membrane_energy(src, dst, lambda, mu) == doctest::Approx(membrane_energy(src, dst, lambda, mu)).epsilon(1e-9));
+    if (s1 >= 1 && s2 >= 1) CHECK(compressive_membrane_energy(src, dst, lambda, mu) == doctest::Approx(0.0).epsilon(1e-12));
+  }
+  // Squashed onto a segment of the same length: e = (−1/2, 0), W = A(λ/8 + μ/4).
+  const Triangle3 s{Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(0, 1, 0)};
+  const Triangle3 seg{Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(0, 0, 0)};
+  CHECK(compressive_membrane_energy(s, seg, 1.0, 1.0) == doctest::Approx(0.5 * (1.0 / 8 + 1.0 / 4)));
+  CHECK(compressive_membrane_energy(seg, s, 1.0, 1.0) == 0.0);  // a degenerate source has no metric
+}
+
+TEST_CASE("energy: with the compressive membrane a stretch is charged once, as compression the other way") {
+  // A product triangle mapping a face onto itself scaled by s > 1: X→Y stretches (free), Y→X
+  // compresses by 1/s, on the target's area s²A.
+  const Mesh x = shapes::octahedron();
+  const double s = 1.4;
+  const Mesh y = test::deformed(x, [&](const Eigen::Vector3d& p) { return Eigen::Vector3d(s * p); });
+  const Geometry gx = compute_geometry(x), gy = compute_geometry(y);
+  EnergyOptions o;
+  o.membrane = MembraneModel::Compressive;
+  o.bending_weight = 0;
+  const EnergyModel model(x, gx, y, gy, o);
+  const ProductTriangle t{x.faces[0], y.faces[0], 0, 0};
+  const double e = 0.5 * (1 / (s * s) - 1);
+  CHECK(model.membrane(t) == doctest::Approx(s * s * gx.face_area[0] * (0.5 * 1 * 4 * e * e + 1 * 2 * e * e)));
+  // The reverse pair costs the same: the energy is symmetric in X and Y.
+  const EnergyModel reverse(y, gy, x, gx, o);
+  CHECK(reverse.membrane(t) == doctest::Approx(model.membrane(t)));
+}
