@@ -1,7 +1,9 @@
 // `shapematch bench lp`: the paper's Fig. 4 (LP solve time against problem size, one line per
 // solver) with Clp in place of CPLEX; `shapematch bench bandwidth`: the streaming memory
-// bandwidth that bounds one PDHG iteration.
+// bandwidth that bounds one PDHG iteration; `shapematch bench match`: whole match runs, at
+// growing sizes (time and memory scaling) or over a list of pairs with their evaluation.
 #include "commands.hpp"
+#include "json_read.hpp"
 #include "shapematch/errors.hpp"
 #include "shapematch/json.hpp"
 #include "shapematch/matching.hpp"
@@ -11,14 +13,19 @@
 #include <spdlog/fmt/fmt.h>
 #include <spdlog/spdlog.h>
 
+#include <fcntl.h>
 #include <poll.h>
 #include <signal.h>
+#include <spawn.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <barrier>
 #include <cerrno>
+#include <chrono>
+#include <climits>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -26,6 +33,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <iterator>
 #include <limits>
 #include <memory>
 #include <set>
@@ -323,10 +331,10 @@ SolveRecord solve_repeated(const LpProblem& lp, const std::string& solver, const
   return best;
 }
 
-// tools/plot_bench.py with Debian's Python, which has matplotlib; a missing matplotlib is a
-// warning, not a failed benchmark. Returns the PNG path, or "" when there is none.
-std::string plot(const std::string& csv_path, const std::string& png_path) {
-  const fs::path script = fs::path(SHAPEMATCH_ASSETS_DIR).parent_path() / "tools" / "plot_bench.py";
+// tools/<script> with Debian's Python, which has matplotlib; a missing matplotlib is a warning,
+// not a failed benchmark. Returns the PNG path, or "" when there is none.
+std::string plot(const std::string& script_name, const std::string& csv_path, const std::string& png_path) {
+  const fs::path script = fs::path(SHAPEMATCH_ASSETS_DIR).parent_path() / "tools" / script_name;
   const std::string python = "/usr/bin/python3";
   if (std::system((python + " -c 'import matplotlib' >/dev/null 2>&1").c_str()) != 0) {
     spdlog::warn("{} cannot import matplotlib (apt install python3-matplotlib); no plot, the CSV is {}", python,
@@ -399,9 +407,390 @@ int run_bench_lp(BenchLpArgs args) {
   if (rows.empty()) write_file_atomic(csv_path, csv_table(rows, bandwidth_gbps));
 
   Json out = Json::object();
-  out.set("csv", csv_path).set("plot", plot(csv_path, png_path));
+  out.set("csv", csv_path).set("plot", plot("plot_bench.py", csv_path, png_path));
   out.set("bandwidth_gbps", bandwidth_gbps);
   std::cout << out.dump() << std::endl;
+  return 0;
+}
+
+// ---------------------------------------------------------------------------------------------
+// bench match: whole `match` (and `eval`) runs as child processes of this executable, so that
+// each one is timed, measured and, past the time limit, killed on its own.
+
+struct ChildRun {
+  std::string status;  // "ok", "timed out" or "failed: <reason>"
+  double seconds = kNaN;
+  double peak_rss_mb = kNaN;
+};
+
+// The child's reason: its first stderr line that is not a log line ("[12:00:00.000] ..."), which
+// is the "shapematch: error: ..." line or CLI11's complaint about an option.
+std::string failure_reason(const fs::path& err_path, int wstatus) {
+  std::ifstream in(err_path);
+  std::string line;
+  while (std::getline(in, line)) {
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (line.empty() || line[0] == '[') continue;
+    for (const std::string prefix : {"shapematch: error: ", "shapematch: "})
+      if (line.rfind(prefix, 0) == 0) {
+        line.erase(0, prefix.size());
+        break;
+      }
+    return line;
+  }
+  if (WIFSIGNALED(wstatus)) return fmt::format("killed by signal {} (out of memory?)", WTERMSIG(wstatus));
+  return fmt::format("exit code {}", WEXITSTATUS(wstatus));
+}
+
+// Runs this executable with `args`: stdout to `out_path` (empty: with stderr), stderr to
+// `err_path`. posix_spawn (vfork underneath) rather than fork, so that the child does not start
+// as a copy of this process and the ru_maxrss that wait4 reports is its own peak.
+ChildRun run_child(const std::vector<std::string>& args, const std::string& out_path, const std::string& err_path,
+                   double time_limit) {
+  static const std::string exe = fs::read_symlink("/proc/self/exe").string();
+  std::vector<std::string> words{exe};
+  words.insert(words.end(), args.begin(), args.end());
+  std::vector<char*> argv;
+  for (std::string& w : words) argv.push_back(w.data());
+  argv.push_back(nullptr);
+
+  posix_spawn_file_actions_t files;
+  posix_spawn_file_actions_init(&files);
+  posix_spawn_file_actions_addopen(&files, STDERR_FILENO, err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  if (out_path.empty())
+    posix_spawn_file_actions_adddup2(&files, STDERR_FILENO, STDOUT_FILENO);
+  else
+    posix_spawn_file_actions_addopen(&files, STDOUT_FILENO, out_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  Stopwatch clock;
+  pid_t pid = 0;
+  const int started = posix_spawn(&pid, exe.c_str(), &files, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&files);
+  if (started != 0) throw SolverError(fmt::format("bench: cannot start {}: {}", exe, std::strerror(started)));
+
+  int wstatus = 0;
+  rusage usage{};
+  bool killed = false;
+  while (true) {
+    const pid_t done = wait4(pid, &wstatus, WNOHANG, &usage);
+    if (done == pid) break;
+    if (done < 0 && errno != EINTR) throw SolverError(std::string("bench: wait4: ") + std::strerror(errno));
+    if (!killed && clock.seconds() > time_limit) {
+      kill(pid, SIGKILL);
+      killed = true;
+    }
+    // Polling keeps the measured wall time within 2 ms of the child's, at no measurable cost.
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+  }
+  ChildRun r;
+  r.seconds = clock.seconds();
+  r.peak_rss_mb = double(usage.ru_maxrss) / 1024.0;  // KiB on Linux
+  if (killed)
+    r.status = "timed out";
+  else if (WIFEXITED(wstatus) && WEXITSTATUS(wstatus) == 0)
+    r.status = "ok";
+  else
+    r.status = "failed: " + failure_reason(err_path, wstatus);
+  return r;
+}
+
+struct BenchMatchArgs {
+  std::vector<std::string> pair;  // scaling: X Y; default: the bundled pair
+  std::string pairs_file;         // pairs mode when given
+  std::vector<std::string> faces;  // face counts or "full"
+  std::string out = "bench";
+  double time_limit = 600.0;
+  std::vector<std::string> match_args;  // after `--`, passed to every match run
+};
+
+// One match run (a size or a pair); NaN where it did not get that far.
+struct MatchRow {
+  std::string name;  // the faces asked for, or the pair
+  double faces_x = kNaN, faces_y = kNaN, levels = kNaN, variables = kNaN, rounds = kNaN;
+  double energy = kNaN, lower_bound = kNaN, gap = kNaN;
+  double mean_error = kNaN, median_error = kNaN, flips = kNaN;
+  ChildRun run;
+};
+
+int faces_value(const std::string& faces) { return faces == "full" ? 0 : std::stoi(faces); }
+
+std::string absolute_path(const std::string& path) { return fs::absolute(path).lexically_normal().string(); }
+
+// The size and rounds are the finest level's: the coarser levels only narrow its product space.
+void read_report(const fs::path& dir, MatchRow& row) {
+  const JsonNode report = read_json_file((dir / "report.json").string());
+  if (const JsonNode* x = report.get("x")) row.faces_x = x->number_or_nan("faces");
+  if (const JsonNode* y = report.get("y")) row.faces_y = y->number_or_nan("faces");
+  const JsonNode* levels = report.get("levels");
+  if (levels && levels->kind == JsonNode::Kind::Array && !levels->members.empty()) {
+    row.levels = double(levels->members.size());
+    const JsonNode& finest = levels->members.back().second;
+    row.variables = finest.number_or_nan("variables");
+    row.rounds = finest.number_or_nan("rounds");
+  }
+  row.energy = report.number_or_nan("energy");
+  row.lower_bound = report.number_or_nan("lower_bound");
+  row.gap = report.number_or_nan("gap");
+}
+
+// `match X Y` into `dir` (kept for inspection, its log beside it as dir.match.log).
+void run_match_child(const BenchMatchArgs& args, const std::string& x, const std::string& y, const std::string& faces,
+                     const fs::path& dir, MatchRow& row) {
+  // A failed run must not leave the previous benchmark's output looking like its own.
+  fs::remove_all(dir);
+  std::vector<std::string> cmd{"match", x, y, "-o", dir.string()};
+  if (!faces.empty()) cmd.insert(cmd.end(), {"--faces", faces});
+  cmd.insert(cmd.end(), args.match_args.begin(), args.match_args.end());
+  row.run = run_child(cmd, "", dir.string() + ".match.log", args.time_limit);
+  if (row.run.status != "ok") return;
+  try {
+    read_report(dir, row);
+  } catch (const Error& e) {
+    row.run.status = std::string("failed: ") + e.what();
+  }
+}
+
+void log_row(const MatchRow& row) {
+  if (row.run.status == "ok")
+    spdlog::info("{}: {}×{} faces, energy {:.6g}, gap {:.2g}, {:.2f} s, peak {:.0f} MiB", row.name, row.faces_x,
+                 row.faces_y, row.energy, row.gap, row.run.seconds, row.run.peak_rss_mb);
+  else if (std::isfinite(row.run.seconds))
+    spdlog::warn("{}: {} ({:.2f} s)", row.name, row.run.status, row.run.seconds);
+  else
+    spdlog::warn("{}: {}", row.name, row.run.status);
+}
+
+std::string csv_int(double v) { return std::isfinite(v) ? fmt::format("{:.0f}", v) : std::string(); }
+
+std::string fixed(double v, int decimals) {
+  return std::isfinite(v) ? fmt::format("{:.{}f}", v, decimals) : std::string();
+}
+
+// A Markdown table padded into aligned columns, so that it reads as plain text too.
+std::string markdown_table(const std::vector<std::string>& header, std::vector<std::vector<std::string>> rows) {
+  for (auto& row : rows)
+    for (std::string& cell : row) {
+      std::string escaped;
+      for (char ch : cell) escaped += ch == '|' ? std::string("\\|") : std::string(1, ch);
+      cell = std::move(escaped);
+    }
+  std::vector<size_t> width(header.size());
+  for (size_t c = 0; c < header.size(); ++c) {
+    width[c] = std::max<size_t>(3, header[c].size());
+    for (const auto& row : rows) width[c] = std::max(width[c], row[c].size());
+  }
+  auto line = [&](const std::vector<std::string>& cells) {
+    std::string text = "|";
+    for (size_t c = 0; c < cells.size(); ++c) text += fmt::format(" {:<{}} |", cells[c], width[c]);
+    return text + "\n";
+  };
+  std::string text = line(header) + "|";
+  for (size_t w : width) text += std::string(w + 2, '-') + "|";
+  text += "\n";
+  for (const auto& row : rows) text += line(row);
+  return text;
+}
+
+std::string csv_line(const std::vector<std::string>& cells) {
+  std::string text;
+  for (size_t c = 0; c < cells.size(); ++c) {
+    if (c) text += ',';
+    text += csv_text(cells[c]);
+  }
+  return text + "\n";
+}
+
+// ---- scaling mode
+
+const std::vector<std::string> kScalingHeader{"faces_requested", "faces_x", "faces_y",   "levels",
+                                              "variables",       "rounds",  "energy",    "lower_bound",
+                                              "gap",             "seconds", "peak_rss_mb", "status"};
+
+// `csv` chooses full precision over readable widths.
+std::vector<std::vector<std::string>> scaling_cells(const std::vector<MatchRow>& rows, bool csv) {
+  std::vector<std::vector<std::string>> cells;
+  for (const MatchRow& r : rows)
+    cells.push_back({r.name, csv_int(r.faces_x), csv_int(r.faces_y), csv_int(r.levels), csv_int(r.variables),
+                     csv_int(r.rounds), csv_number(r.energy, csv ? 12 : 6), csv_number(r.lower_bound, csv ? 12 : 6),
+                     csv_number(r.gap, csv ? 4 : 3), csv ? csv_number(r.run.seconds) : fixed(r.run.seconds, 2),
+                     csv ? csv_number(r.run.peak_rss_mb, 5) : fixed(r.run.peak_rss_mb, 0), r.run.status});
+  return cells;
+}
+
+std::string scaling_csv(const std::vector<MatchRow>& rows) {
+  std::string text = csv_line(kScalingHeader);
+  for (const auto& row : scaling_cells(rows, true)) text += csv_line(row);
+  return text;
+}
+
+int run_bench_scaling(const BenchMatchArgs& args) {
+  const std::vector<std::string> pair = args.pair.empty() ? std::vector<std::string>{default_mesh_x(), default_mesh_y()}
+                                                          : args.pair;
+  const std::string x = absolute_path(pair[0]), y = absolute_path(pair[1]);
+  std::vector<std::string> sizes = args.faces;
+  if (sizes.empty()) sizes = {"500", "1000", "2000", "4000", "full"};
+  // Ascending with "full" last, so that a size that timed out can skip the larger ones.
+  auto order = [](const std::string& s) { return s == "full" ? INT_MAX : faces_value(s); };
+  std::stable_sort(sizes.begin(), sizes.end(), [&](const auto& a, const auto& b) { return order(a) < order(b); });
+
+  const fs::path out(args.out);
+  fs::create_directories(out / "runs");
+  const std::string csv_path = (out / "bench_match.csv").string();
+  std::vector<MatchRow> rows;
+  bool gave_up = false;
+  for (const std::string& size : sizes) {
+    MatchRow row;
+    row.name = size;
+    if (gave_up) {
+      row.run.status = "skipped (a smaller size timed out)";
+    } else {
+      spdlog::info("match at {} faces", size);
+      run_match_child(args, x, y, std::to_string(faces_value(size)), out / "runs" / ("faces_" + size), row);
+      gave_up = row.run.status == "timed out";
+    }
+    log_row(row);
+    rows.push_back(std::move(row));
+    // Rewritten after every run, so that a long benchmark that is stopped keeps what it measured.
+    write_file_atomic(csv_path, scaling_csv(rows));
+  }
+  const std::string png = plot("plot_bench_match.py", csv_path, (out / "bench_match.png").string());
+
+  std::cout << markdown_table(kScalingHeader, scaling_cells(rows, false)) << std::flush;
+  spdlog::info("wrote {}{}", csv_path, png.empty() ? "" : " and " + png);
+  return 0;
+}
+
+// ---- pairs mode
+
+struct PairSpec {
+  std::string x, y;
+  std::vector<std::string> truth;  // the options of `eval` that name the ground truth
+};
+
+// One pair per line, `X Y [identity | A.vts B.vts | map FILE] [# comment]`; relative paths are
+// relative to the file, so that a pairs file can travel with its data set.
+std::vector<PairSpec> read_pairs_file(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw IoError(path + ": cannot open");
+  const fs::path base = fs::absolute(path).parent_path();
+  auto resolve = [&](const std::string& p) {
+    const fs::path q(p);
+    return (q.is_absolute() ? q : base / q).lexically_normal().string();
+  };
+  std::vector<PairSpec> pairs;
+  std::string line;
+  for (int number = 1; std::getline(in, line); ++number) {
+    std::istringstream words(line);
+    std::vector<std::string> w{std::istream_iterator<std::string>(words), {}};
+    // A comment runs from a word that starts with '#' to the end of the line.
+    w.erase(std::find_if(w.begin(), w.end(), [](const std::string& word) { return word[0] == '#'; }), w.end());
+    if (w.empty()) continue;
+    const bool identity = w.size() == 2 || (w.size() == 3 && w[2] == "identity");
+    const bool map = w.size() == 4 && w[2] == "map";
+    if (!identity && w.size() != 4)
+      throw InvalidInputError(fmt::format("{}:{}: expected `X Y [identity | A.vts B.vts | map FILE]`, found {} field{}",
+                                          path, number, w.size(), w.size() == 1 ? "" : "s"));
+    PairSpec p{resolve(w[0]), resolve(w[1]), {}};
+    if (identity)
+      p.truth = {"--gt", "identity"};
+    else if (map)
+      p.truth = {"--gt-map", resolve(w[3])};
+    else
+      p.truth = {"--gt-x", resolve(w[2]), "--gt-y", resolve(w[3])};
+    pairs.push_back(std::move(p));
+  }
+  if (pairs.empty()) throw InvalidInputError(path + ": no pairs (one `X Y [ground truth]` per line)");
+  return pairs;
+}
+
+// The median over the rows that succeeded; a failed row's numbers are partial or missing.
+double median_ok(const std::vector<MatchRow>& rows, double (*value)(const MatchRow&)) {
+  std::vector<double> v;
+  for (const MatchRow& r : rows)
+    if (r.run.status == "ok" && std::isfinite(value(r))) v.push_back(value(r));
+  if (v.empty()) return kNaN;
+  std::sort(v.begin(), v.end());
+  const size_t n = v.size();
+  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+const std::vector<std::string> kPairsHeader{"pair",        "faces_x", "faces_y", "seconds",
+                                            "peak_rss_mb", "energy",  "lower_bound", "gap",
+                                            "rounds",      "mean_geodesic_error", "median_geodesic_error",
+                                            "orientation_flips", "status"};
+
+// The rows plus a last one of medians; `csv` chooses full precision over readable widths.
+std::vector<std::vector<std::string>> pairs_cells(const std::vector<MatchRow>& rows, bool csv) {
+  auto num = [&](double v, int digits, int decimals) { return csv ? csv_number(v, digits) : fixed(v, decimals); };
+  auto general = [&](double v, int digits) { return csv_number(v, csv ? digits : 4); };
+  std::vector<std::vector<std::string>> cells;
+  for (const MatchRow& r : rows)
+    cells.push_back({r.name, csv_int(r.faces_x), csv_int(r.faces_y), num(r.run.seconds, 6, 2),
+                     num(r.run.peak_rss_mb, 5, 0), general(r.energy, 12), general(r.lower_bound, 12),
+                     general(r.gap, 4), csv_int(r.rounds), num(r.mean_error, 6, 4), num(r.median_error, 6, 4),
+                     csv_int(r.flips), r.run.status});
+  const auto ok = std::count_if(rows.begin(), rows.end(), [](const MatchRow& r) { return r.run.status == "ok"; });
+  cells.push_back({csv ? "median" : "**median**", "", "",
+                   num(median_ok(rows, [](const MatchRow& r) { return r.run.seconds; }), 6, 2),
+                   num(median_ok(rows, [](const MatchRow& r) { return r.run.peak_rss_mb; }), 5, 0), "", "",
+                   general(median_ok(rows, [](const MatchRow& r) { return r.gap; }), 4), "",
+                   num(median_ok(rows, [](const MatchRow& r) { return r.mean_error; }), 6, 4),
+                   num(median_ok(rows, [](const MatchRow& r) { return r.median_error; }), 6, 4), "",
+                   fmt::format("{} of {} ok", ok, rows.size())});
+  return cells;
+}
+
+std::string pairs_csv(const std::vector<MatchRow>& rows) {
+  std::string text = csv_line(kPairsHeader);
+  for (const auto& row : pairs_cells(rows, true)) text += csv_line(row);
+  return text;
+}
+
+// Fills the errors from `eval`'s JSON; a failed evaluation keeps the match's numbers.
+void evaluate(const BenchMatchArgs& args, const PairSpec& pair, const fs::path& dir, MatchRow& row) {
+  std::vector<std::string> cmd{"eval", dir.string()};
+  cmd.insert(cmd.end(), pair.truth.begin(), pair.truth.end());
+  const std::string json_path = dir.string() + ".eval.json";
+  const ChildRun e = run_child(cmd, json_path, dir.string() + ".eval.log", args.time_limit);
+  if (e.status != "ok") {
+    row.run.status = "eval " + e.status;
+    return;
+  }
+  try {
+    const JsonNode result = read_json_file(json_path);
+    row.mean_error = result.number_or_nan("mean_geodesic_error");
+    row.median_error = result.number_or_nan("median_geodesic_error");
+    row.flips = result.number_or_nan("orientation_flips");
+  } catch (const Error& error) {
+    row.run.status = std::string("eval failed: ") + error.what();
+  }
+}
+
+int run_bench_pairs(const BenchMatchArgs& args) {
+  if (args.faces.size() > 1)
+    throw InvalidInputError("--faces: one size with --pairs (a list of sizes is for the scaling mode, --pair)");
+  // Read before any run, so that a malformed file costs nothing.
+  const std::vector<PairSpec> pairs = read_pairs_file(args.pairs_file);
+  const std::string faces = args.faces.empty() ? std::string() : std::to_string(faces_value(args.faces[0]));
+  const fs::path out(args.out);
+  fs::create_directories(out / "runs");
+  const std::string csv_path = (out / "bench_pairs.csv").string(), md_path = (out / "bench_pairs.md").string();
+  std::vector<MatchRow> rows;
+  for (size_t i = 0; i < pairs.size(); ++i) {
+    const PairSpec& pair = pairs[i];
+    MatchRow row;
+    row.name = fs::path(pair.x).stem().string() + "-" + fs::path(pair.y).stem().string();
+    // Numbered, because a list may hold the same pair twice (e.g. with different ground truth).
+    const fs::path dir = out / "runs" / fmt::format("{:02}_{}", i + 1, row.name);
+    spdlog::info("pair {} of {}: {}", i + 1, pairs.size(), row.name);
+    run_match_child(args, pair.x, pair.y, faces, dir, row);
+    if (row.run.status == "ok") evaluate(args, pair, dir, row);
+    log_row(row);
+    rows.push_back(std::move(row));
+    write_file_atomic(csv_path, pairs_csv(rows));
+    write_file_atomic(md_path, markdown_table(kPairsHeader, pairs_cells(rows, false)));
+  }
+  std::cout << markdown_table(kPairsHeader, pairs_cells(rows, false)) << std::flush;
+  spdlog::info("wrote {} and {}", csv_path, md_path);
   return 0;
 }
 
@@ -437,8 +826,34 @@ Action add_bench_command(CLI::App& app) {
   bandwidth->add_option("--threads", bw->threads, "threads (0 = all)")->check(CLI::NonNegativeNumber)->capture_default_str();
   bandwidth->add_option("--repeats", bw->repeats, "best of this many runs")->check(CLI::PositiveNumber)->capture_default_str();
 
-  return [lp, args, bw] {
+  CLI::App* match = app.add_subcommand(
+      "match", "time whole match runs at growing sizes, or match and evaluate a list of pairs (CSV, Markdown, plot)");
+  auto m = std::make_shared<BenchMatchArgs>();
+  auto* pair = match->add_option("--pair", m->pair, "scaling: the two meshes X Y; default: bundled asset pair")->expected(2);
+  match->add_option("--pairs", m->pairs_file, "pairs mode: a file of lines `X Y [identity | A.vts B.vts | map FILE]`")
+      ->excludes(pair);
+  const CLI::Validator size(
+      [](std::string& s) -> std::string {
+        if (s == "full") return {};
+        char* end = nullptr;
+        const long n = std::strtol(s.c_str(), &end, 10);
+        return !s.empty() && *end == '\0' && n > 0 && n <= INT_MAX ? "" : "'" + s + "' is neither a face count nor `full`";
+      },
+      "INT|full");
+  match->add_option("--faces", m->faces,
+                    "faces per shape; scaling: one run per entry (default 500,1000,2000,4000,full); pairs: one size "
+                    "(default: match's)")
+      ->delimiter(',')
+      ->check(size);
+  match->add_option("--out", m->out, "directory for the tables, the plot and runs/")->capture_default_str();
+  match->add_option("--time-limit", m->time_limit, "seconds per child run (match, eval); then it is killed")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  match->add_option("match-args", m->match_args, "after `--`: options for every match run, verbatim");
+
+  return [lp, args, match, m, bw] {
     if (lp->parsed()) return run_bench_lp(*args);
+    if (match->parsed()) return m->pairs_file.empty() ? run_bench_scaling(*m) : run_bench_pairs(*m);
     const double gbps = measure_bandwidth_gbps(*bw);
     Json out = Json::object();
     out.set("threads", bw->threads > 0 ? bw->threads : int(std::thread::hardware_concurrency()));

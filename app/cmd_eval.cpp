@@ -1,5 +1,6 @@
 // `shapematch eval DIR`: a `match` output directory against ground truth (DESIGN.md §9).
 #include "commands.hpp"
+#include "json_read.hpp"
 #include "shapematch/errors.hpp"
 #include "shapematch/evaluation.hpp"
 #include "shapematch/files.hpp"
@@ -9,14 +10,10 @@
 #include <spdlog/fmt/fmt.h>
 #include <spdlog/spdlog.h>
 
-#include <cctype>
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
 #include <random>
-#include <sstream>
-#include <string_view>
 
 namespace fs = std::filesystem;
 
@@ -31,158 +28,6 @@ struct EvalArgs {
   std::string pck_csv, pck_png;
   int threads = 0;
 };
-
-// Just enough JSON to read report.json back: the values are kept as a tree and looked up by key.
-struct JsonNode {
-  enum class Kind { Null, Bool, Number, String, Array, Object } kind = Kind::Null;
-  double number = 0;
-  std::string text;
-  std::vector<std::pair<std::string, JsonNode>> members;  // object members; array items have no key
-
-  const JsonNode* get(const std::string& key) const {
-    if (kind != Kind::Object) return nullptr;
-    for (const auto& [k, v] : members)
-      if (k == key) return &v;
-    return nullptr;
-  }
-};
-
-class JsonParser {
-public:
-  JsonParser(std::string text, std::string path) : text_(std::move(text)), path_(std::move(path)) {}
-
-  JsonNode parse() {
-    JsonNode root = value(0);
-    skip_space();
-    if (pos_ != text_.size()) fail("unexpected text after the JSON value");
-    return root;
-  }
-
-private:
-  [[noreturn]] void fail(const std::string& problem) const {
-    throw InvalidInputError(path_ + ": not valid JSON at byte " + std::to_string(pos_) + ": " + problem);
-  }
-  void skip_space() {
-    while (pos_ < text_.size() && std::string_view(" \t\r\n").find(text_[pos_]) != std::string_view::npos) ++pos_;
-  }
-  bool eat(char c) {
-    skip_space();
-    if (pos_ < text_.size() && text_[pos_] == c) return ++pos_, true;
-    return false;
-  }
-  void expect(char c) {
-    if (!eat(c)) fail(std::string("expected '") + c + "'");
-  }
-
-  JsonNode value(int depth) {
-    if (depth > 64) fail("nested too deeply");
-    skip_space();
-    if (pos_ >= text_.size()) fail("unexpected end");
-    JsonNode node;
-    const char c = text_[pos_];
-    if (c == '{' || c == '[') {
-      const bool object = c == '{';
-      node.kind = object ? JsonNode::Kind::Object : JsonNode::Kind::Array;
-      ++pos_;
-      if (eat(object ? '}' : ']')) return node;
-      do {
-        std::string key;
-        if (object) {
-          skip_space();
-          key = string();
-          expect(':');
-        }
-        node.members.emplace_back(std::move(key), value(depth + 1));
-      } while (eat(','));
-      expect(object ? '}' : ']');
-    } else if (c == '"') {
-      node.kind = JsonNode::Kind::String;
-      node.text = string();
-    } else if (literal("true")) {
-      node.kind = JsonNode::Kind::Bool;
-      node.number = 1;
-    } else if (literal("false")) {
-      node.kind = JsonNode::Kind::Bool;
-    } else if (literal("null")) {
-      node.kind = JsonNode::Kind::Null;
-    } else {
-      const size_t begin = pos_;
-      while (pos_ < text_.size() && std::string_view("+-0123456789.eE").find(text_[pos_]) != std::string_view::npos)
-        ++pos_;
-      const std::string token = text_.substr(begin, pos_ - begin);
-      char* end = nullptr;
-      node.kind = JsonNode::Kind::Number;
-      node.number = token.empty() ? 0 : std::strtod(token.c_str(), &end);
-      if (token.empty() || end != token.c_str() + token.size()) fail("expected a value");
-    }
-    return node;
-  }
-
-  bool literal(const char* word) {
-    const std::string_view w(word);
-    if (text_.compare(pos_, w.size(), w) != 0) return false;
-    pos_ += w.size();
-    return true;
-  }
-
-  std::string string() {
-    if (pos_ >= text_.size() || text_[pos_] != '"') fail("expected a string");
-    ++pos_;
-    std::string out;
-    while (true) {
-      if (pos_ >= text_.size()) fail("unterminated string");
-      const char c = text_[pos_++];
-      if (c == '"') return out;
-      if (c != '\\') {
-        out += c;
-        continue;
-      }
-      if (pos_ >= text_.size()) fail("unterminated string");
-      const char e = text_[pos_++];
-      switch (e) {
-        case '"': case '\\': case '/': out += e; break;
-        case 'b': out += '\b'; break;
-        case 'f': out += '\f'; break;
-        case 'n': out += '\n'; break;
-        case 'r': out += '\r'; break;
-        case 't': out += '\t'; break;
-        case 'u': {
-          if (pos_ + 4 > text_.size()) fail("short \\u escape");
-          unsigned code = 0;
-          for (int i = 0; i < 4; ++i) {
-            const unsigned char h = static_cast<unsigned char>(text_[pos_++]);
-            if (!std::isxdigit(h)) fail("bad \\u escape");
-            code = code * 16 + (std::isdigit(h) ? h - '0' : std::tolower(h) - 'a' + 10);
-          }
-          // UTF-8; the writer escapes only control characters, so surrogate pairs are not joined.
-          if (code < 0x80) {
-            out += static_cast<char>(code);
-          } else if (code < 0x800) {
-            out += static_cast<char>(0xC0 | (code >> 6));
-            out += static_cast<char>(0x80 | (code & 0x3F));
-          } else {
-            out += static_cast<char>(0xE0 | (code >> 12));
-            out += static_cast<char>(0x80 | ((code >> 6) & 0x3F));
-            out += static_cast<char>(0x80 | (code & 0x3F));
-          }
-          break;
-        }
-        default: fail("bad escape");
-      }
-    }
-  }
-
-  std::string text_, path_;
-  size_t pos_ = 0;
-};
-
-std::string read_text(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw IoError(path.string() + ": cannot open");
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
 
 std::string shell_quote(const std::string& s) {
   std::string q = "'";
@@ -235,7 +80,7 @@ int run_eval(const EvalArgs& args) {
   const fs::path dir(args.dir);
   if (!fs::is_directory(dir)) throw IoError(args.dir + ": not a directory (expected an output of `shapematch match`)");
   const fs::path report_path = dir / "report.json";
-  const JsonNode report = JsonParser(read_text(report_path), report_path.string()).parse();
+  const JsonNode report = read_json_file(report_path.string());
   auto field = [&](const std::string& side, const std::string& key, JsonNode::Kind kind) -> const JsonNode& {
     const JsonNode* s = report.get(side);
     const JsonNode* v = s ? s->get(key) : nullptr;

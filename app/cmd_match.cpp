@@ -173,8 +173,9 @@ int run_match(const MatchArgs& args) {
           .set("vertices", mesh.num_vertices())
           .set("faces", mesh.num_faces());
     };
-    report.set("x", shape(p.x_file, p.x_input_vertices, x));
-    report.set("y", shape(p.y_file, p.y_input_vertices, y));
+    // Absolute, so that `shapematch eval DIR` finds the inputs from any working directory.
+    report.set("x", shape(fs::absolute(p.x_file).lexically_normal().string(), p.x_input_vertices, x));
+    report.set("y", shape(fs::absolute(p.y_file).lexically_normal().string(), p.y_input_vertices, y));
     report.set("variables", m.lp.cols()).set("constraints", m.lp.rows()).set("nonzeros", m.lp.nonzeros());
     report.set("backend", ro.solver).set("device", rr.first_lp.device);
     report.set("energy", rr.energy).set("lower_bound", rr.lower_bound).set("gap", rr.gap);

@@ -25,7 +25,7 @@ void add_pair_options(CLI::App& app, PairArgs& args) {
                  "extra cost per unit area of every degenerate product triangle")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
-  app.add_option("--membrane", args.membrane, "membrane energy: svk (the paper) or compressive")
+  app.add_option("--membrane", args.membrane, "membrane energy: compressive (default) or svk (the paper's St. Venant–Kirchhoff)")
       ->check(CLI::IsMember({"svk", "compressive"}))
       ->capture_default_str();
   app.add_option("--features-x", args.features_x, "per-vertex descriptors of X (text rows or .npy)");

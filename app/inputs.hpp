@@ -20,7 +20,7 @@ struct PairArgs {
   std::string wks = "auto";  // on, off, auto (on unless user features are given)
   double feature_weight = 0.0;
   double degenerate_penalty = 0.0;
-  std::string membrane = "svk";
+  std::string membrane = "compressive";
   int wks_eigenpairs = 100;
 };
 

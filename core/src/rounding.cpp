@@ -276,7 +276,12 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
     result.first_lp = solver->solve(lp, options.lp);
   }
   result.lower_bound = result.first_lp.lower_bound;
-  result.gap = (result.energy - result.lower_bound) / std::max(std::abs(result.lower_bound), 1e-300);
+  // An energy that meets its bound to rounding error has no gap, also when both are ~0 (the
+  // identity of a shape with itself), where the relative formula would read 100 %.
+  const double slack = result.energy - result.lower_bound;
+  result.gap = slack <= 1e-9 * std::max(1.0, std::abs(result.energy))
+                   ? 0.0
+                   : slack / std::max(std::abs(result.lower_bound), 1e-300);
   return result;
 }
 

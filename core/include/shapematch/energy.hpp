@@ -12,7 +12,7 @@ namespace shapematch {
 enum class MembraneModel { StVenantKirchhoff, Compressive };
 
 struct EnergyOptions {
-  MembraneModel membrane = MembraneModel::StVenantKirchhoff;
+  MembraneModel membrane = MembraneModel::Compressive;  // measured: docs/architecture.md
   double lame_lambda = 1.0;   // Lamé λ of the membrane (St. Venant–Kirchhoff)
   double lame_mu = 1.0;       // Lamé μ
   double bending_weight = 1.0;
