@@ -39,7 +39,7 @@ int main(int argc, char** argv) {
   add(app::add_lp_command, "lp", "build the single-level matching LP and solve its relaxation");
   add(app::add_devices_command, "devices", "list Vulkan compute devices");
   add(app::add_generate_assets_command, "generate-assets", "regenerate the bundled demo meshes");
-  add(app::add_bench_command, "bench", "benchmark the LP solvers (Fig. 4) and the memory bandwidth");
+  add(app::add_bench_command, "bench", "benchmarks: LP solvers (Fig. 4), memory bandwidth, match scaling and pair tables");
   add(app::add_eval_command, "eval", "evaluate a match output against ground truth: geodesic error, PCK, flips");
 
   try {
