@@ -51,6 +51,8 @@ MeshPair load_pair(const PairArgs& args) {
     throw InvalidInputError("give both --features-x and --features-y, or neither");
   const bool user = !args.features_x.empty();
   if (user && args.wks == "on") throw InvalidInputError("--wks on and --features-x/y exclude each other");
+  if (args.feature_weight == 0 && (user || args.wks == "on"))
+    spdlog::warn("features given but --feature-weight is 0: the feature term is off");
   Stopwatch clock;
   if (args.feature_weight > 0 && user) {
     p.features_x = load_features(args.features_x, p.x.num_vertices());

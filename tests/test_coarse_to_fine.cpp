@@ -103,6 +103,28 @@ TEST_CASE("coarse to fine: a deformed pair with different triangulations ends ve
   }
 }
 
+TEST_CASE("coarse to fine: shapes of different sizes share the level count and end at their inputs") {
+  const Mesh small = lumpy_sphere(0, 7), large = lumpy_sphere(1, 8);  // 20 and 80 faces
+  CoarseToFineOptions o;
+  o.hierarchy.coarsest_faces = 20;
+  o.rounding.solver = "pdhg-cpu";
+  for (const bool swap : {false, true}) {
+    CAPTURE(swap);
+    const CoarseToFineMatcher matcher(swap ? large : small, swap ? small : large, o);
+    REQUIRE(matcher.x_levels().size() == 2);
+    REQUIRE(matcher.y_levels().size() == 2);
+    CHECK(matcher.x_levels().levels.back().mesh.num_faces() == (swap ? 80 : 20));
+    CHECK(matcher.y_levels().levels.back().mesh.num_faces() == (swap ? 20 : 80));
+    const CoarseToFineResult r = matcher.run();
+    CHECK(&r.finest.space.x() == &matcher.x_levels().levels.back().mesh);
+    CHECK(&r.finest.space.y() == &matcher.y_levels().levels.back().mesh);
+    const GraphSurfaceCheck c = check_graph_surface(r.finest.space, r.rounding.gamma);
+    CHECK(c.covers_x);
+    CHECK(c.covers_y);
+    CHECK(c.orientation);
+  }
+}
+
 TEST_CASE("coarse to fine: features must have one row per input vertex") {
   const Mesh m = lumpy_sphere(1, 6);
   CoarseToFineMatcher matcher(m, m, {});

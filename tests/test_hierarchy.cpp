@@ -29,6 +29,7 @@ TEST_CASE("hierarchy: face counts are geometric from the coarsest level to the i
   CHECK(level_face_counts(200, o) == std::vector<int>{200});
   o.levels = 2;
   CHECK(level_face_counts(1000, o) == std::vector<int>{250, 1000});
+  CHECK(level_face_counts(100, o) == std::vector<int>{100, 100});  // padded: a pair shares a level count
   o.coarsest_faces = 2;
   CHECK_THROWS_AS(level_face_counts(1000, o), InvalidInputError);
 }

@@ -110,20 +110,14 @@ CoarseToFineMatcher::CoarseToFineMatcher(const Mesh& x, const Mesh& y, CoarseToF
     : options_(std::move(options)) {
   if (options_.ring < 0 || options_.max_ring < options_.ring)
     throw InvalidInputError("coarse to fine: need 0 ≤ --ring ≤ max ring");
-  // Both shapes get the same number of levels, each its own face counts.
+  // Both shapes get the same number of levels (the larger shape's count), each its own face counts.
   HierarchyOptions ho = options_.hierarchy;
-  if (ho.levels == 0) {
-    ho.levels = std::max(level_face_counts(x.num_faces(), ho).size(), level_face_counts(y.num_faces(), ho).size());
-  }
+  if (ho.levels == 0)
+    ho.levels = static_cast<int>(
+        std::max(level_face_counts(x.num_faces(), ho).size(), level_face_counts(y.num_faces(), ho).size()));
   hx_ = build_hierarchy(x, level_face_counts(x.num_faces(), ho));
   hy_ = build_hierarchy(y, level_face_counts(y.num_faces(), ho));
-  if (hx_.size() != hy_.size()) {  // one shape is already at or below the coarsest size
-    const int n = std::max(hx_.size(), hy_.size());
-    ho.levels = n;
-    ho.coarsest_faces = std::min({ho.coarsest_faces, x.num_faces(), y.num_faces()});
-    hx_ = build_hierarchy(x, level_face_counts(x.num_faces(), ho));
-    hy_ = build_hierarchy(y, level_face_counts(y.num_faces(), ho));
-  }
+  if (hx_.size() != hy_.size()) throw Error("coarse to fine: the hierarchies differ in length (a bug)");
   if (options_.matching.features_x.size() > 0 || options_.matching.features_y.size() > 0)
     set_features(std::move(options_.matching.features_x), std::move(options_.matching.features_y));
 }

@@ -22,7 +22,10 @@ std::vector<int> level_face_counts(int input_faces, const HierarchyOptions& o) {
     levels = 1 + static_cast<int>(std::ceil(std::log(double(input_faces) / coarsest) / std::log(o.ratio) - 1e-9));
     levels = std::max(levels, 1);
   }
-  if (levels == 1 || coarsest == input_faces) return {input_faces};
+  if (levels == 1) return {input_faces};
+  // A shape already at the coarsest size repeats itself, so both shapes of a pair can share a
+  // level count (decimating to its own size returns the mesh unchanged).
+  if (coarsest == input_faces) return std::vector<int>(levels, input_faces);
   std::vector<int> counts(levels);
   for (int l = 0; l < levels; ++l)
     counts[l] = static_cast<int>(std::lround(coarsest * std::pow(double(input_faces) / coarsest, double(l) / (levels - 1))));

@@ -155,7 +155,7 @@ std::vector<std::pair<int64_t, int>> shrink_and_fix(Fixer& fixer, std::vector<st
     } else if (batch.front().second == 1) {
       batch.front().second = 0;
     } else {
-      throw SolverError("rounding: no consistent fixing exists (the LP is infeasible)");
+      throw InfeasibleError("rounding: no consistent fixing exists (no binary solution)");
     }
   }
   return batch;
@@ -226,7 +226,7 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
       auto smaller = last->batch;
       if (smaller.size() > 1) smaller.resize(smaller.size() / 2);
       else if (smaller.front().second == 1) smaller.front().second = 0;  // the single variable cannot be 1
-      else throw SolverError("rounding: no consistent fixing exists (the LP is infeasible)");
+      else throw InfeasibleError("rounding: no consistent fixing exists (no binary solution)");
       smaller = shrink_and_fix(fixer, smaller, last->before);
       info.fixed_to_one = fixer.state().ones - last->before.ones;
       info.fixed_to_zero = fixer.state().zeros - last->before.zeros;
