@@ -1,4 +1,6 @@
 // End-to-end tests of the `shapematch` executable: exit codes, one-line errors, JSON output.
+#include "test_helpers.hpp"
+
 #include <doctest/doctest.h>
 
 #include <algorithm>
@@ -15,33 +17,9 @@ namespace fs = std::filesystem;
 
 namespace {
 
-struct Run {
-  int code = -1;
-  std::string out;  // stdout
-  std::string err;  // stderr
-};
-
-Run run(const std::string& args) {
-  const fs::path err = fs::temp_directory_path() / "shapematch_cli_stderr.txt";
-  const std::string cmd = std::string(SHAPEMATCH_CLI) + " " + args + " 2>" + err.string();
-  Run r;
-  FILE* p = popen(cmd.c_str(), "r");
-  REQUIRE(p != nullptr);
-  std::array<char, 4096> buf{};
-  size_t k;
-  while ((k = fread(buf.data(), 1, buf.size(), p)) > 0) r.out.append(buf.data(), k);
-  const int status = pclose(p);
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  std::ifstream f(err);
-  r.err.assign(std::istreambuf_iterator<char>(f), {});
-  return r;
-}
-
-double json_number(const std::string& json, const std::string& key) {
-  const auto at = json.find("\"" + key + "\": ");
-  REQUIRE(at != std::string::npos);
-  return std::stod(json.substr(at + key.size() + 4));
-}
+using Run = shapematch::test::CliRun;
+using shapematch::test::json_number;
+Run run(const std::string& args) { return shapematch::test::run_cli(args); }
 
 std::string json_string(const std::string& json, const std::string& key) {
   const auto at = json.find("\"" + key + "\": \"");

@@ -10,13 +10,7 @@
 using namespace shapematch;
 
 namespace {
-Mesh lumpy_sphere(int subdivisions, unsigned seed) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> u(-0.1, 0.1);
-  return test::deformed(shapes::icosphere(subdivisions), [&](const Eigen::Vector3d& p) {
-    return Eigen::Vector3d(1.3 * p.x() + u(rng), p.y() + u(rng), 0.8 * p.z() + u(rng));
-  });
-}
+Mesh lumpy_sphere(int subdivisions, unsigned seed) { return test::lumpy_sphere(subdivisions, seed, 0.1); }
 
 std::set<int64_t> full_indices(const ProductSpace& full, const std::vector<ProductTriangle>& list) {
   std::set<int64_t> s;

@@ -39,24 +39,7 @@ double max_relative_difference(const Eigen::MatrixXd& a, const Eigen::MatrixXd& 
   return (a - b).cwiseAbs().maxCoeff() / a.cwiseAbs().maxCoeff();
 }
 
-// A fresh directory under the system temp dir, removed with everything in it at scope exit.
-struct TempDir {
-  fs::path path;
-  TempDir() {
-    std::random_device rd;
-    path = fs::temp_directory_path() / ("shapematch-desc-" + std::to_string(rd()) + std::to_string(rd()));
-    fs::create_directories(path);
-  }
-  ~TempDir() {
-    std::error_code ignored;
-    fs::remove_all(path, ignored);
-  }
-  std::string file(const std::string& name, const std::string& content) const {
-    const std::string p = (path / name).string();
-    std::ofstream(p, std::ios::binary) << content;
-    return p;
-  }
-};
+using test::TempDir;
 
 // A .npy file encoded by hand: magic, version, little-endian header length, the dict padded with
 // spaces to a multiple of 64 bytes and ended by '\n', then the raw data.

@@ -71,32 +71,9 @@ std::string error_of(F&& f) {
   return "(no error)";
 }
 
-struct Run {
-  int code = -1;
-  std::string out, err;
-};
-
-Run run_cli(const std::string& args, const fs::path& dir) {
-  const fs::path err = dir / "stderr.txt";
-  const std::string cmd = std::string(SHAPEMATCH_CLI) + " " + args + " 2>" + err.string();
-  Run r;
-  FILE* p = popen(cmd.c_str(), "r");
-  REQUIRE(p != nullptr);
-  std::array<char, 4096> buf{};
-  size_t k;
-  while ((k = fread(buf.data(), 1, buf.size(), p)) > 0) r.out.append(buf.data(), k);
-  const int status = pclose(p);
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  std::ifstream f(err);
-  r.err.assign(std::istreambuf_iterator<char>(f), {});
-  return r;
-}
-
-double json_number(const std::string& json, const std::string& key) {
-  const auto at = json.find("\"" + key + "\": ");
-  REQUIRE_MESSAGE(at != std::string::npos, key << " missing in " << json);
-  return std::stod(json.substr(at + key.size() + 4));
-}
+using Run = test::CliRun;
+using test::json_number;
+using test::run_cli;
 
 int count_lines(const fs::path& p) {
   std::ifstream in(p);

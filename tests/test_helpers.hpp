@@ -4,10 +4,18 @@
 
 #include "shapematch/device.hpp"
 #include "shapematch/errors.hpp"
+#include "shapematch/shapes.hpp"
 
 #include <Eigen/Geometry>
 #include <doctest/doctest.h>
+#include <array>
+#include <cstdio>
 #include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <sys/wait.h>
+#include <optional>
 #include <random>
 #include <string>
 
@@ -46,6 +54,74 @@ inline bool vulkan_wanted() {
          "/usr/share/vulkan/icd.d/lvp_icd.x86_64.json for lavapipe, or "
          "SHAPEMATCH_SKIP_VULKAN=1 to skip the Vulkan tests.");
   return true;
+}
+
+// A fresh directory under the system temp dir, removed with everything in it at scope exit.
+struct TempDir {
+  std::filesystem::path path;
+  TempDir() {
+    std::random_device rd;
+    path = std::filesystem::temp_directory_path() / ("shapematch-test-" + std::to_string(rd()) + std::to_string(rd()));
+    std::filesystem::create_directories(path);
+  }
+  ~TempDir() {
+    std::error_code ignored;
+    std::filesystem::remove_all(path, ignored);
+  }
+  TempDir(const TempDir&) = delete;
+  TempDir& operator=(const TempDir&) = delete;
+  std::string file(const std::string& name, const std::string& content) const {
+    const std::string p = (path / name).string();
+    std::ofstream(p, std::ios::binary) << content;
+    return p;
+  }
+  std::string read(const std::string& name) const {
+    std::ifstream in(path / name, std::ios::binary);
+    return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+  }
+  std::string operator/(const std::string& name) const { return (path / name).string(); }
+};
+
+struct CliRun {
+  int code = -1;
+  std::string out;  // stdout
+  std::string err;  // stderr
+};
+
+// Runs the built `shapematch` with `args`; stderr goes through a file in `dir` (a fresh
+// temporary directory when empty, so that tests running in parallel never share it).
+inline CliRun run_cli(const std::string& args, const std::filesystem::path& dir = {}) {
+  std::optional<TempDir> own;
+  if (dir.empty()) own.emplace();
+  const std::filesystem::path err = (dir.empty() ? own->path : dir) / "stderr.txt";
+  const std::string cmd = std::string(SHAPEMATCH_CLI) + " " + args + " 2>" + err.string();
+  CliRun r;
+  FILE* p = popen(cmd.c_str(), "r");
+  REQUIRE(p != nullptr);
+  std::array<char, 4096> buf{};
+  size_t k;
+  while ((k = fread(buf.data(), 1, buf.size(), p)) > 0) r.out.append(buf.data(), k);
+  const int status = pclose(p);
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  std::ifstream f(err);
+  r.err.assign(std::istreambuf_iterator<char>(f), {});
+  return r;
+}
+
+// The number after "key": in a JSON text (the CLI's flat outputs).
+inline double json_number(const std::string& json, const std::string& key) {
+  const auto at = json.find("\"" + key + "\": ");
+  REQUIRE_MESSAGE(at != std::string::npos, key << " missing in " << json);
+  return std::stod(json.substr(at + key.size() + 4));
+}
+
+// An ellipsoid with jittered vertices: no symmetries, so a self-match has one zero-energy answer.
+inline Mesh lumpy_sphere(int subdivisions, unsigned seed, double jitter = 0.1) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(-jitter, jitter);
+  return deformed(shapes::icosphere(subdivisions), [&](const Eigen::Vector3d& p) {
+    return Eigen::Vector3d(1.3 * p.x() + u(rng), p.y() + u(rng), 0.8 * p.z() + u(rng));
+  });
 }
 
 }  // namespace shapematch::test

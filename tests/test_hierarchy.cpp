@@ -9,13 +9,7 @@
 using namespace shapematch;
 
 namespace {
-Mesh lumpy_sphere(int subdivisions, unsigned seed) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<double> u(-0.08, 0.08);
-  return test::deformed(shapes::icosphere(subdivisions), [&](const Eigen::Vector3d& p) {
-    return Eigen::Vector3d(1.3 * p.x() + u(rng), p.y() + u(rng), 0.8 * p.z() + u(rng));
-  });
-}
+Mesh lumpy_sphere(int subdivisions, unsigned seed) { return test::lumpy_sphere(subdivisions, seed, 0.08); }
 }  // namespace
 
 TEST_CASE("hierarchy: face counts are geometric from the coarsest level to the input") {
