@@ -26,7 +26,8 @@ int run_lp(const LpArgs& args) {
   const Mesh& x = p.x;
   const Mesh& y = p.y;
   Stopwatch build_clock;
-  const MatchingLp m = build_matching_lp(x, p.gx, y, p.gy, matching_options(args.pair, p));
+  const Geometry gx = compute_geometry(x), gy = compute_geometry(y);
+  const MatchingLp m = build_matching_lp(x, gx, y, gy, matching_options(args.pair, p));
   const double build_seconds = build_clock.seconds();
   spdlog::info("LP: {} variables, {} constraints, {} nonzeros ({:.2f} s)", m.lp.cols(), m.lp.rows(),
                m.lp.nonzeros(), build_seconds);

@@ -80,8 +80,6 @@ MeshPair load_pair(const PairArgs& args) {
     p.features_x = select_rows(p.features_x, p.x_ids);
     p.features_y = select_rows(p.features_y, p.y_ids);
   }
-  p.gx = compute_geometry(p.x);
-  p.gy = compute_geometry(p.y);
   spdlog::info("X: {} ({} faces), Y: {} ({} faces)", p.x.name, p.x.num_faces(), p.y.name, p.y.num_faces());
   return p;
 }

@@ -29,7 +29,6 @@ void add_pair_options(CLI::App& app, PairArgs& args);
 
 struct MeshPair {
   Mesh x, y;
-  Geometry gx, gy;
   int x_input_vertices = 0, y_input_vertices = 0;
   std::vector<int> x_ids, y_ids;  // each vertex's index in its input file (decimation keeps a subset)
   Eigen::MatrixXd features_x, features_y;  // one row per vertex of x and y; empty without a feature term
@@ -38,7 +37,7 @@ struct MeshPair {
   std::string x_file, y_file;
 };
 
-// Loads (the bundled pair when none is given), validates, decimates and computes geometry.
+// Loads (the bundled pair when none is given), validates, decimates and computes features.
 MeshPair load_pair(const PairArgs& args);
 
 MatchingLpOptions matching_options(const PairArgs& args, const MeshPair& pair);

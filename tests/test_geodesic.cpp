@@ -2,6 +2,8 @@
 #include "shapematch/errors.hpp"
 #include "shapematch/shapes.hpp"
 
+#include "test_helpers.hpp"
+
 #include <doctest/doctest.h>
 
 #include <algorithm>
@@ -129,15 +131,7 @@ Mesh split_faces(const Mesh& m) {
   return make_mesh(v, f, m.name + " split");
 }
 
-// An icosphere with every vertex pushed in or out at random: curved, irregular, obtuse triangles.
-Mesh bumpy_sphere() {
-  Mesh m = shapes::icosphere(3);
-  std::mt19937 rng(7);
-  std::uniform_real_distribution<double> jitter(0.85, 1.15);
-  std::vector<Eigen::Vector3d> v;
-  for (const auto& p : m.vertices) v.push_back(p * jitter(rng));
-  return make_mesh(v, m.faces, "bumpy");
-}
+Mesh bumpy_sphere() { return test::bumpy_sphere(0.15); }
 
 }  // namespace
 

@@ -1,6 +1,8 @@
 #include "shapematch/geometry.hpp"
 #include "shapematch/shapes.hpp"
 
+#include "test_helpers.hpp"
+
 #include <doctest/doctest.h>
 
 #include <numeric>
@@ -10,15 +12,7 @@ using namespace shapematch;
 
 namespace {
 
-// An icosphere with every vertex pushed in or out at random: irregular, with obtuse triangles.
-Mesh bumpy_sphere() {
-  Mesh m = shapes::icosphere(3);
-  std::mt19937 rng(7);
-  std::uniform_real_distribution<double> jitter(0.8, 1.2);
-  std::vector<Eigen::Vector3d> v;
-  for (const auto& p : m.vertices) v.push_back(p * jitter(rng));
-  return make_mesh(v, m.faces, "bumpy");
-}
+Mesh bumpy_sphere() { return test::bumpy_sphere(0.2); }
 
 }  // namespace
 

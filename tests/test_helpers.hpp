@@ -115,6 +115,17 @@ inline double json_number(const std::string& json, const std::string& key) {
   return std::stod(json.substr(at + key.size() + 4));
 }
 
+// icosphere(3) with every vertex's radius scaled by a random factor in [1 − jitter, 1 + jitter]:
+// curved and irregular, with obtuse triangles.
+inline Mesh bumpy_sphere(double jitter) {
+  Mesh m = shapes::icosphere(3);
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> scale(1.0 - jitter, 1.0 + jitter);
+  std::vector<Eigen::Vector3d> v;
+  for (const auto& p : m.vertices) v.push_back(p * scale(rng));
+  return make_mesh(v, m.faces, "bumpy");
+}
+
 // An ellipsoid with jittered vertices: no symmetries, so a self-match has one zero-energy answer.
 inline Mesh lumpy_sphere(int subdivisions, unsigned seed, double jitter = 0.1) {
   std::mt19937 rng(seed);

@@ -1,5 +1,6 @@
 #include "shapematch/coarse_to_fine.hpp"
 
+#include "shapematch/descriptors.hpp"
 #include "shapematch/errors.hpp"
 #include "shapematch/system.hpp"
 
@@ -17,12 +18,6 @@ void sort_unique(std::vector<int>& v) {
   v.erase(std::unique(v.begin(), v.end()), v.end());
 }
 
-Eigen::MatrixXd rows_of(const Eigen::MatrixXd& m, const std::vector<int>& rows) {
-  if (m.size() == 0) return {};
-  Eigen::MatrixXd out(static_cast<Eigen::Index>(rows.size()), m.cols());
-  for (size_t i = 0; i < rows.size(); ++i) out.row(static_cast<Eigen::Index>(i)) = m.row(rows[i]);
-  return out;
-}
 
 }  // namespace
 
@@ -144,7 +139,7 @@ CoarseToFineResult CoarseToFineMatcher::run(const Progress& progress) const {
     rep.full_variables = ProductSpace::full_size(lx.mesh, ly.mesh);
 
     EnergyModel model(lx.mesh, lx.geometry, ly.mesh, ly.geometry, options_.matching.energy);
-    if (fx_.size() > 0) model.set_features(rows_of(fx_, lx.input_vertex), rows_of(fy_, ly.input_vertex));
+    if (fx_.size() > 0) model.set_features(select_rows(fx_, lx.input_vertex), select_rows(fy_, ly.input_vertex));
 
     for (int ring = options_.ring;; ++ring) {
       MatchingLp m;
