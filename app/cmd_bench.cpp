@@ -247,7 +247,7 @@ SolveRecord solve_isolated(const LpProblem& lp, const std::string& solver, const
 // bench lp
 
 struct BenchLpArgs {
-  std::vector<std::string> pair;  // X Y; default: the bundled pair
+  std::vector<std::string> pair;  // X Y; default: the bundled finger pair
   std::vector<int> faces{25, 50, 100, 200, 400};
   std::vector<std::string> solvers{"pdhg-cpu", "pdhg-vulkan", "clp-dual", "clp-barrier"};
   double tolerance = 1e-4;
@@ -351,7 +351,7 @@ std::string plot(const std::string& script_name, const std::string& csv_path, co
 }
 
 int run_bench_lp(BenchLpArgs args) {
-  if (args.pair.empty()) args.pair = {default_mesh_x(), default_mesh_y()};
+  if (args.pair.empty()) args.pair = default_bench_lp_pair();
   std::sort(args.faces.begin(), args.faces.end());  // "timed out, skip larger sizes" needs ascending sizes
   fs::create_directories(args.out);
   const std::string csv_path = (fs::path(args.out) / "bench_lp.csv").string();
@@ -800,7 +800,7 @@ Action add_bench_command(CLI::App& app) {
   app.require_subcommand(1);
   CLI::App* lp = app.add_subcommand("lp", "time every LP solver on the matching LP at growing sizes (CSV + plot)");
   auto args = std::make_shared<BenchLpArgs>();
-  lp->add_option("--pair", args->pair, "the two meshes X Y; default: bundled asset pair")->expected(2);
+  lp->add_option("--pair", args->pair, "the two meshes X Y; default: the bundled finger pair")->expected(2);
   lp->add_option("--faces", args->faces, "faces per shape of each size (decimated)")
       ->delimiter(',')
       ->check(CLI::PositiveNumber)

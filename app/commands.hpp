@@ -3,6 +3,7 @@
 #include <CLI/CLI.hpp>
 #include <functional>
 #include <string>
+#include <vector>
 
 namespace shapematch::app {
 
@@ -18,5 +19,8 @@ Action add_eval_command(CLI::App& app);
 // The bundled demo pair (assets/), used when a command is given no meshes.
 std::string default_mesh_x();
 std::string default_mesh_y();
+// `bench lp`'s default pair: the bundled finger, on which docs/benchmarks.md was measured, so
+// that its numbers stay comparable from run to run.
+std::vector<std::string> default_bench_lp_pair();
 
 }  // namespace shapematch::app

@@ -13,8 +13,12 @@
 
 namespace shapematch::app {
 
-std::string default_mesh_x() { return std::string(SHAPEMATCH_ASSETS_DIR) + "/finger_straight.off"; }
-std::string default_mesh_y() { return std::string(SHAPEMATCH_ASSETS_DIR) + "/finger_bent.off"; }
+std::string default_mesh_x() { return std::string(SHAPEMATCH_ASSETS_DIR) + "/dolphin_straight.off"; }
+std::string default_mesh_y() { return std::string(SHAPEMATCH_ASSETS_DIR) + "/dolphin_swimming.off"; }
+std::vector<std::string> default_bench_lp_pair() {
+  return {std::string(SHAPEMATCH_ASSETS_DIR) + "/finger_straight.off",
+          std::string(SHAPEMATCH_ASSETS_DIR) + "/finger_bent.off"};
+}
 
 }  // namespace shapematch::app
 

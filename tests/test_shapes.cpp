@@ -96,12 +96,76 @@ TEST_CASE("shapes: the bent finger keeps its connectivity and bends by the given
   CHECK_THROWS_AS(shapes::bent_finger(10, 1, 20), InvalidInputError);
 }
 
+TEST_CASE("shapes: the dolphin keeps its connectivity, bends by the given angles and has no symmetry") {
+  const int rings = 30, segments = 20;
+  const Mesh straight = shapes::dolphin(0, 0, rings, segments);
+  const Mesh swimming = shapes::dolphin(-40, 45, rings, segments);
+  CHECK(straight.faces == swimming.faces);
+  CHECK(straight.num_faces() == 2 * rings * segments);
+  CHECK(validate_mesh(straight) == 0);
+  CHECK(validate_mesh(swimming) == 0);
+  CHECK(signed_volume(straight) > 0);
+  CHECK(signed_volume(swimming) > 0);
+  CHECK(surface_area(swimming) == doctest::Approx(surface_area(straight)).epsilon(0.03));
+  CHECK(signed_volume(swimming) == doctest::Approx(signed_volume(straight)).epsilon(0.03));
+
+  // The spine runs along (1, 0, -1) and turns in the vertical plane through it: rings 2-5 lie
+  // before the tail joint, 14-17 between the joints, 25-27 after the head joint. A ring's two
+  // side vertices (theta = 0 and pi) straddle the spine; the fin shifts its centroid.
+  auto spine = [&](const Mesh& m, int ring) {
+    return Eigen::Vector3d(
+        (m.vertices[1 + ring * segments] + m.vertices[1 + ring * segments + segments / 2]) / 2);
+  };
+  auto direction = [&](const Mesh& m, int from, int to) {
+    return Eigen::Vector3d(spine(m, to) - spine(m, from)).normalized();
+  };
+  auto degrees_up = [](const Eigen::Vector3d& a, const Eigen::Vector3d& b) {  // signed, + turns up
+    return std::atan2(b.y(), b.cwiseProduct(Eigen::Vector3d(1, 0, 1)).norm()) * 180 / M_PI -
+           std::atan2(a.y(), a.cwiseProduct(Eigen::Vector3d(1, 0, 1)).norm()) * 180 / M_PI;
+  };
+  for (const auto& [head, tail] : {std::pair{0.0, 0.0}, {-40.0, 45.0}, {30.0, -20.0}}) {
+    const Mesh m = shapes::dolphin(head, tail, rings, segments);
+    const Eigen::Vector3d t = direction(m, 2, 5), b = direction(m, 14, 17), h = direction(m, 25, 27);
+    CAPTURE(head);
+    CAPTURE(tail);
+    CHECK(degrees_up(t, b) == doctest::Approx(tail).scale(10.0).epsilon(0.02));
+    CHECK(degrees_up(b, h) == doctest::Approx(head).scale(10.0).epsilon(0.02));
+    CHECK(t.x() == doctest::Approx(-t.z()).epsilon(1e-6));  // the spine stays in the plane x = -z
+  }
+  const Eigen::Vector3d along = direction(straight, 2, 27);
+  CHECK(along.isApprox(Eigen::Vector3d(1, 0, -1).normalized(), 1e-6));
+
+  // The fin makes up differ from down; the body thickness makes the head differ from the tail;
+  // the flukes are wider than high (the body the other way), so no rotation about the spine fits.
+  double ymax = 0, ymin = 0;
+  for (const auto& p : straight.vertices) {
+    ymax = std::max(ymax, p.y());
+    ymin = std::min(ymin, p.y());
+  }
+  CHECK(ymax > -ymin + 0.1);
+  auto extent = [&](int ring, const Eigen::Vector3d& axis) {
+    double lo = 1e9, hi = -1e9;
+    for (int j = 0; j < segments; ++j) {
+      const double v = straight.vertices[1 + ring * segments + j].dot(axis);
+      lo = std::min(lo, v);
+      hi = std::max(hi, v);
+    }
+    return hi - lo;
+  };
+  const Eigen::Vector3d side = Eigen::Vector3d(1, 0, 1).normalized(), up = Eigen::Vector3d::UnitY();
+  CHECK(extent(24, up) > 2 * extent(4, up));
+  CHECK(extent(4, side) > 1.5 * extent(4, up));
+  CHECK(extent(20, up) > 1.2 * extent(20, side));
+  CHECK_THROWS_AS(shapes::dolphin(10, std::nan(""), rings, segments), InvalidInputError);
+}
+
 TEST_CASE("shapes: bundled assets are what the generator writes") {
   const fs::path committed = SHAPEMATCH_ASSETS_DIR;
   std::random_device rd;
   const fs::path fresh = fs::temp_directory_path() / ("shapematch-assets-" + std::to_string(rd()));
   shapes::write_bundled_assets(fresh.string());
-  for (const std::string name : {"finger_straight.off", "finger_bent.off"}) {
+  for (const std::string name :
+       {"dolphin_straight.off", "dolphin_swimming.off", "finger_straight.off", "finger_bent.off"}) {
     CAPTURE(name);
     const Mesh a = load_mesh((committed / name).string(), {.normalize_area = false});
     const Mesh b = load_mesh((fresh / name).string(), {.normalize_area = false});
@@ -119,5 +183,7 @@ TEST_CASE("shapes: bundled assets are what the generator writes") {
   }
   CHECK(load_mesh((committed / "finger_straight.off").string()).faces ==
         load_mesh((committed / "finger_bent.off").string()).faces);
+  CHECK(load_mesh((committed / "dolphin_straight.off").string()).faces ==
+        load_mesh((committed / "dolphin_swimming.off").string()).faces);
   fs::remove_all(fresh);
 }

@@ -155,8 +155,9 @@ CoarseToFineResult CoarseToFineMatcher::run(const Progress& progress) const {
       }
       rep.variables = m.lp.cols();
       rep.constraints = m.lp.rows();
-      spdlog::info("level {}/{}: {} × {} faces, {} variables ({:.2g} % of the full space){}", l + 1, hx_.size(),
-                   rep.faces_x, rep.faces_y, rep.variables, 100.0 * double(rep.variables) / double(rep.full_variables),
+      const double kept = 100.0 * double(rep.variables) / double(rep.full_variables);
+      spdlog::info("level {}/{}: {} × {} faces, {} variables ({}){}", l + 1, hx_.size(), rep.faces_x, rep.faces_y,
+                   rep.variables, l > 0 ? fmt::format("{:.3g} % of the full space", kept) : "the full space",
                    l > 0 ? fmt::format(", ring {}", ring) : std::string());
       try {
         RoundingResult rr = round_to_graph_surface(m.space, m.lp, m.energy, options_.rounding,

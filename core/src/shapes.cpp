@@ -85,6 +85,41 @@ Mesh torus(int n_major, int n_minor, double major_radius, double minor_radius) {
   return make_mesh(std::move(vertices), std::move(faces), fmt::format("torus({}, {})", n_major, n_minor));
 }
 
+namespace {
+
+// Faces of a closed tube: a pole vertex 0, `rings` rings of `segments` vertices, a pole last.
+// theta grows counter-clockwise around the axis and rings grow along it: (a, b, c), (a, c, d)
+// face out.
+std::vector<std::array<int, 3>> tube_faces(int rings, int segments) {
+  const int top = rings * segments + 1;
+  auto ring = [&](int i, int j) { return 1 + i * segments + j % segments; };
+  std::vector<std::array<int, 3>> faces;
+  faces.reserve(2 * rings * segments);
+  for (int j = 0; j < segments; ++j) {
+    faces.push_back({0, ring(0, j + 1), ring(0, j)});
+    for (int i = 0; i + 1 < rings; ++i) {
+      const int a = ring(i, j), b = ring(i, j + 1), c = ring(i + 1, j + 1), d = ring(i + 1, j);
+      faces.push_back({a, b, c});
+      faces.push_back({a, c, d});
+    }
+    faces.push_back({top, ring(rings - 1, j), ring(rings - 1, j + 1)});
+  }
+  return faces;
+}
+
+// Ring i of `rings` on a capsule (hemispherical caps of `radius`, a cylinder between): its
+// position s along the axis and distance r from it. Rings are equally spaced in arc length
+// along the meridian, so caps and cylinder get triangles of the same size.
+std::pair<double, double> capsule_ring(int i, int rings, double radius, double cylinder) {
+  const double cap = M_PI * radius / 2.0, profile = 2.0 * cap + cylinder, length = cylinder + 2 * radius;
+  const double t = profile * (i + 1) / (rings + 1);
+  if (t < cap) return {radius * (1 - std::cos(t / radius)), radius * std::sin(t / radius)};
+  if (t <= cap + cylinder) return {radius + (t - cap), radius};
+  return {length - radius * (1 - std::cos((profile - t) / radius)), radius * std::sin((profile - t) / radius)};
+}
+
+}  // namespace
+
 Mesh bent_finger(double bend_degrees, int rings, int segments) {
   if (rings < 2 || segments < 3 || !std::isfinite(bend_degrees))
     throw InvalidInputError(fmt::format("bent_finger: need rings >= 2, segments >= 3 and a finite angle, "
@@ -94,8 +129,6 @@ Mesh bent_finger(double bend_degrees, int rings, int segments) {
   constexpr double radius = 0.5, cylinder = 3.0, length = cylinder + 2 * radius;
   constexpr double joint = length / 2, joint_width = 1.5;
   const double bend = bend_degrees * M_PI / 180.0;
-  const double cap = M_PI * radius / 2.0;           // meridian arc length of one hemisphere
-  const double profile = 2.0 * cap + cylinder;      // meridian arc length pole to pole
   const double joint_begin = joint - joint_width / 2, joint_end = joint + joint_width / 2;
 
   // Tangent angle of the axis: 0 before the joint, `bend` after it, a C2 smootherstep between.
@@ -132,38 +165,72 @@ Mesh bent_finger(double bend_degrees, int rings, int segments) {
   vertices.reserve(rings * segments + 2);
   vertices.push_back(point(0, 0, 0));
   for (int i = 0; i < rings; ++i) {
-    // Rings equally spaced in arc length along the meridian, so caps and cylinder match.
-    const double t = profile * (i + 1) / (rings + 1);
-    double s, r;
-    if (t < cap) {
-      s = radius * (1 - std::cos(t / radius));
-      r = radius * std::sin(t / radius);
-    } else if (t <= cap + cylinder) {
-      s = radius + (t - cap);
-      r = radius;
-    } else {
-      s = length - radius * (1 - std::cos((profile - t) / radius));
-      r = radius * std::sin((profile - t) / radius);
-    }
+    const auto [s, r] = capsule_ring(i, rings, radius, cylinder);
     for (int j = 0; j < segments; ++j) vertices.push_back(point(s, r, 2 * M_PI * j / segments));
   }
   vertices.push_back(point(length, 0, 0));
 
-  // theta grows counter-clockwise around +z and rings grow along +z: (a, b, c), (a, c, d) face out.
-  const int top = rings * segments + 1;
-  auto ring = [&](int i, int j) { return 1 + i * segments + j % segments; };
-  std::vector<std::array<int, 3>> faces;
-  faces.reserve(2 * rings * segments);
-  for (int j = 0; j < segments; ++j) {
-    faces.push_back({0, ring(0, j + 1), ring(0, j)});
-    for (int i = 0; i + 1 < rings; ++i) {
-      const int a = ring(i, j), b = ring(i, j + 1), c = ring(i + 1, j + 1), d = ring(i + 1, j);
-      faces.push_back({a, b, c});
-      faces.push_back({a, c, d});
-    }
-    faces.push_back({top, ring(rings - 1, j), ring(rings - 1, j + 1)});
+  return make_mesh(std::move(vertices), tube_faces(rings, segments), fmt::format("bent_finger({})", bend_degrees));
+}
+
+Mesh dolphin(double head_bend_degrees, double tail_bend_degrees, int rings, int segments) {
+  if (rings < 2 || segments < 3 || !std::isfinite(head_bend_degrees) || !std::isfinite(tail_bend_degrees))
+    throw InvalidInputError(fmt::format("dolphin: need rings >= 2, segments >= 3 and finite angles, got {}, {}, {}, {}",
+                                        rings, segments, head_bend_degrees, tail_bend_degrees));
+  // A capsule along +z from s = 0 (tail) to s = length (head), reshaped: the thickness profile
+  // breaks the end-to-end symmetry, the dorsal fin on +y and the flat tail (flukes in x) break
+  // every rotation about the spine. Only the mirror x -> -x remains, which reverses orientation,
+  // so a matching that keeps orientation has exactly one right answer.
+  constexpr double radius = 0.5, cylinder = 3.0, length = cylinder + 2 * radius;
+  constexpr double tail_joint = 1.3, head_joint = 2.9, joint_width = 1.0;
+  const double tail_bend = tail_bend_degrees * M_PI / 180.0, head_bend = head_bend_degrees * M_PI / 180.0;
+
+  auto smootherstep = [](double u) {
+    u = std::clamp(u, 0.0, 1.0);
+    return u * u * u * (u * (6 * u - 15) + 10);
+  };
+  // The spine turns up and down (in the y-z plane, as a dolphin swims) at two joints.
+  auto angle = [&](double s) {
+    return tail_bend * smootherstep((s - tail_joint) / joint_width + 0.5) +
+           head_bend * smootherstep((s - head_joint) / joint_width + 0.5);
+  };
+  auto tangent = [&](double s) { return Eigen::Vector3d(0, std::sin(angle(s)), std::cos(angle(s))); };
+  auto axis = [&](double s) {  // Simpson's rule for the integral of the tangent from the tail
+    constexpr int n = 256;
+    const double h = s / n;
+    Eigen::Vector3d sum = tangent(0) + tangent(s);
+    for (int k = 1; k < n; ++k) sum += (k % 2 ? 4.0 : 2.0) * tangent(k * h);
+    return Eigen::Vector3d(sum * (h / 3.0));
+  };
+  auto point = [&](double s, double r, double theta) {
+    // Thickest behind the head, thin at the tail; the tail is flattened into horizontal flukes.
+    const double body = 0.35 + 0.95 * std::exp(-(s - 2.8) * (s - 2.8) / (1.4 * 1.4));
+    const double tail = std::exp(-s * s / (0.7 * 0.7));
+    const double width = 0.75 * (1.0 + 1.5 * tail), height = 1.0 - 0.6 * tail;
+    const double around = std::remainder(theta - M_PI / 2, 2 * M_PI);  // 0 on the back (+y)
+    const double fin = 1.0 + 0.7 * std::exp(-(s - 2.0) * (s - 2.0) / (0.6 * 0.6)) *
+                                 std::exp(-around * around / (2 * 0.25 * 0.25));
+    const double d = r * body;
+    const double a = angle(s);
+    const Eigen::Vector3d up(0, std::cos(a), -std::sin(a));  // +y turned with the spine
+    return Eigen::Vector3d(axis(s) + d * width * std::cos(theta) * Eigen::Vector3d::UnitX() +
+                           d * height * fin * std::sin(theta) * up);
+  };
+
+  std::vector<Eigen::Vector3d> vertices;
+  vertices.reserve(rings * segments + 2);
+  vertices.push_back(point(0, 0, 0));
+  for (int i = 0; i < rings; ++i) {
+    const auto [s, r] = capsule_ring(i, rings, radius, cylinder);
+    for (int j = 0; j < segments; ++j) vertices.push_back(point(s, r, 2 * M_PI * j / segments));
   }
-  return make_mesh(std::move(vertices), std::move(faces), fmt::format("bent_finger({})", bend_degrees));
+  vertices.push_back(point(length, 0, 0));
+  // Turn the spine from +z to (1, 0, -1): the renderer's default camera, from (1, 0.5, 1), then
+  // sees the dolphin from its side and a little above.
+  const Eigen::Matrix3d turn = Eigen::AngleAxisd(0.75 * M_PI, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  for (auto& p : vertices) p = turn * p;
+  return make_mesh(std::move(vertices), tube_faces(rings, segments),
+                   fmt::format("dolphin({}, {})", head_bend_degrees, tail_bend_degrees));
 }
 
 void write_bundled_assets(const std::string& dir) {
@@ -174,6 +241,8 @@ void write_bundled_assets(const std::string& dir) {
   // 30 rings x 20 segments: 1200 faces, nearly equilateral triangles on the cylinder.
   save_mesh(bent_finger(10.0, 30, 20), (fs::path(dir) / "finger_straight.off").string());
   save_mesh(bent_finger(70.0, 30, 20), (fs::path(dir) / "finger_bent.off").string());
+  save_mesh(dolphin(0.0, 5.0, 30, 20), (fs::path(dir) / "dolphin_straight.off").string());
+  save_mesh(dolphin(-40.0, 45.0, 30, 20), (fs::path(dir) / "dolphin_swimming.off").string());
 }
 
 }  // namespace shapematch::shapes

@@ -18,8 +18,16 @@ Mesh torus(int n_major, int n_minor, double major_radius = 1.0, double minor_rad
 // Large bends (beyond about 100 degrees) make the inside of the joint intersect itself.
 Mesh bent_finger(double bend_degrees, int rings = 24, int segments = 16);
 
-// Writes the bundled assets into `dir` (created if missing): finger_straight.off (10 degrees)
-// and finger_bent.off (70 degrees), 1200 faces each, sharing connectivity.
+// The bundled demo pair: a dolphin-like tube, thick behind the head and thin at a tail
+// flattened into horizontal flukes, with a dorsal fin on +y, its spine turned up or down by the
+// given angles at a head joint and a tail joint, then laid along (1, 0, -1). Only the
+// orientation-reversing mirror is a symmetry. Same connectivity for all angles (identity ground
+// truth); 2*rings*segments faces.
+Mesh dolphin(double head_bend_degrees, double tail_bend_degrees, int rings = 30, int segments = 20);
+
+// Writes the bundled assets into `dir` (created if missing): dolphin_straight.off and
+// dolphin_swimming.off (the demo pair), finger_straight.off (10 degrees) and finger_bent.off
+// (70 degrees); 1200 faces each, each pair sharing connectivity.
 void write_bundled_assets(const std::string& dir);
 
 }  // namespace shapematch::shapes
