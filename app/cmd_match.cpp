@@ -117,11 +117,12 @@ int run_match(const MatchArgs& args) {
                       (theorem.covers_x ? "yes" : "no") +
                       ", covers Y " + (theorem.covers_y ? "yes" : "no") + ", orientation " +
                       (theorem.orientation ? "yes" : "no") + "); nothing was written");
-  // The constraints of (13) admit solutions that are not continuous everywhere (measured on
-  // coarse pairs): report them rather than hide them.
+  // Continuity is checked, not assumed: report a failure rather than hide it.
   if (!theorem.continuous)
-    spdlog::warn("continuity: {} edges of X and {} edges of Y have images that are not one connected piece",
-                 theorem.discontinuous_edges_x, theorem.discontinuous_edges_y);
+    spdlog::warn("continuity: {} vertices and {} edges of X, {} vertices and {} edges of Y are related to "
+                 "disconnected sets of the other shape",
+                 theorem.discontinuous_vertices_x, theorem.discontinuous_edges_x, theorem.discontinuous_vertices_y,
+                 theorem.discontinuous_edges_y);
   const VertexMaps maps = vertex_maps(m.space, rr.gamma);
   seconds.set("verify", stage.seconds());
   spdlog::info("energy {:.6g}, lower bound {:.6g}, gap {:.2f} %, {} rounds, verified", rr.energy, rr.lower_bound,
@@ -189,6 +190,8 @@ int run_match(const MatchArgs& args) {
                                .set("covers_y", theorem.covers_y)
                                .set("orientation_preserved", theorem.orientation)
                                .set("continuous", theorem.continuous)
+                               .set("discontinuous_vertices_x", theorem.discontinuous_vertices_x)
+                               .set("discontinuous_vertices_y", theorem.discontinuous_vertices_y)
                                .set("discontinuous_edges_x", theorem.discontinuous_edges_x)
                                .set("discontinuous_edges_y", theorem.discontinuous_edges_y));
     report.set("graph_surface_triangles", static_cast<int64_t>(rr.gamma.size()));

@@ -142,6 +142,9 @@ TEST_CASE("cli: the bundled pair matches sensibly" * doctest::test_suite("slow")
   const std::string report((std::istreambuf_iterator<char>(f)), {});
   CHECK(report.find("\"verified\": true") != std::string::npos);
   CHECK(report.find("dolphin_straight.off") != std::string::npos);
+  // Theorem 1 on a solved pair with independent triangulations (decimated separately).
+  CHECK(report.find("\"orientation_preserved\": true") != std::string::npos);
+  CHECK(report.find("\"continuous\": true") != std::string::npos);
   r = run("eval " + out.string() + " --gt identity");
   REQUIRE_MESSAGE(r.code == 0, r.err);
   CHECK(json_number(r.out, "mean_geodesic_error") < 0.15);

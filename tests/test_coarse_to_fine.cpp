@@ -90,6 +90,7 @@ TEST_CASE("coarse to fine: a deformed pair with different triangulations ends ve
   CHECK(c.covers_x);
   CHECK(c.covers_y);
   CHECK(c.orientation);
+  CHECK(c.continuous);
   CHECK(satisfies_exactly(r.finest.lp, r.rounding.gamma));
   for (const auto& l : r.levels) {
     CHECK(l.lower_bound <= l.energy + 1e-9);
@@ -116,6 +117,7 @@ TEST_CASE("coarse to fine: shapes of different sizes share the level count and e
     CHECK(c.covers_x);
     CHECK(c.covers_y);
     CHECK(c.orientation);
+    CHECK(c.continuous);
   }
 }
 

@@ -296,80 +296,98 @@ GraphSurfaceCheck check_graph_surface(const ProductSpace& space, const std::vect
       if (t[0] == f[r] && t[1] == f[(r + 1) % 3] && t[2] == f[(r + 2) % 3]) return true;
     return false;
   };
-  // Images (as sets of vertices of the other shape) of every real face, and of every edge
-  // stretched over a patch (the product triangles degenerate on that side).
-  std::vector<std::array<int, 3>> image_x(X.num_faces()), image_y(Y.num_faces());
-  std::vector<std::vector<std::array<int, 3>>> stretched_x(X.num_edges()), stretched_y(Y.num_edges());
-  std::vector<std::vector<std::array<int, 3>>> collapsed_x(X.num_vertices()), collapsed_y(Y.num_vertices());
   for (int64_t j : gamma) {
     const ProductTriangle t = space[j];
     if (t.fa >= 0) {
       ++cover_x[t.fa];
       orientation = orientation && is_rotation(t.a, X.faces[t.fa]);
-      image_x[t.fa] = t.b;
-    } else if (t.a[0] != t.a[1]) {
-      stretched_x[X.edge_index(t.a[0], t.a[1])].push_back(t.b);
-    } else {
-      collapsed_x[t.a[0]].push_back(t.b);
     }
     if (t.fb >= 0) {
       ++cover_y[t.fb];
       orientation = orientation && is_rotation(t.b, Y.faces[t.fb]);
-      image_y[t.fb] = t.a;
-    } else if (t.b[0] != t.b[1]) {
-      stretched_y[Y.edge_index(t.b[0], t.b[1])].push_back(t.a);
-    } else {
-      collapsed_y[t.b[0]].push_back(t.a);
     }
   }
   check.covers_x = std::all_of(cover_x.begin(), cover_x.end(), [](int c) { return c == 1; });
   check.covers_y = std::all_of(cover_y.begin(), cover_y.end(), [](int c) { return c == 1; });
   check.orientation = orientation;
-  // Continuity (Theorem 1 b, c): for two faces sharing an edge e, their images, the patch Γ(e)
-  // that e is stretched over and the patches its end points are blown up to form one connected
-  // piece of the other shape (consecutive pieces share a vertex).
-  auto continuous = [](const Mesh& mesh, const std::vector<std::array<int, 3>>& image,
-                       const std::vector<std::vector<std::array<int, 3>>>& stretched,
-                       const std::vector<std::vector<std::array<int, 3>>>& collapsed) {
-    int64_t broken = 0;
-    std::vector<std::array<int, 2>> edge_faces(mesh.num_edges(), {-1, -1});
-    for (int f = 0; f < mesh.num_faces(); ++f)
-      for (int i = 0; i < 3; ++i) {
-        auto& ef = edge_faces[mesh.edge_index(mesh.faces[f][i], mesh.faces[f][(i + 1) % 3])];
-        ef[ef[0] < 0 ? 0 : 1] = f;
-      }
-    for (int e = 0; e < mesh.num_edges(); ++e) {
-      std::vector<std::array<int, 3>> pieces = stretched[e];
-      for (int v : mesh.edges[e]) pieces.insert(pieces.end(), collapsed[v].begin(), collapsed[v].end());
-      pieces.push_back(image[edge_faces[e][0]]);
-      pieces.push_back(image[edge_faces[e][1]]);
-      std::vector<bool> reached(pieces.size(), false);
-      std::vector<size_t> stack{pieces.size() - 1};
-      reached.back() = true;
-      size_t count = 1;
-      while (!stack.empty()) {
-        const auto& p = pieces[stack.back()];
-        stack.pop_back();
-        for (size_t q = 0; q < pieces.size(); ++q) {
-          if (reached[q]) continue;
-          const bool touch = std::any_of(p.begin(), p.end(), [&](int v) {
-            return std::find(pieces[q].begin(), pieces[q].end(), v) != pieces[q].end();
-          });
-          if (touch) {
-            reached[q] = true;
-            ++count;
-            stack.push_back(q);
-          }
+
+  // Continuity (Theorem 1 b, c), read as: Γ relates every point of one shape to a connected
+  // set of the other. For a vertex v that set, its fibre, is the union of the simplices of the
+  // other shape paired with v in the product triangles through v (a vertex in a real triangle,
+  // an edge or a whole face where v is blown up); for an edge e, the simplices paired with its
+  // interior together with both end points' fibres. Pieces are vertex sets, connected when they
+  // share a vertex. An edge's two faces then map to touching patches. (Requiring the pieces of
+  // one edge to connect without the rest of its end points' fibres is too strict: a blown-up
+  // vertex can attach to the rest through a neighbouring edge.)
+  using Piece = std::vector<int>;
+  struct Side {
+    std::vector<std::vector<Piece>> vertex_fibre, edge_interior;
+  };
+  Side sx{std::vector<std::vector<Piece>>(X.num_vertices()), std::vector<std::vector<Piece>>(X.num_edges())};
+  Side sy{std::vector<std::vector<Piece>>(Y.num_vertices()), std::vector<std::vector<Piece>>(Y.num_edges())};
+  auto add = [](const Mesh& mesh, Side& side, const std::array<int, 3>& a, const std::array<int, 3>& b) {
+    for (int i = 0; i < 3; ++i) {
+      if ((i > 0 && a[0] == a[i]) || (i > 1 && a[1] == a[i])) continue;  // each distinct vertex once
+      Piece fibre;
+      for (int k = 0; k < 3; ++k)
+        if (a[k] == a[i]) fibre.push_back(b[k]);
+      side.vertex_fibre[a[i]].push_back(std::move(fibre));
+    }
+    for (int i = 0; i < 3; ++i) {
+      const int u = a[i], w = a[(i + 1) % 3];
+      if (u == w) continue;
+      // A real triangle pairs its edge u-w with b's edge (or vertex) at the same positions; a
+      // triangle degenerate onto u-w pairs the edge's interior with all of b.
+      const bool stretched = a[(i + 2) % 3] == u || a[(i + 2) % 3] == w;
+      side.edge_interior[mesh.edge_index(u, w)].push_back(stretched ? Piece(b.begin(), b.end())
+                                                                    : Piece{b[i], b[(i + 1) % 3]});
+      if (stretched) break;  // its other "edge" is the same edge reversed
+    }
+  };
+  for (int64_t j : gamma) {
+    const ProductTriangle t = space[j];
+    add(X, sx, t.a, t.b);
+    add(Y, sy, t.b, t.a);
+  }
+  auto connected = [](const std::vector<const std::vector<Piece>*>& groups) {
+    std::vector<const Piece*> pieces;
+    for (const auto* g : groups)
+      for (const Piece& p : *g) pieces.push_back(&p);
+    if (pieces.size() <= 1) return true;
+    std::vector<bool> reached(pieces.size(), false);
+    std::vector<size_t> stack{0};
+    reached[0] = true;
+    size_t count = 1;
+    while (!stack.empty()) {
+      const Piece& p = *pieces[stack.back()];
+      stack.pop_back();
+      for (size_t q = 0; q < pieces.size(); ++q) {
+        if (reached[q]) continue;
+        const bool touch = std::any_of(p.begin(), p.end(), [&](int v) {
+          return std::find(pieces[q]->begin(), pieces[q]->end(), v) != pieces[q]->end();
+        });
+        if (touch) {
+          reached[q] = true;
+          ++count;
+          stack.push_back(q);
         }
       }
-      broken += count != pieces.size();
     }
-    return broken;
+    return count == pieces.size();
+  };
+  auto broken = [&](const Mesh& mesh, const Side& side, int64_t& vertices, int64_t& edges) {
+    vertices = edges = 0;
+    for (int v = 0; v < mesh.num_vertices(); ++v) vertices += !connected({&side.vertex_fibre[v]});
+    for (int e = 0; e < mesh.num_edges(); ++e) {
+      const auto [u, w] = mesh.edges[e];
+      edges += !connected({&side.edge_interior[e], &side.vertex_fibre[u], &side.vertex_fibre[w]});
+    }
   };
   if (check.covers_x && check.covers_y) {
-    check.discontinuous_edges_x = continuous(X, image_x, stretched_x, collapsed_x);
-    check.discontinuous_edges_y = continuous(Y, image_y, stretched_y, collapsed_y);
-    check.continuous = check.discontinuous_edges_x == 0 && check.discontinuous_edges_y == 0;
+    broken(X, sx, check.discontinuous_vertices_x, check.discontinuous_edges_x);
+    broken(Y, sy, check.discontinuous_vertices_y, check.discontinuous_edges_y);
+    check.continuous = check.discontinuous_vertices_x == 0 && check.discontinuous_edges_x == 0 &&
+                       check.discontinuous_vertices_y == 0 && check.discontinuous_edges_y == 0;
   }
   return check;
 }

@@ -49,10 +49,12 @@ bool satisfies_exactly(const LpProblem& lp, const std::vector<int64_t>& gamma);
 struct GraphSurfaceCheck {
   bool covers_x = false, covers_y = false;      // every face of X (Y) in exactly one product triangle
   bool orientation = false;                     // every real face mapped with its own cyclic order
-  bool continuous = false;                      // no discontinuous edge on either side
-  int64_t discontinuous_edges_x = -1;           // edges of X whose two faces' images, the patch
-  int64_t discontinuous_edges_y = -1;           // the edge is stretched over and the patches of its
-                                                // end points are not one connected piece
+  // Every point related to a connected set of the other shape (see check_graph_surface):
+  bool continuous = false;                      // no discontinuous vertex or edge on either side
+  int64_t discontinuous_vertices_x = -1;        // vertices of X whose fibre in Y is disconnected
+  int64_t discontinuous_vertices_y = -1;
+  int64_t discontinuous_edges_x = -1;           // edges of X whose relation (interior and end
+  int64_t discontinuous_edges_y = -1;           // points) to Y is disconnected
   bool ok() const { return covers_x && covers_y && orientation && continuous; }
 };
 GraphSurfaceCheck check_graph_surface(const ProductSpace& space, const std::vector<int64_t>& gamma);
