@@ -33,6 +33,7 @@ struct MatchArgs {
   int device = -1;
   HierarchyOptions hierarchy;
   int ring = 1, max_ring = 3;
+  std::string neighbourhood = "fine";
 };
 
 // auto: a GPU if there is one, else the native solver (lavapipe is for testing, not speed).
@@ -82,6 +83,7 @@ int run_match(const MatchArgs& args) {
   CoarseToFineOptions co;
   co.hierarchy = args.hierarchy;
   co.ring = args.ring;
+  co.neighbourhood = args.neighbourhood == "fine" ? Neighbourhood::Fine : Neighbourhood::Coarse;
   co.max_ring = std::max(args.max_ring, args.ring);
   co.matching = matching_options(args.pair, p);
   RoundingOptions& ro = co.rounding;
@@ -207,7 +209,8 @@ int run_match(const MatchArgs& args) {
                               .set("feature_weight", args.pair.feature_weight)
                               .set("levels", matcher.x_levels().size())
                               .set("coarsest_faces", args.hierarchy.coarsest_faces)
-                              .set("ring", args.ring));
+                              .set("ring", args.ring)
+                              .set("neighbourhood", args.neighbourhood));
     report.set("seconds", seconds);
     report.set("peak_rss_mb", peak_rss_mb());
     report.set("round_log", rounds);
@@ -265,6 +268,10 @@ Action add_match_command(CLI::App& app) {
       ->capture_default_str();
   app.add_option("--ring", a->ring, "neighbourhood rings of the reduced product space (eq. 17)")
       ->check(CLI::Range(0, 8))
+      ->capture_default_str();
+  app.add_option("--neighbourhood", a->neighbourhood,
+                 "where rings count: coarse (eq. 17 on the coarse level) or fine (on Y's fine level)")
+      ->check(CLI::IsMember({"coarse", "fine"}))
       ->capture_default_str();
   app.add_option("--max-ring", a->max_ring, "widen the ring up to this when a reduced LP is infeasible")
       ->check(CLI::Range(0, 8))

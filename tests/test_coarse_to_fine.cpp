@@ -1,5 +1,6 @@
 #include "shapematch/coarse_to_fine.hpp"
 #include "shapematch/errors.hpp"
+#include "shapematch/evaluation.hpp"
 #include "shapematch/shapes.hpp"
 #include "test_helpers.hpp"
 
@@ -54,6 +55,34 @@ TEST_CASE("coarse to fine: the fine identity survives the reduction of a coarse 
   }
 }
 
+TEST_CASE("coarse to fine: the fine neighbourhood is smaller than eq. (17)'s, grows with the ring, keeps the identity") {
+  const Mesh m = lumpy_sphere(3, 6);  // 1280 faces
+  const MeshHierarchy h = build_hierarchy(m, {80, 320, 1280});
+  for (int l = 1; l < h.size(); ++l) {
+    const MeshLevel& fine = h.levels[l];
+    const Mesh& coarse = h.levels[l - 1].mesh;
+    const ProductSpace full = ProductSpace::full(fine.mesh, fine.mesh);
+    const auto id = identity_matching(coarse);
+    CAPTURE(l);
+    // Ring 0 is eq. (17) at ring 0 in both.
+    CHECK(reduced_product_space(fine, fine, coarse, coarse, id, 0, Neighbourhood::Fine) ==
+          reduced_product_space(fine, fine, coarse, coarse, id, 0, Neighbourhood::Coarse));
+    std::set<int64_t> previous;
+    for (int ring : {0, 1, 2, 3}) {
+      CAPTURE(ring);
+      const auto list = reduced_product_space(fine, fine, coarse, coarse, id, ring, Neighbourhood::Fine);
+      const auto s = full_indices(full, list);
+      CHECK(s.size() == list.size());
+      CHECK(std::includes(s.begin(), s.end(), previous.begin(), previous.end()));
+      if (ring > 0) CHECK(s.size() > previous.size());
+      if (ring == 1)
+        CHECK(s.size() < reduced_product_space(fine, fine, coarse, coarse, id, 1, Neighbourhood::Coarse).size());
+      for (const auto& t : identity_matching(fine.mesh)) CHECK(s.count(full.index_in_full(t)) == 1);
+      previous = s;
+    }
+  }
+}
+
 TEST_CASE("coarse to fine: a shape against itself is matched to the identity at every level") {
   const Mesh m = lumpy_sphere(2, 5);
   CoarseToFineOptions o;
@@ -83,19 +112,37 @@ TEST_CASE("coarse to fine: a deformed pair with different triangulations ends ve
   o.hierarchy.coarsest_faces = 16;
   o.matching.energy.membrane = MembraneModel::Compressive;
   o.rounding.solver = "pdhg-cpu";
-  const CoarseToFineMatcher matcher(decimate(x, 50), decimate(y, 60), o);
-  const CoarseToFineResult r = matcher.run();
-  REQUIRE(r.levels.size() == 2);
-  const GraphSurfaceCheck c = check_graph_surface(r.finest.space, r.rounding.gamma);
-  CHECK(c.covers_x);
-  CHECK(c.covers_y);
-  CHECK(c.orientation);
-  CHECK(c.continuous);
-  CHECK(satisfies_exactly(r.finest.lp, r.rounding.gamma));
-  for (const auto& l : r.levels) {
-    CHECK(l.lower_bound <= l.energy + 1e-9);
-    CHECK(l.rounds >= 1);
+  int flips_untangled = 0, flips_first = 0;
+  for (const Neighbourhood n : {Neighbourhood::Coarse, Neighbourhood::Fine}) {
+    CAPTURE(static_cast<int>(n));
+    o.neighbourhood = n;
+    const CoarseToFineMatcher matcher(decimate(x, 50), decimate(y, 60), o);
+    const CoarseToFineResult r = matcher.run();
+    REQUIRE(r.levels.size() == 2);
+    const GraphSurfaceCheck c = check_graph_surface(r.finest.space, r.rounding.gamma);
+    CHECK(c.covers_x);
+    CHECK(c.covers_y);
+    CHECK(c.orientation);
+    CHECK(c.continuous);
+    CHECK(satisfies_exactly(r.finest.lp, r.rounding.gamma));
+    // Within each fibre, the vertex maps pick partners that invert fewer faces than the first
+    // partner found (measured: 1 inverted face left of 5 in the first pass, summed over both
+    // directions and both neighbourhoods).
+    const Mesh &fx = r.finest.space.x(), &fy = r.finest.space.y();
+    const VertexMaps maps = vertex_maps(r.finest.space, r.rounding.gamma);
+    const VertexMaps plain = vertex_maps(r.finest.space, r.rounding.gamma, false);
+    const int untangled = count_orientation_flips(fx, fy, maps.x_to_y).flips + count_orientation_flips(fy, fx, maps.y_to_x).flips;
+    const int first = count_orientation_flips(fx, fy, plain.x_to_y).flips + count_orientation_flips(fy, fx, plain.y_to_x).flips;
+    MESSAGE("inverted faces: ", untangled, " untangled, ", first, " first partners");
+    CHECK(untangled <= first);
+    flips_untangled += untangled;
+    flips_first += first;
+    for (const auto& l : r.levels) {
+      CHECK(l.lower_bound <= l.energy + 1e-9);
+      CHECK(l.rounds >= 1);
+    }
   }
+  CHECK(flips_untangled < flips_first);
 }
 
 TEST_CASE("coarse to fine: shapes of different sizes share the level count and end at their inputs") {

@@ -23,7 +23,8 @@ void sort_unique(std::vector<int>& v) {
 
 std::vector<ProductTriangle> reduced_product_space(const MeshLevel& fine_x, const MeshLevel& fine_y,
                                                    const Mesh& coarse_x, const Mesh& coarse_y,
-                                                   const std::vector<ProductTriangle>& coarse_gamma, int ring) {
+                                                   const std::vector<ProductTriangle>& coarse_gamma, int ring,
+                                                   Neighbourhood neighbourhood) {
   const Mesh& X = fine_x.mesh;
   const Mesh& Y = fine_y.mesh;
   if (fine_x.parent_face.size() != size_t(X.num_faces()) || fine_y.parent_face.size() != size_t(Y.num_faces()))
@@ -31,11 +32,15 @@ std::vector<ProductTriangle> reduced_product_space(const MeshLevel& fine_x, cons
 
   // S(c) for every coarse X face c: the coarse Y faces ψ(f_b) may take when χ(f_a) = c, i.e. the
   // union of N(f'_b) over the coarse product triangles with c ∈ N(f'_a). Exactly eq. (17).
+  // In the fine neighbourhood the coarse ring is 0 and the widening happens below on the fine
+  // level: ring 1 widens Y by one fine ring; ring k >= 2 also lets X faces at a parent's border
+  // take their neighbours' parents' allowances, and widens Y by k - 1 fine rings.
+  const int coarse_ring = neighbourhood == Neighbourhood::Coarse ? ring : 0;
   const auto vfx = vertex_face_table(coarse_x), vfy = vertex_face_table(coarse_y);
   std::vector<std::vector<int>> allowed(coarse_x.num_faces());
   for (const ProductTriangle& g : coarse_gamma) {
-    const std::vector<int> na = ring_faces(coarse_x, vfx, {g.a.begin(), g.a.end()}, ring);
-    const std::vector<int> nb = ring_faces(coarse_y, vfy, {g.b.begin(), g.b.end()}, ring);
+    const std::vector<int> na = ring_faces(coarse_x, vfx, {g.a.begin(), g.a.end()}, coarse_ring);
+    const std::vector<int> nb = ring_faces(coarse_y, vfy, {g.b.begin(), g.b.end()}, coarse_ring);
     for (int c : na) allowed[c].insert(allowed[c].end(), nb.begin(), nb.end());
   }
   for (auto& s : allowed) sort_unique(s);
@@ -45,9 +50,16 @@ std::vector<ProductTriangle> reduced_product_space(const MeshLevel& fine_x, cons
   for (int f = 0; f < Y.num_faces(); ++f) children_y[fine_y.parent_face[f]].push_back(f);
   std::vector<std::vector<int>> faces_y(coarse_x.num_faces()), verts_y(coarse_x.num_faces()),
       dedges_y(coarse_x.num_faces());
+  const auto vf_fine_y = vertex_face_table(Y);
+  std::vector<int> seed;
   for (int c = 0; c < coarse_x.num_faces(); ++c) {
     for (int d : allowed[c]) faces_y[c].insert(faces_y[c].end(), children_y[d].begin(), children_y[d].end());
     sort_unique(faces_y[c]);
+    if (neighbourhood == Neighbourhood::Fine && ring > 0 && !faces_y[c].empty()) {
+      seed.clear();
+      for (int f : faces_y[c]) seed.insert(seed.end(), Y.faces[f].begin(), Y.faces[f].end());
+      faces_y[c] = ring_faces(Y, vf_fine_y, seed, std::max(1, ring - 1));
+    }
     for (int f : faces_y[c])
       for (int i = 0; i < 3; ++i) {
         const int u = Y.faces[f][i], w = Y.faces[f][(i + 1) % 3];
@@ -59,26 +71,64 @@ std::vector<ProductTriangle> reduced_product_space(const MeshLevel& fine_x, cons
     sort_unique(dedges_y[c]);
   }
 
+  // Fine X faces next to their parent's border also take the allowances of the parents of their
+  // fine neighbours (fine neighbourhood only): the two parent maps are drawn independently, so a
+  // fine face near a coarse edge may belong, on Y, to the neighbouring coarse face's image.
+  const auto vf_fine = vertex_face_table(X);
+  std::vector<std::vector<int>> own_faces_y(X.num_faces());  // empty: the parent's sets
+  if (neighbourhood == Neighbourhood::Fine && ring > 1) {
+    std::vector<int> parents;
+    for (int fa = 0; fa < X.num_faces(); ++fa) {
+      parents.clear();
+      for (int f : ring_faces(X, vf_fine, {X.faces[fa].begin(), X.faces[fa].end()}, 1))
+        parents.push_back(fine_x.parent_face[f]);
+      sort_unique(parents);
+      if (parents.size() < 2) continue;
+      for (int c : parents) own_faces_y[fa].insert(own_faces_y[fa].end(), faces_y[c].begin(), faces_y[c].end());
+      sort_unique(own_faces_y[fa]);
+    }
+  }
+  auto candidates = [&](int fa) -> const std::vector<int>& {
+    return own_faces_y[fa].empty() ? faces_y[fine_x.parent_face[fa]] : own_faces_y[fa];
+  };
+
   std::vector<ProductTriangle> out;
+  std::vector<int> vs, ds;
   // Real faces of X: TT, TV, TE.
   for (int fa = 0; fa < X.num_faces(); ++fa) {
     const int c = fine_x.parent_face[fa];
+    const std::vector<int>* verts = &verts_y[c];
+    const std::vector<int>* dedges = &dedges_y[c];
+    if (!own_faces_y[fa].empty()) {
+      vs.clear();
+      ds.clear();
+      for (int f : own_faces_y[fa])
+        for (int i = 0; i < 3; ++i) {
+          const int u = Y.faces[f][i], w = Y.faces[f][(i + 1) % 3];
+          vs.push_back(u);
+          ds.push_back(Y.directed_edge_index(u, w));
+          ds.push_back(Y.directed_edge_index(w, u));
+        }
+      sort_unique(vs);
+      sort_unique(ds);
+      verts = &vs;
+      dedges = &ds;
+    }
     for (int r = 0; r < 3; ++r)
-      for (int fb : faces_y[c]) out.push_back({rotated(X.faces[fa], r), Y.faces[fb], fa, fb});
-    for (int w : verts_y[c]) out.push_back({X.faces[fa], {w, w, w}, fa, -1});
+      for (int fb : candidates(fa)) out.push_back({rotated(X.faces[fa], r), Y.faces[fb], fa, fb});
+    for (int w : *verts) out.push_back({X.faces[fa], {w, w, w}, fa, -1});
     for (int r = 0; r < 3; ++r)
-      for (int d : dedges_y[c]) {
+      for (int d : *dedges) {
         const auto e = Y.directed_edge(d);
         out.push_back({rotated(X.faces[fa], r), {e[0], e[1], e[1]}, fa, -1});
       }
   }
   // Degenerate elements of X inherit their incident faces' allowances: VT and ET.
-  const auto vf_fine = vertex_face_table(X);
   std::vector<int> ys;
   for (int v = 0; v < X.num_vertices(); ++v) {
     ys.clear();
     for (int f : vf_fine[v]) {
-      const auto& s = faces_y[fine_x.parent_face[f]];
+      const auto& s = candidates(f);
       ys.insert(ys.end(), s.begin(), s.end());
     }
     sort_unique(ys);
@@ -90,7 +140,7 @@ std::vector<ProductTriangle> reduced_product_space(const MeshLevel& fine_x, cons
     for (int f : vf_fine[u]) {
       const auto& t = X.faces[f];
       if (std::find(t.begin(), t.end(), w) == t.end()) continue;  // not one of the edge's two faces
-      const auto& s = faces_y[fine_x.parent_face[f]];
+      const auto& s = candidates(f);
       ys.insert(ys.end(), s.begin(), s.end());
     }
     sort_unique(ys);
@@ -150,7 +200,7 @@ CoarseToFineResult CoarseToFineMatcher::run(const Progress& progress) const {
         m = build_matching_lp(
             ProductSpace::from_list(lx.mesh, ly.mesh,
                                     reduced_product_space(lx, ly, hx_.levels[l - 1].mesh, hy_.levels[l - 1].mesh,
-                                                          coarse_gamma, ring)),
+                                                          coarse_gamma, ring, options_.neighbourhood)),
             model, options_.matching.scale_costs);
       }
       rep.variables = m.lp.cols();
@@ -164,6 +214,18 @@ CoarseToFineResult CoarseToFineMatcher::run(const Progress& progress) const {
                                                    [&](const RoundingRound& r) {
                                                      if (progress) progress(rep, r);
                                                    });
+        // A reduced space can force a tear that the full one would not: widen rather than accept
+        // it, while the ring may still grow.
+        if (l > 0 && ring < options_.max_ring) {
+          const GraphSurfaceCheck c = check_graph_surface(m.space, rr.gamma);
+          if (!c.continuous) {
+            ++rep.widenings;
+            spdlog::warn("level {}: Γ at ring {} is not continuous ({} + {} vertices, {} + {} edges); widening to ring {}",
+                         l + 1, ring, c.discontinuous_vertices_x, c.discontinuous_vertices_y,
+                         c.discontinuous_edges_x, c.discontinuous_edges_y, ring + 1);
+            continue;
+          }
+        }
         rep.rounds = static_cast<int>(rr.rounds.size());
         for (const auto& r : rr.rounds) rep.iterations += r.iterations;
         rep.lower_bound = rr.lower_bound;

@@ -233,15 +233,10 @@ OrientationFlips count_orientation_flips(const Mesh& x, const Mesh& y, const std
   OrientationFlips r;
   r.faces = x.num_faces();
   for (const auto& f : x.faces) {
-    const int a = map_x_to_y[f[0]], b = map_x_to_y[f[1]], c = map_x_to_y[f[2]];
-    const Eigen::Vector3d ab = y.vertices[b] - y.vertices[a], ac = y.vertices[c] - y.vertices[a];
-    const Eigen::Vector3d normal = ab.cross(ac);
     // Collinear images count with the collapsed ones: they have no orientation to compare.
-    if (a == b || b == c || c == a || normal.norm() <= 1e-12 * (ab.squaredNorm() + ac.squaredNorm())) {
-      ++r.degenerate;
-      continue;
-    }
-    if (normal.dot(gy.vertex_normal[a] + gy.vertex_normal[b] + gy.vertex_normal[c]) < 0) ++r.flips;
+    const int o = image_orientation(y, gy, map_x_to_y[f[0]], map_x_to_y[f[1]], map_x_to_y[f[2]]);
+    r.degenerate += o == 0;
+    r.flips += o < 0;
   }
   return r;
 }

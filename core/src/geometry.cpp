@@ -73,4 +73,11 @@ Geometry compute_geometry(const Mesh& mesh) {
   return g;
 }
 
+int image_orientation(const Mesh& y, const Geometry& gy, int a, int b, int c) {
+  const Eigen::Vector3d ab = y.vertices[b] - y.vertices[a], ac = y.vertices[c] - y.vertices[a];
+  const Eigen::Vector3d normal = ab.cross(ac);
+  if (a == b || b == c || c == a || normal.norm() <= 1e-12 * (ab.squaredNorm() + ac.squaredNorm())) return 0;
+  return normal.dot(gy.vertex_normal[a] + gy.vertex_normal[b] + gy.vertex_normal[c]) < 0 ? -1 : 1;
+}
+
 }  // namespace shapematch

@@ -1,6 +1,7 @@
 #include "shapematch/rounding.hpp"
 
 #include "shapematch/errors.hpp"
+#include "shapematch/geometry.hpp"
 #include "shapematch/system.hpp"
 
 #include <spdlog/spdlog.h>
@@ -392,7 +393,69 @@ GraphSurfaceCheck check_graph_surface(const ProductSpace& space, const std::vect
   return check;
 }
 
-VertexMaps vertex_maps(const ProductSpace& space, const std::vector<int64_t>& gamma) {
+namespace {
+
+// Moves vertices of `from` to other partners in their fibre (`candidates`) while that lowers the
+// number of inverted images among their faces, then the number of degenerate ones. Γ keeps
+// orientation everywhere, but one partner per vertex can invert a face where Γ blows a vertex up
+// or stretches an edge; another partner from the same fibre usually does not.
+void untangle(const Mesh& from, const Mesh& to, const std::vector<std::vector<int>>& candidates,
+              std::vector<int>& map) {
+  const Geometry g = compute_geometry(to);
+  std::vector<std::vector<int>> vf(from.num_vertices());
+  for (int f = 0; f < from.num_faces(); ++f)
+    for (int v : from.faces[f]) vf[v].push_back(f);
+  auto cost = [&](int v) {  // inverted images weigh more than any number of degenerate ones
+    int64_t c = 0;
+    for (int f : vf[v]) {
+      const auto& t = from.faces[f];
+      const int o = image_orientation(to, g, map[t[0]], map[t[1]], map[t[2]]);
+      c += o < 0 ? 1000 : o == 0 ? 1 : 0;
+    }
+    return c;
+  };
+  for (int sweep = 0; sweep < 8; ++sweep) {
+    bool changed = false;
+    for (int v = 0; v < from.num_vertices(); ++v) {
+      if (candidates[v].size() < 2) continue;
+      const int current = map[v];
+      int best = current;
+      int64_t best_cost = cost(v);
+      if (best_cost == 0) continue;
+      for (int c : candidates[v]) {
+        if (c == current) continue;
+        map[v] = c;
+        const int64_t k = cost(v);
+        if (k < best_cost) best_cost = k, best = c;
+      }
+      map[v] = best;
+      changed = changed || best != current;
+    }
+    if (!changed) break;
+  }
+  // What single moves cannot fix, a face's three corners moved together may (bounded search).
+  for (int f = 0; f < from.num_faces(); ++f) {
+    const auto& t = from.faces[f];
+    if (image_orientation(to, g, map[t[0]], map[t[1]], map[t[2]]) >= 0) continue;
+    const auto &c0 = candidates[t[0]], &c1 = candidates[t[1]], &c2 = candidates[t[2]];
+    if (c0.size() * c1.size() * c2.size() > 4096) continue;
+    auto total = [&] { return cost(t[0]) + cost(t[1]) + cost(t[2]); };
+    std::array<int, 3> best{map[t[0]], map[t[1]], map[t[2]]};
+    int64_t best_cost = total();
+    for (int a : c0)
+      for (int b : c1)
+        for (int c : c2) {
+          map[t[0]] = a, map[t[1]] = b, map[t[2]] = c;
+          const int64_t k = total();
+          if (k < best_cost) best_cost = k, best = {a, b, c};
+        }
+    map[t[0]] = best[0], map[t[1]] = best[1], map[t[2]] = best[2];
+  }
+}
+
+}  // namespace
+
+VertexMaps vertex_maps(const ProductSpace& space, const std::vector<int64_t>& gamma, bool untangle_maps) {
   VertexMaps maps;
   maps.x_to_y.assign(space.x().num_vertices(), -1);
   maps.y_to_x.assign(space.y().num_vertices(), -1);
@@ -406,6 +469,25 @@ VertexMaps vertex_maps(const ProductSpace& space, const std::vector<int64_t>& ga
         if (maps.y_to_x[t.b[i]] < 0) maps.y_to_x[t.b[i]] = t.a[i];
       }
     }
+  // Every vertex's fibre: the partners Γ pairs it with, position by position.
+  std::vector<std::vector<int>> fibre_x(maps.x_to_y.size()), fibre_y(maps.y_to_x.size());
+  for (int64_t j : gamma) {
+    const ProductTriangle t = space[j];
+    for (int i = 0; i < 3; ++i) {
+      fibre_x[t.a[i]].push_back(t.b[i]);
+      fibre_y[t.b[i]].push_back(t.a[i]);
+    }
+  }
+  for (auto* fibres : {&fibre_x, &fibre_y})
+    for (auto& f : *fibres) {
+      std::sort(f.begin(), f.end());
+      f.erase(std::unique(f.begin(), f.end()), f.end());
+    }
+  if (untangle_maps && std::find(maps.x_to_y.begin(), maps.x_to_y.end(), -1) == maps.x_to_y.end() &&
+      std::find(maps.y_to_x.begin(), maps.y_to_x.end(), -1) == maps.y_to_x.end()) {
+    untangle(space.x(), space.y(), fibre_x, maps.x_to_y);
+    untangle(space.y(), space.x(), fibre_y, maps.y_to_x);
+  }
   return maps;
 }
 

@@ -9,10 +9,21 @@
 
 namespace shapematch {
 
+// Where the rings of the reduced space are counted. Coarse: eq. (17) as written, N on the coarse
+// level on both sides, so one ring adds a whole coarse face's width on X and on Y. Fine: the
+// coarse Γ at ring 0 picks the coarse Y faces, and rings widen on the fine level: ring 1 adds one
+// fine ring around their children on Y; ring k >= 2 adds k - 1 fine rings on Y and lets X faces
+// at a coarse face's border also take the allowances of their fine neighbours' parents. Measured
+// on FAUST_r 020-024 / 021-029 at 1000 faces (3 levels from 100): 0.93 M / 2.0 M variables
+// against 2.9 M for coarse ring 1, 36 s / 180 s against 538 s / 449 s, mean geodesic error
+// 0.048 / 0.051 against 0.050 / 0.065.
+enum class Neighbourhood { Coarse, Fine };
+
 struct CoarseToFineOptions {
   HierarchyOptions hierarchy;
+  Neighbourhood neighbourhood = Neighbourhood::Fine;  // measured: as accurate, 2.5-15x faster
   int ring = 1;      // N(f) = faces within this many rings of f's vertices (eq. 17)
-  int max_ring = 3;  // widen up to this when a reduced LP is infeasible
+  int max_ring = 3;  // widen up to this when a reduced LP is infeasible or its Γ is torn
   MatchingLpOptions matching;  // its features (if any) have one row per vertex of the input meshes
   RoundingOptions rounding;
 };
@@ -23,7 +34,8 @@ struct CoarseToFineOptions {
 // Enumerated directly: memory is linear in the number of product triangles kept.
 std::vector<ProductTriangle> reduced_product_space(const MeshLevel& fine_x, const MeshLevel& fine_y,
                                                    const Mesh& coarse_x, const Mesh& coarse_y,
-                                                   const std::vector<ProductTriangle>& coarse_gamma, int ring);
+                                                   const std::vector<ProductTriangle>& coarse_gamma, int ring,
+                                                   Neighbourhood neighbourhood = Neighbourhood::Coarse);
 
 struct LevelReport {
   int level = 0;  // 0 = coarsest
@@ -32,7 +44,7 @@ struct LevelReport {
   int64_t full_variables = 0;  // the full product space at this level, for comparison
   int64_t constraints = 0;
   int ring = -1;               // ring of the reduced space (-1: full space)
-  int widenings = 0;           // times the ring was widened after an infeasible reduced LP
+  int widenings = 0;           // times the ring was widened: infeasible reduced LP or a torn Γ
   int rounds = 0;
   int64_t iterations = 0;      // LP iterations over all rounds
   double lower_bound = 0.0, energy = 0.0, gap = 0.0;

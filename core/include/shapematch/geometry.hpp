@@ -17,4 +17,9 @@ struct Geometry {
 
 Geometry compute_geometry(const Mesh& mesh);
 
+// The orientation of the triangle (a, b, c) of y's vertices against y's vertex normals at its
+// corners: +1 kept, -1 inverted, 0 degenerate (a repeated or collinear corner). How a vertex
+// map's image of a face is judged.
+int image_orientation(const Mesh& y, const Geometry& gy, int a, int b, int c);
+
 }  // namespace shapematch

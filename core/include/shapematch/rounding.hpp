@@ -60,11 +60,12 @@ struct GraphSurfaceCheck {
 GraphSurfaceCheck check_graph_surface(const ProductSpace& space, const std::vector<int64_t>& gamma);
 
 // Vertex maps read off Γ: for every vertex one partner on the other shape, preferring partners
-// from product triangles that are real on both sides.
+// from product triangles that are real on both sides; then, where a vertex's faces map to
+// inverted (or degenerate) triangles, another partner from its fibre that inverts fewer.
 struct VertexMaps {
   std::vector<int> x_to_y;
   std::vector<int> y_to_x;
 };
-VertexMaps vertex_maps(const ProductSpace& space, const std::vector<int64_t>& gamma);
+VertexMaps vertex_maps(const ProductSpace& space, const std::vector<int64_t>& gamma, bool untangle = true);
 
 }  // namespace shapematch
