@@ -1,13 +1,18 @@
+#include "pdhg_backend.hpp"
 #include "shapematch/errors.hpp"
 #include "shapematch/matching.hpp"
 #include "shapematch/pdhg.hpp"
 #include "shapematch/shapes.hpp"
 #include "test_helpers.hpp"
+#include "thread_pool.hpp"
 
 #include <doctest/doctest.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <cstring>
+#include <memory>
 #include <set>
 
 using namespace shapematch;
@@ -119,4 +124,107 @@ TEST_CASE("pdhg-cpu: matching LPs agree with Clp within 1e-4 relative") {
   const LpResult warm = solve_lp(m.lp, "pdhg-cpu", params);
   REQUIRE(warm.status == LpStatus::Optimal);
   CHECK(warm.iterations * 4 <= r.iterations);
+}
+
+TEST_CASE("thread pool: every chunk runs exactly once, loop after loop") {
+  for (const int threads : {1, 2, 3, 5}) {
+    detail::ThreadPool pool(threads);
+    CHECK(pool.size() == threads);
+    std::vector<std::atomic<int>> runs(40);
+    for (int loop = 0; loop < 3000; ++loop) {
+      const int chunks = loop % 41;  // 0 chunks included; more chunks than threads and fewer
+      pool.run(chunks, [&](int c) { runs[c].fetch_add(1); });
+      for (int c = 0; c < chunks; ++c) REQUIRE(runs[c].exchange(0) == 1);
+      for (int c = chunks; c < 40; ++c) REQUIRE(runs[c].load() == 0);
+    }
+  }
+}
+
+// The native backend splits rows into chunks of equal cost, sums rows in pairs and hands chunks
+// to whichever thread is free; none of that may change an iterate, only the grouping of the
+// reported sums (which split evenly by thread count, as before).
+TEST_CASE("pdhg-cpu: iterates are bitwise the same on any number of threads") {
+  // Rows of 0..12 entries, an odd count, then long rows at the end like the π rows of A.
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  const int64_t n = 3001, m = 2001;
+  SignedCsr a;
+  a.rows = m;
+  a.cols = n;
+  a.row_ptr.push_back(0);
+  for (int64_t i = 0; i < m; ++i) {
+    std::set<uint32_t> cols;
+    const int count = i >= m - 9 ? 300 + int(i % 3) * 57 : int(rng() % 13);
+    while (int(cols.size()) < count) cols.insert(uint32_t(rng() % n));
+    for (const uint32_t j : cols) a.entry.push_back(j | (u(rng) < 0.5 ? SignedCsr::kNegative : 0u));
+    a.row_ptr.push_back(uint32_t(a.entry.size()));
+  }
+  const SignedCsr at = transpose(a);
+  detail::ScaledLp lp;
+  lp.a = &a;
+  lp.at = &at;
+  std::vector<double> x(n), y(m);
+  for (int64_t j = 0; j < n; ++j) {
+    lp.col_scale.push_back(0.5 + u(rng));
+    lp.c.push_back(2.0 * u(rng) - 0.5);
+    x[j] = u(rng) < 0.3 ? 0.0 : u(rng) / lp.col_scale.back();
+  }
+  for (int64_t i = 0; i < m; ++i) {
+    lp.row_scale.push_back(0.5 + u(rng));
+    lp.b.push_back(3.0 * u(rng) - 1.0);
+    y[i] = 2.0 * u(rng) - 1.0;
+  }
+  const detail::Step step{0.05, 0.05, 1.0};
+
+  const auto run = [&](int threads, std::vector<double>& xhat, std::vector<double>& yhat) {
+    const auto backend = detail::make_cpu_backend(threads);
+    backend->load(lp, x, y);
+    backend->iterate(1, 0, step);
+    backend->iterate(63, 1, step);
+    backend->restart();
+    const detail::BatchStats s = backend->iterate(64, 0, step);
+    backend->read(xhat, yhat);
+    return s;
+  };
+  // One iteration against the kernel formulas of pdhg_backend.hpp, each row summed in entry order.
+  {
+    const auto backend = detail::make_cpu_backend(3);
+    backend->load(lp, x, y);
+    backend->iterate(1, 0, step);
+    std::vector<double> xhat, yhat;
+    backend->read(xhat, yhat);
+    const auto row_sum = [](const SignedCsr& mat, int64_t i, const std::vector<double>& v) {
+      double s = 0.0;
+      for (uint32_t k = mat.row_ptr[i]; k < mat.row_ptr[i + 1]; ++k)
+        s += is_negative(mat.entry[k]) ? -v[col_of(mat.entry[k])] : v[col_of(mat.entry[k])];
+      return s;
+    };
+    std::vector<double> yr(m), xr(n);
+    for (int64_t i = 0; i < m; ++i) yr[i] = lp.row_scale[i] * y[i];
+    int64_t wrong_x = 0, wrong_y = 0;
+    for (int64_t j = 0; j < n; ++j) {
+      const double d = lp.col_scale[j];
+      const double xh = std::clamp(x[j] - step.tau * (lp.c[j] - d * row_sum(at, j, yr)), 0.0, 1.0 / d);
+      xr[j] = d * (2.0 * xh - x[j]);
+      wrong_x += xh != xhat[j];
+    }
+    for (int64_t i = 0; i < m; ++i)
+      wrong_y += y[i] + step.sigma * (lp.b[i] - lp.row_scale[i] * row_sum(a, i, xr)) != yhat[i];
+    CHECK(wrong_x == 0);
+    CHECK(wrong_y == 0);
+  }
+
+  std::vector<double> x1, y1;
+  const detail::BatchStats s1 = run(1, x1, y1);
+  CHECK(s1.dx2 > 0.0);  // the iterates moved
+  CHECK(std::count(x1.begin(), x1.end(), 0.0) < n);
+  for (const int threads : {2, 3, 8}) {
+    CAPTURE(threads);
+    std::vector<double> xt, yt;
+    const detail::BatchStats st = run(threads, xt, yt);
+    CHECK(std::memcmp(xt.data(), x1.data(), n * sizeof(double)) == 0);
+    CHECK(std::memcmp(yt.data(), y1.data(), m * sizeof(double)) == 0);
+    CHECK(std::abs(st.dx2 - s1.dx2) <= 1e-12 * s1.dx2);
+    CHECK(std::abs(st.residual2 - s1.residual2) <= 1e-12 * s1.residual2);
+  }
 }

@@ -1,6 +1,7 @@
 #pragma once
 // A persistent pool for the native PDHG kernels: one iteration is two short parallel loops, so
 // threads are kept alive and woken per loop instead of being created each time.
+#include <atomic>
 #include <condition_variable>
 #include <cstdint>
 #include <functional>
@@ -18,17 +19,25 @@ public:
   ThreadPool& operator=(const ThreadPool&) = delete;
 
   int size() const { return static_cast<int>(workers_.size()) + 1; }
-  // Runs job(t) for t = 0 … size()−1 (t = 0 on the calling thread) and waits for all.
-  void run(const std::function<void(int)>& job);
+  // Runs job(c) once for each chunk c = 0 … chunks−1 and waits for all. Chunks go to whichever
+  // thread asks first, the caller included, which starts at once: on a shared machine a worker
+  // that is not scheduled delays the loop by at most the chunk it holds, not by its whole share.
+  void run(int chunks, const std::function<void(int)>& job);
 
 private:
-  void work(int t);
+  void work();
+  // Claims and runs chunks of the current loop until none is left; `lock` holds mutex_.
+  void drain(std::unique_lock<std::mutex>& lock);
+
   std::vector<std::thread> workers_;
   std::mutex mutex_;
   std::condition_variable start_, done_;
+  // Under mutex_; generation_ and finished_ are atomic so that waiting threads can spin on them.
   const std::function<void(int)>* job_ = nullptr;
-  uint64_t generation_ = 0;
-  int pending_ = 0;
+  int chunks_ = 0, next_ = 0;
+  std::atomic<int> finished_{0};
+  std::atomic<uint64_t> generation_{0};
+  int sleeping_ = 0;
   bool stop_ = false;
 };
 
