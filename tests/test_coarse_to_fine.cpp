@@ -28,7 +28,7 @@ TEST_CASE("coarse to fine: the reduced space is a duplicate-free subset that gro
   const ProductSpace full = ProductSpace::full(fine.mesh, fine.mesh);
   std::vector<std::set<int64_t>> spaces;
   for (int ring : {0, 1, 2}) {
-    const auto list = reduced_product_space(fine, fine, coarse, coarse, identity_matching(coarse), ring);
+    const auto list = reduced_product_space(fine, fine, coarse, coarse, identity_matching(coarse), ring, Neighbourhood::Coarse);
     const auto s = full_indices(full, list);  // throws if any entry is not canonical
     CHECK(s.size() == list.size());
     if (ring < 2) CHECK(int64_t(list.size()) < full.size());
@@ -40,7 +40,7 @@ TEST_CASE("coarse to fine: the reduced space is a duplicate-free subset that gro
   std::vector<ProductTriangle> everything;
   const ProductSpace coarse_full = ProductSpace::full(coarse, coarse);
   for (int64_t j = 0; j < coarse_full.size(); ++j) everything.push_back(coarse_full[j]);
-  CHECK(int64_t(reduced_product_space(fine, fine, coarse, coarse, everything, 0).size()) == full.size());
+  CHECK(int64_t(reduced_product_space(fine, fine, coarse, coarse, everything, 0, Neighbourhood::Coarse).size()) == full.size());
 }
 
 TEST_CASE("coarse to fine: the fine identity survives the reduction of a coarse identity") {
@@ -48,7 +48,7 @@ TEST_CASE("coarse to fine: the fine identity survives the reduction of a coarse 
   const MeshHierarchy h = build_hierarchy(m, {20, 80, 320});
   for (int l = 1; l < h.size(); ++l) {
     const auto list = reduced_product_space(h.levels[l], h.levels[l], h.levels[l - 1].mesh, h.levels[l - 1].mesh,
-                                            identity_matching(h.levels[l - 1].mesh), 0);
+                                            identity_matching(h.levels[l - 1].mesh), 0, Neighbourhood::Coarse);
     const ProductSpace full = ProductSpace::full(h.levels[l].mesh, h.levels[l].mesh);
     const auto s = full_indices(full, list);
     for (const auto& t : identity_matching(h.levels[l].mesh)) CHECK(s.count(full.index_in_full(t)) == 1);
@@ -131,10 +131,14 @@ TEST_CASE("coarse to fine: a deformed pair with different triangulations ends ve
     const Mesh &fx = r.finest.space.x(), &fy = r.finest.space.y();
     const VertexMaps maps = vertex_maps(r.finest.space, r.rounding.gamma);
     const VertexMaps plain = vertex_maps(r.finest.space, r.rounding.gamma, false);
-    const int untangled = count_orientation_flips(fx, fy, maps.x_to_y).flips + count_orientation_flips(fy, fx, maps.y_to_x).flips;
-    const int first = count_orientation_flips(fx, fy, plain.x_to_y).flips + count_orientation_flips(fy, fx, plain.y_to_x).flips;
+    const int untangled_x = count_orientation_flips(fx, fy, maps.x_to_y).flips;
+    const int untangled_y = count_orientation_flips(fy, fx, maps.y_to_x).flips;
+    const int first_x = count_orientation_flips(fx, fy, plain.x_to_y).flips;
+    const int first_y = count_orientation_flips(fy, fx, plain.y_to_x).flips;
+    const int untangled = untangled_x + untangled_y, first = first_x + first_y;
     MESSAGE("inverted faces: ", untangled, " untangled, ", first, " first partners");
-    CHECK(untangled <= first);
+    CHECK(untangled_x <= first_x);  // never worse, in either direction
+    CHECK(untangled_y <= first_y);
     flips_untangled += untangled;
     flips_first += first;
     for (const auto& l : r.levels) {
@@ -150,6 +154,9 @@ TEST_CASE("coarse to fine: shapes of different sizes share the level count and e
   CoarseToFineOptions o;
   o.hierarchy.coarsest_faces = 20;
   o.rounding.solver = "pdhg-cpu";
+  // Measured: eq. (17)'s neighbourhood keeps this pair continuous; the fine one tears one vertex
+  // (a reduced space can force a tear; match reports it).
+  o.neighbourhood = Neighbourhood::Coarse;
   for (const bool swap : {false, true}) {
     CAPTURE(swap);
     const CoarseToFineMatcher matcher(swap ? large : small, swap ? small : large, o);

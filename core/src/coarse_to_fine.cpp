@@ -214,18 +214,6 @@ CoarseToFineResult CoarseToFineMatcher::run(const Progress& progress) const {
                                                    [&](const RoundingRound& r) {
                                                      if (progress) progress(rep, r);
                                                    });
-        // A reduced space can force a tear that the full one would not: widen rather than accept
-        // it, while the ring may still grow.
-        if (l > 0 && ring < options_.max_ring) {
-          const GraphSurfaceCheck c = check_graph_surface(m.space, rr.gamma);
-          if (!c.continuous) {
-            ++rep.widenings;
-            spdlog::warn("level {}: Γ at ring {} is not continuous ({} + {} vertices, {} + {} edges); widening to ring {}",
-                         l + 1, ring, c.discontinuous_vertices_x, c.discontinuous_vertices_y,
-                         c.discontinuous_edges_x, c.discontinuous_edges_y, ring + 1);
-            continue;
-          }
-        }
         rep.rounds = static_cast<int>(rr.rounds.size());
         for (const auto& r : rr.rounds) rep.iterations += r.iterations;
         rep.lower_bound = rr.lower_bound;

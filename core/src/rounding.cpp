@@ -405,13 +405,14 @@ void untangle(const Mesh& from, const Mesh& to, const std::vector<std::vector<in
   std::vector<std::vector<int>> vf(from.num_vertices());
   for (int f = 0; f < from.num_faces(); ++f)
     for (int v : from.faces[f]) vf[v].push_back(f);
-  auto cost = [&](int v) {  // inverted images weigh more than any number of degenerate ones
+  auto face_cost = [&](int f) {  // an inverted image weighs more than any number of degenerate ones
+    const auto& t = from.faces[f];
+    const int o = image_orientation(to, g, map[t[0]], map[t[1]], map[t[2]]);
+    return int64_t(o < 0 ? 1000 : o == 0 ? 1 : 0);
+  };
+  auto cost = [&](int v) {
     int64_t c = 0;
-    for (int f : vf[v]) {
-      const auto& t = from.faces[f];
-      const int o = image_orientation(to, g, map[t[0]], map[t[1]], map[t[2]]);
-      c += o < 0 ? 1000 : o == 0 ? 1 : 0;
-    }
+    for (int f : vf[v]) c += face_cost(f);
     return c;
   };
   for (int sweep = 0; sweep < 8; ++sweep) {
@@ -439,7 +440,18 @@ void untangle(const Mesh& from, const Mesh& to, const std::vector<std::vector<in
     if (image_orientation(to, g, map[t[0]], map[t[1]], map[t[2]]) >= 0) continue;
     const auto &c0 = candidates[t[0]], &c1 = candidates[t[1]], &c2 = candidates[t[2]];
     if (c0.size() * c1.size() * c2.size() > 4096) continue;
-    auto total = [&] { return cost(t[0]) + cost(t[1]) + cost(t[2]); };
+    // The three stars overlap: count each face of their union once, so that a lower total
+    // means fewer inverted faces, never more.
+    std::vector<int> star(vf[t[0]]);
+    star.insert(star.end(), vf[t[1]].begin(), vf[t[1]].end());
+    star.insert(star.end(), vf[t[2]].begin(), vf[t[2]].end());
+    std::sort(star.begin(), star.end());
+    star.erase(std::unique(star.begin(), star.end()), star.end());
+    auto total = [&] {
+      int64_t c = 0;
+      for (int h : star) c += face_cost(h);
+      return c;
+    };
     std::array<int, 3> best{map[t[0]], map[t[1]], map[t[2]]};
     int64_t best_cost = total();
     for (int a : c0)

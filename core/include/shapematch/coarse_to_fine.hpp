@@ -23,7 +23,7 @@ struct CoarseToFineOptions {
   HierarchyOptions hierarchy;
   Neighbourhood neighbourhood = Neighbourhood::Fine;  // measured: as accurate, 2.5-15x faster
   int ring = 1;      // N(f) = faces within this many rings of f's vertices (eq. 17)
-  int max_ring = 3;  // widen up to this when a reduced LP is infeasible or its Γ is torn
+  int max_ring = 3;  // widen up to this when a reduced LP is infeasible
   MatchingLpOptions matching;  // its features (if any) have one row per vertex of the input meshes
   RoundingOptions rounding;
 };
@@ -35,7 +35,7 @@ struct CoarseToFineOptions {
 std::vector<ProductTriangle> reduced_product_space(const MeshLevel& fine_x, const MeshLevel& fine_y,
                                                    const Mesh& coarse_x, const Mesh& coarse_y,
                                                    const std::vector<ProductTriangle>& coarse_gamma, int ring,
-                                                   Neighbourhood neighbourhood = Neighbourhood::Coarse);
+                                                   Neighbourhood neighbourhood);
 
 struct LevelReport {
   int level = 0;  // 0 = coarsest
@@ -44,9 +44,10 @@ struct LevelReport {
   int64_t full_variables = 0;  // the full product space at this level, for comparison
   int64_t constraints = 0;
   int ring = -1;               // ring of the reduced space (-1: full space)
-  int widenings = 0;           // times the ring was widened: infeasible reduced LP or a torn Γ
+  int widenings = 0;           // times the ring was widened after an infeasible reduced LP
   int rounds = 0;
-  int64_t iterations = 0;      // LP iterations over all rounds
+  int64_t iterations = 0;      // LP iterations over all rounds of the accepted ring (seconds
+                               // include an infeasible attempt's, which ends within a few dozen)
   double lower_bound = 0.0, energy = 0.0, gap = 0.0;
   double seconds = 0.0;
   double peak_rss_mb = 0.0;
