@@ -48,6 +48,20 @@ inline void signed_gather2(const uint32_t* e0, uint32_t n0, const uint32_t* e1, 
   s1 = b;
 }
 
+// update(row, Σ ±v over the row) for rows [begin, end), two rows at a time (signed_gather2).
+template <class Update>
+inline void for_each_row_sum(const uint32_t* ptr, const uint32_t* entry, const double* v, int64_t begin, int64_t end,
+                             Update&& update) {
+  int64_t i = begin;
+  for (; i + 1 < end; i += 2) {
+    double s0, s1;
+    signed_gather2(entry + ptr[i], ptr[i + 1] - ptr[i], entry + ptr[i + 1], ptr[i + 2] - ptr[i + 1], v, s0, s1);
+    update(i, s0);
+    update(i + 1, s1);
+  }
+  if (i < end) update(i, signed_gather(entry, ptr[i], ptr[i + 1], v));
+}
+
 // clamp(v, 0, hi) for hi > 0, equal to std::clamp (−0 and NaN pass through) but without the
 // data-dependent branch GCC makes of its lower bound (a hot spot in the profile: most x̂_j
 // sit at the bound 0, some do not).
@@ -189,14 +203,7 @@ private:
         dx2 += (xh - xj) * (xh - xj);
       }
     };
-    int64_t j = begin;
-    for (; j + 1 < end; j += 2) {
-      double aty0, aty1;
-      signed_gather2(entry + ptr[j], ptr[j + 1] - ptr[j], entry + ptr[j + 1], ptr[j + 2] - ptr[j + 1], yr, aty0, aty1);
-      update(j, aty0);
-      update(j + 1, aty1);
-    }
-    if (j < end) update(j, signed_gather(entry, ptr[j], ptr[j + 1], yr));
+    for_each_row_sum(ptr, entry, yr, begin, end, update);
     return dx2;
   }
 
@@ -231,14 +238,7 @@ private:
         dy2 += (yh - yi) * (yh - yi);
       }
     };
-    int64_t i = begin;
-    for (; i + 1 < end; i += 2) {
-      double ax0, ax1;
-      signed_gather2(entry + ptr[i], ptr[i + 1] - ptr[i], entry + ptr[i + 1], ptr[i + 2] - ptr[i + 1], xr, ax0, ax1);
-      update(i, ax0);
-      update(i + 1, ax1);
-    }
-    if (i < end) update(i, signed_gather(entry, ptr[i], ptr[i + 1], xr));
+    for_each_row_sum(ptr, entry, xr, begin, end, update);
     return dy2;
   }
 

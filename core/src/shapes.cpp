@@ -118,6 +118,22 @@ std::pair<double, double> capsule_ring(int i, int rings, double radius, double c
   return {length - radius * (1 - std::cos((profile - t) / radius)), radius * std::sin((profile - t) / radius)};
 }
 
+// The vertices of a capsule's tube (tube_faces' order): point(s, r, theta) at both poles and at
+// every ring, s along the axis, r from it, theta around it.
+template <class Point>
+std::vector<Eigen::Vector3d> capsule_vertices(const Point& point, int rings, int segments, double radius,
+                                              double cylinder) {
+  std::vector<Eigen::Vector3d> vertices;
+  vertices.reserve(rings * segments + 2);
+  vertices.push_back(point(0, 0, 0));
+  for (int i = 0; i < rings; ++i) {
+    const auto [s, r] = capsule_ring(i, rings, radius, cylinder);
+    for (int j = 0; j < segments; ++j) vertices.push_back(point(s, r, 2 * M_PI * j / segments));
+  }
+  vertices.push_back(point(cylinder + 2 * radius, 0, 0));
+  return vertices;
+}
+
 }  // namespace
 
 Mesh bent_finger(double bend_degrees, int rings, int segments) {
@@ -161,14 +177,7 @@ Mesh bent_finger(double bend_degrees, int rings, int segments) {
     return Eigen::Vector3d(axis(s) + d * std::cos(theta) * Eigen::Vector3d::UnitX() + d * std::sin(theta) * back);
   };
 
-  std::vector<Eigen::Vector3d> vertices;
-  vertices.reserve(rings * segments + 2);
-  vertices.push_back(point(0, 0, 0));
-  for (int i = 0; i < rings; ++i) {
-    const auto [s, r] = capsule_ring(i, rings, radius, cylinder);
-    for (int j = 0; j < segments; ++j) vertices.push_back(point(s, r, 2 * M_PI * j / segments));
-  }
-  vertices.push_back(point(length, 0, 0));
+  std::vector<Eigen::Vector3d> vertices = capsule_vertices(point, rings, segments, radius, cylinder);
 
   return make_mesh(std::move(vertices), tube_faces(rings, segments), fmt::format("bent_finger({})", bend_degrees));
 }
@@ -177,11 +186,11 @@ Mesh dolphin(double head_bend_degrees, double tail_bend_degrees, int rings, int 
   if (rings < 2 || segments < 3 || !std::isfinite(head_bend_degrees) || !std::isfinite(tail_bend_degrees))
     throw InvalidInputError(fmt::format("dolphin: need rings >= 2, segments >= 3 and finite angles, got {}, {}, {}, {}",
                                         rings, segments, head_bend_degrees, tail_bend_degrees));
-  // A capsule along +z from s = 0 (tail) to s = length (head), reshaped: the thickness profile
+  // A capsule along +z from s = 0 (tail) to s = 4 (head), reshaped: the thickness profile
   // breaks the end-to-end symmetry, the dorsal fin on +y and the flat tail (flukes in x) break
   // every rotation about the spine. Only the mirror x -> -x remains, which reverses orientation,
   // so a matching that keeps orientation has exactly one right answer.
-  constexpr double radius = 0.5, cylinder = 3.0, length = cylinder + 2 * radius;
+  constexpr double radius = 0.5, cylinder = 3.0;
   constexpr double tail_joint = 1.3, head_joint = 2.9, joint_width = 1.0;
   const double tail_bend = tail_bend_degrees * M_PI / 180.0, head_bend = head_bend_degrees * M_PI / 180.0;
 
@@ -217,14 +226,7 @@ Mesh dolphin(double head_bend_degrees, double tail_bend_degrees, int rings, int 
                            d * height * fin * std::sin(theta) * up);
   };
 
-  std::vector<Eigen::Vector3d> vertices;
-  vertices.reserve(rings * segments + 2);
-  vertices.push_back(point(0, 0, 0));
-  for (int i = 0; i < rings; ++i) {
-    const auto [s, r] = capsule_ring(i, rings, radius, cylinder);
-    for (int j = 0; j < segments; ++j) vertices.push_back(point(s, r, 2 * M_PI * j / segments));
-  }
-  vertices.push_back(point(length, 0, 0));
+  std::vector<Eigen::Vector3d> vertices = capsule_vertices(point, rings, segments, radius, cylinder);
   // Turn the spine from +z to (1, 0, -1): the renderer's default camera, from (1, 0.5, 1), then
   // sees the dolphin from its side and a little above.
   const Eigen::Matrix3d turn = Eigen::AngleAxisd(0.75 * M_PI, Eigen::Vector3d::UnitY()).toRotationMatrix();
