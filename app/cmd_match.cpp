@@ -34,6 +34,8 @@ struct MatchArgs {
   HierarchyOptions hierarchy;
   int ring = 1, max_ring = 3;
   std::string neighbourhood = "fine";
+  std::string widen = "local";
+  int widen_margin = CoarseToFineOptions{}.widen_margin;
 };
 
 // auto: a GPU if there is one, else the native solver (lavapipe is for testing, not speed).
@@ -85,6 +87,8 @@ int run_match(const MatchArgs& args) {
   co.ring = args.ring;
   co.neighbourhood = args.neighbourhood == "fine" ? Neighbourhood::Fine : Neighbourhood::Coarse;
   co.max_ring = std::max(args.max_ring, args.ring);
+  co.local_widening = args.widen == "local";
+  co.widen_margin = args.widen_margin;
   co.matching = matching_options(args.pair, p);
   RoundingOptions& ro = co.rounding;
   ro.solver = solver_for(args);
@@ -210,7 +214,8 @@ int run_match(const MatchArgs& args) {
                               .set("levels", matcher.x_levels().size())
                               .set("coarsest_faces", args.hierarchy.coarsest_faces)
                               .set("ring", args.ring)
-                              .set("neighbourhood", args.neighbourhood));
+                              .set("neighbourhood", args.neighbourhood)
+                              .set("widen", args.widen));
     report.set("seconds", seconds);
     report.set("peak_rss_mb", peak_rss_mb());
     report.set("round_log", rounds);
@@ -225,6 +230,8 @@ int run_match(const MatchArgs& args) {
                       .set("constraints", l.constraints)
                       .set("ring", l.ring)
                       .set("widenings", l.widenings)
+                      .set("local_widenings", l.local_widenings)
+                      .set("widened_faces", l.widened_faces)
                       .set("rounds", l.rounds)
                       .set("iterations", l.iterations)
                       .set("lower_bound", l.lower_bound)
@@ -275,6 +282,13 @@ Action add_match_command(CLI::App& app) {
       ->capture_default_str();
   app.add_option("--max-ring", a->max_ring, "widen the ring up to this when a reduced LP is infeasible")
       ->check(CLI::Range(0, 8))
+      ->capture_default_str();
+  app.add_option("--widen", a->widen,
+                 "after an infeasible reduced LP: local (near the proof first, then everywhere) or global")
+      ->check(CLI::IsMember({"local", "global"}))
+      ->capture_default_str();
+  app.add_option("--widen-margin", a->widen_margin, "fine rings of faces around the proof that widen with it")
+      ->check(CLI::Range(0, 64))
       ->capture_default_str();
   return [a] { return run_match(*a); };
 }

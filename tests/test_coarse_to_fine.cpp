@@ -181,3 +181,88 @@ TEST_CASE("coarse to fine: features must have one row per input vertex") {
   CHECK_THROWS_AS(matcher.set_features(Eigen::MatrixXd::Zero(3, 2), Eigen::MatrixXd::Zero(3, 2)), InvalidInputError);
   CHECK_NOTHROW(matcher.set_features(Eigen::MatrixXd::Zero(m.num_vertices(), 2), Eigen::MatrixXd::Zero(m.num_vertices(), 2)));
 }
+
+TEST_CASE("coarse to fine: extra rings grow only the chosen faces' candidates") {
+  const Mesh m = lumpy_sphere(2, 11);  // 320 faces
+  const MeshHierarchy h = build_hierarchy(m, {80, 320});
+  const MeshLevel& fine = h.levels[1];
+  const Mesh& coarse = h.levels[0].mesh;
+  const ProductSpace full = ProductSpace::full(fine.mesh, fine.mesh);
+  const auto id = identity_matching(coarse);
+  const auto plain = full_indices(full, reduced_product_space(fine, fine, coarse, coarse, id, 1, Neighbourhood::Fine));
+  const int chosen = 17;
+  std::vector<int> extra(fine.mesh.num_faces(), 0);
+  extra[chosen] = 1;
+  const auto list = reduced_product_space(fine, fine, coarse, coarse, id, 1, Neighbourhood::Fine, extra);
+  const auto grown = full_indices(full, list);
+  CHECK(grown.size() == list.size());
+  CHECK(std::includes(grown.begin(), grown.end(), plain.begin(), plain.end()));
+  CHECK(grown.size() > plain.size());
+  // Every new product triangle has the chosen face, one of its edges or one of its vertices on X.
+  const auto& f = fine.mesh.faces[chosen];
+  auto on_chosen = [&](int v) { return v == f[0] || v == f[1] || v == f[2]; };
+  for (const auto& t : list) {
+    if (plain.count(full.index_in_full(t))) continue;
+    CHECK((t.fa == chosen || (t.fa < 0 && on_chosen(t.a[0]) && on_chosen(t.a[1]) && on_chosen(t.a[2]))));
+  }
+  // A list of the wrong size is an error, not a silent partial widening.
+  CHECK_THROWS_AS(reduced_product_space(fine, fine, coarse, coarse, id, 1, Neighbourhood::Fine, {1, 2}),
+                  InvalidInputError);
+}
+
+TEST_CASE("coarse to fine: a coarse face no fine face took as parent still has a candidate") {
+  const Mesh m = lumpy_sphere(2, 12);
+  const MeshHierarchy h = build_hierarchy(m, {80, 320});
+  MeshLevel fine_y = h.levels[1];
+  const Mesh& coarse = h.levels[0].mesh;
+  // Hand coarse face 0's children to another parent: face 0 is now childless on Y.
+  const int other = coarse.num_faces() - 1;
+  int moved = 0;
+  for (int& p : fine_y.parent_face)
+    if (p == 0) p = other, ++moved;
+  REQUIRE(moved > 0);
+  const auto list = reduced_product_space(h.levels[1], fine_y, coarse, coarse, identity_matching(coarse), 0,
+                                          Neighbourhood::Fine);
+  std::vector<int> candidates(h.levels[1].mesh.num_faces(), 0);
+  for (const auto& t : list)
+    if (t.fa >= 0) ++candidates[t.fa];
+  for (int f = 0; f < h.levels[1].mesh.num_faces(); ++f) {
+    CAPTURE(f);
+    CHECK(candidates[f] > 0);  // before: the children of coarse face 0 had none
+  }
+}
+
+TEST_CASE("coarse to fine: an infeasible reduced LP is widened near the proof, not everywhere") {
+  // Measured: at ring 0 this pair's finest reduced LP is infeasible; propagation names the
+  // places, and widening 17 of 80 faces makes it feasible (the global ring 1 keeps 1.8x as many
+  // variables).
+  const Mesh x = shapes::bent_finger(10, 8, 8), y = shapes::bent_finger(60, 8, 8);
+  CoarseToFineOptions o;
+  o.hierarchy.levels = 2;
+  o.hierarchy.coarsest_faces = 16;
+  o.rounding.solver = "pdhg-cpu";
+  o.ring = 0;
+  o.max_ring = 2;
+  o.widen_margin = 0;
+  int64_t variables[2] = {0, 0};
+  for (const bool local : {true, false}) {
+    CAPTURE(local);
+    o.local_widening = local;
+    const CoarseToFineMatcher matcher(decimate(x, 80), decimate(y, 90), o);
+    const CoarseToFineResult r = matcher.run();
+    const LevelReport& l = r.levels.back();
+    CHECK(check_graph_surface(r.finest.space, r.rounding.gamma).ok());
+    CHECK(satisfies_exactly(r.finest.lp, r.rounding.gamma));
+    if (local) {
+      CHECK(l.local_widenings >= 1);
+      CHECK(l.widenings == 0);
+      CHECK(l.widened_faces > 0);
+      CHECK(l.widened_faces < l.faces_x);
+    } else {
+      CHECK(l.local_widenings == 0);
+      CHECK(l.widenings == 1);
+    }
+    variables[local ? 0 : 1] = l.variables;
+  }
+  CHECK(variables[0] < variables[1]);
+}

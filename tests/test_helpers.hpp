@@ -4,6 +4,7 @@
 
 #include "shapematch/device.hpp"
 #include "shapematch/errors.hpp"
+#include "shapematch/lp.hpp"
 #include "shapematch/shapes.hpp"
 
 #include <Eigen/Geometry>
@@ -20,6 +21,23 @@
 #include <string>
 
 namespace shapematch::test {
+
+// Builds an LP from dense rows with entries in {-1, 0, 1}.
+inline LpProblem dense_lp(const std::vector<std::vector<int>>& rows, std::vector<double> b, std::vector<double> c) {
+  LpProblem p;
+  p.a.rows = static_cast<int64_t>(rows.size());
+  p.a.cols = static_cast<int64_t>(c.size());
+  p.a.row_ptr.push_back(0);
+  for (const auto& r : rows) {
+    for (size_t j = 0; j < r.size(); ++j)
+      if (r[j] != 0) p.a.entry.push_back(static_cast<uint32_t>(j) | (r[j] < 0 ? SignedCsr::kNegative : 0u));
+    p.a.row_ptr.push_back(static_cast<uint32_t>(p.a.entry.size()));
+  }
+  p.at = transpose(p.a);
+  p.b = std::move(b);
+  p.c = std::move(c);
+  return p;
+}
 
 // The same connectivity with every vertex mapped by f.
 template <class F>

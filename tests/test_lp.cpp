@@ -11,26 +11,7 @@
 
 using namespace shapematch;
 
-namespace {
-
-// Builds an LP from dense rows with entries in {-1, 0, 1}.
-LpProblem dense_lp(const std::vector<std::vector<int>>& rows, std::vector<double> b, std::vector<double> c) {
-  LpProblem p;
-  p.a.rows = static_cast<int64_t>(rows.size());
-  p.a.cols = static_cast<int64_t>(c.size());
-  p.a.row_ptr.push_back(0);
-  for (const auto& r : rows) {
-    for (size_t j = 0; j < r.size(); ++j)
-      if (r[j] != 0) p.a.entry.push_back(static_cast<uint32_t>(j) | (r[j] < 0 ? SignedCsr::kNegative : 0u));
-    p.a.row_ptr.push_back(static_cast<uint32_t>(p.a.entry.size()));
-  }
-  p.at = transpose(p.a);
-  p.b = std::move(b);
-  p.c = std::move(c);
-  return p;
-}
-
-}  // namespace
+using test::dense_lp;
 
 TEST_CASE("clp: tiny LPs with known optima and an infeasible one") {
   for (const std::string solver : {"clp-dual", "clp-barrier"}) {

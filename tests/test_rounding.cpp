@@ -121,3 +121,32 @@ TEST_CASE("rounding: the continuity check catches two faces that trade images") 
   CHECK(c.discontinuous_vertices_y == 6);
   CHECK(c.discontinuous_edges_x >= 6);
 }
+
+TEST_CASE("rounding: propagation names the row of a contradiction, and skipped rows are left out") {
+  // x0 + x1 = 1, x0 = 1, x1 = 1: propagation fixes x0 = 1, then x1 = 0 and x1 = 1 clash.
+  const LpProblem clash = test::dense_lp({{1, 1}, {1, 0}, {0, 1}}, {1, 1, 1}, {0, 0});
+  const int64_t row = propagation_conflict(clash);
+  CHECK(row >= 0);
+  CHECK(row <= 2);
+  CHECK(propagation_conflict(clash, {0, 0, 1}) == -1);  // without x1 = 1 it is consistent
+  CHECK(propagation_conflict(clash, {1, 0, 0}) == -1);  // without the sum, too
+  // A row no entry can satisfy is itself the contradiction.
+  CHECK(propagation_conflict(test::dense_lp({{1, 1}, {0, 0}}, {1, 1}, {0, 0})) == 1);
+  // A feasible system has none.
+  CHECK(propagation_conflict(test::dense_lp({{1, 1, 0}, {0, 1, 1}}, {1, 1}, {0, 0, 0})) == -1);
+  CHECK_THROWS_AS(propagation_conflict(clash, {0, 1}), InvalidInputError);
+  // The rounding's error carries the row, for callers that widen the problem there.
+  const Mesh x = shapes::octahedron();
+  const Geometry g = compute_geometry(x);
+  MatchingLp m = build_matching_lp(x, g, x, g);
+  CHECK(propagation_conflict(m.lp) == -1);
+  m.lp.b[m.lp.rows() - 1] = -1;  // a face of Y covered −1 times
+  try {
+    round_to_graph_surface(m.space, m.lp, m.energy);
+    FAIL("no InfeasibleError");
+  } catch (const InfeasibleError& e) {
+    REQUIRE(e.rows().size() == 1);
+    CHECK(e.rows()[0] == m.lp.rows() - 1);
+    CHECK(propagation_conflict(m.lp) == m.lp.rows() - 1);
+  }
+}

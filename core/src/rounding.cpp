@@ -42,6 +42,8 @@ public:
 
   const FixState& state() const { return s_; }
   void restore(const FixState& s) { s_ = s; }
+  // The row at which the last failed propagation found a contradiction.
+  int64_t failed_row() const { return failed_row_; }
 
   // Fixes the variables and propagates; false if that proves the system infeasible.
   bool fix(const std::vector<std::pair<int64_t, int>>& assignments) {
@@ -51,11 +53,16 @@ public:
     return propagate(queue);
   }
 
-  // Propagates from every row (used once at the start).
-  bool propagate_all() {
-    std::deque<int64_t> queue(lp_.rows());
-    std::iota(queue.begin(), queue.end(), 0);
-    return propagate(queue);
+  // Propagates from every row (used once at the start). Rows marked in `skip` are left out, as
+  // if they were not there.
+  bool propagate_all(const std::vector<char>* skip = nullptr) {
+    std::deque<int64_t> queue;
+    for (int64_t i = 0; i < lp_.rows(); ++i)
+      if (!skip || !(*skip)[i]) queue.push_back(i);
+    skip_ = skip;
+    const bool ok = propagate(queue);
+    skip_ = nullptr;
+    return ok;
   }
 
 private:
@@ -85,7 +92,11 @@ private:
       const int64_t i = queue.front();
       queue.pop_front();
       const int64_t r = s_.rhs[i], pos = s_.free_pos[i], neg = s_.free_neg[i];
-      if (r > pos || r < -neg) return false;
+      if (skip_ && (*skip_)[i]) continue;
+      if (r > pos || r < -neg) {
+        failed_row_ = i;
+        return false;
+      }
       if (pos + neg == 0 || (r != pos && r != -neg)) continue;
       // r == pos: + entries 1, − entries 0; r == −neg: − entries 1, + entries 0.
       const bool plus_is_one = r == pos && !(r == -neg && pos == 0);
@@ -94,7 +105,10 @@ private:
         const int64_t j = col_of(e);
         if (s_.value[j] >= 0) continue;
         const int v = (is_negative(e) != plus_is_one) ? 1 : 0;
-        if (!assign(j, v, queue)) return false;
+        if (!assign(j, v, queue)) {
+          failed_row_ = i;
+          return false;
+        }
       }
     }
     return true;
@@ -102,6 +116,8 @@ private:
 
   const LpProblem& lp_;
   FixState s_;
+  int64_t failed_row_ = -1;
+  const std::vector<char>* skip_ = nullptr;
 };
 
 // The LP over the free variables and the rows that still contain one.
@@ -162,7 +178,27 @@ std::vector<std::pair<int64_t, int>> shrink_and_fix(Fixer& fixer, std::vector<st
   return batch;
 }
 
+// The rows that carry a Farkas certificate y (in the reduced LP's numbering): those where |y_i|
+// is a sizeable fraction of the largest, mapped back to the full LP.
+std::vector<int64_t> certificate_rows(const std::vector<double>& y, const std::vector<int64_t>& rows) {
+  double largest = 0.0;
+  for (double v : y) largest = std::max(largest, std::abs(v));
+  std::vector<int64_t> out;
+  if (!(largest > 0.0)) return out;
+  for (size_t i = 0; i < y.size() && i < rows.size(); ++i)
+    if (std::abs(y[i]) >= 0.1 * largest) out.push_back(rows[i]);
+  spdlog::debug("infeasibility certificate: {} of {} rows", out.size(), y.size());
+  return out;
+}
+
 }  // namespace
+
+int64_t propagation_conflict(const LpProblem& lp, const std::vector<char>& skip) {
+  if (!skip.empty() && static_cast<int64_t>(skip.size()) != lp.rows())
+    throw InvalidInputError("propagation: need one skip flag per row");
+  Fixer fixer(lp);
+  return fixer.propagate_all(skip.empty() ? nullptr : &skip) ? -1 : fixer.failed_row();
+}
 
 bool satisfies_exactly(const LpProblem& lp, const std::vector<int64_t>& gamma) {
   std::vector<int64_t> ax(lp.rows(), 0);
@@ -184,7 +220,8 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
   auto solver = make_solver(options.solver);
   RoundingResult result;
   Fixer fixer(lp);
-  if (!fixer.propagate_all()) throw InfeasibleError("rounding: the matching LP is infeasible (found before any fixing)");
+  if (!fixer.propagate_all())
+    throw InfeasibleError("rounding: the matching LP is infeasible (found before any fixing)", {fixer.failed_row()});
 
   std::vector<double> x_full(lp.cols(), 0.0), y_full(lp.rows(), 0.0);
   struct Step {
@@ -221,7 +258,7 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
 
     if (r.status == LpStatus::Infeasible) {
       // The last fixing left an infeasible LP that propagation could not see: undo it and fix less.
-      if (!last) throw InfeasibleError("rounding: the matching LP is infeasible");
+      if (!last) throw InfeasibleError("rounding: the matching LP is infeasible", certificate_rows(r.y, red.rows));
       fixer.restore(last->before);
       info.undone = true;
       auto smaller = last->batch;

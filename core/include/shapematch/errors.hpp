@@ -1,8 +1,10 @@
 #pragma once
 // The exception hierarchy of shapematch. Every error that reaches the command line is one of
 // these; what() is a single line that names the file (if any) and the problem.
+#include <cstdint>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace shapematch {
 
@@ -34,6 +36,13 @@ public:
 class InfeasibleError : public SolverError {
 public:
   using SolverError::SolverError;
+  InfeasibleError(const std::string& what, std::vector<int64_t> rows) : SolverError(what), rows_(std::move(rows)) {}
+  // Rows of the problem's constraint system where the proof lies (the support of a Farkas
+  // certificate, or the row propagation emptied), so a caller can widen there; may be empty.
+  const std::vector<int64_t>& rows() const { return rows_; }
+
+private:
+  std::vector<int64_t> rows_;
 };
 
 // No usable Vulkan device, out of device memory, a failed Vulkan call.

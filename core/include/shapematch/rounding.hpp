@@ -42,6 +42,10 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
                                       const RoundingOptions& options = {},
                                       const std::function<void(const RoundingRound&)>& progress = {});
 
+// Unit propagation of A x = b over binary x with nothing fixed, leaving out the rows marked in
+// `skip` (empty: none): the row where it finds a contradiction, or -1 if it finds none.
+int64_t propagation_conflict(const LpProblem& lp, const std::vector<char>& skip = {});
+
 // A x = b checked exactly in integers for the 0/1 vector with ones at `gamma`.
 bool satisfies_exactly(const LpProblem& lp, const std::vector<int64_t>& gamma);
 
