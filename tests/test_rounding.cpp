@@ -150,3 +150,24 @@ TEST_CASE("rounding: propagation names the row of a contradiction, and skipped r
     CHECK(propagation_conflict(m.lp) == m.lp.rows() - 1);
   }
 }
+
+TEST_CASE("rounding: a batch full of clashing candidates still ends in an exact graph surface") {
+  // Threshold 0: every variable the LP touches is a candidate, so fixings clash with larger ones
+  // and must be taken back exactly (propagation included). Measured: fixing every candidate that
+  // does not clash, one at a time, ends in fewer rounds but at a 123 % gap on the 30-face bench
+  // pair, against < 100 % for halving the batch; halving stays.
+  const Mesh x = decimate(shapes::dolphin(0, 5), 60), y = decimate(shapes::dolphin(-40, 45), 60);
+  const Geometry gx = compute_geometry(x), gy = compute_geometry(y);
+  const MatchingLp m = build_matching_lp(x, gx, y, gy);
+  RoundingOptions o;
+  o.solver = "pdhg-cpu";
+  o.threshold = 0.0;
+  const RoundingResult r = round_to_graph_surface(m.space, m.lp, m.energy, o);
+  CHECK(satisfies_exactly(m.lp, r.gamma));
+  CHECK(check_graph_surface(m.space, r.gamma).ok());
+  CHECK(r.energy >= r.lower_bound - 1e-9);
+  bool skipped = false;
+  for (const auto& k : r.rounds) skipped = skipped || k.undone;
+  CHECK(skipped);  // the clashes happened
+  MESSAGE("threshold 0: ", r.rounds.size(), " rounds, gap ", r.gap);
+}
