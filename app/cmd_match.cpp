@@ -29,6 +29,7 @@ struct MatchArgs {
   double threshold = 0.5;
   int max_rounds = 50;
   double tolerance = 1e-4;
+  double coarse_tolerance = CoarseToFineOptions{}.coarse_tolerance;
   double time_limit = std::numeric_limits<double>::infinity();
   int device = -1;
   HierarchyOptions hierarchy;
@@ -88,6 +89,7 @@ int run_match(const MatchArgs& args) {
   co.neighbourhood = args.neighbourhood == "fine" ? Neighbourhood::Fine : Neighbourhood::Coarse;
   co.max_ring = std::max(args.max_ring, args.ring);
   co.local_widening = args.widen == "local";
+  co.coarse_tolerance = args.coarse_tolerance;
   co.widen_margin = args.widen_margin;
   co.matching = matching_options(args.pair, p);
   RoundingOptions& ro = co.rounding;
@@ -207,6 +209,7 @@ int run_match(const MatchArgs& args) {
                               .set("lame_mu", args.pair.lame.at(1))
                               .set("threshold", args.threshold)
                               .set("tolerance", args.tolerance)
+                              .set("coarse_tolerance", co.coarse_tolerance)
                               .set("faces", args.pair.faces)
                               .set("keep_scale", args.pair.keep_scale)
                               .set("features", p.features)
@@ -266,6 +269,9 @@ Action add_match_command(CLI::App& app) {
       ->capture_default_str();
   app.add_option("--max-rounds", a->max_rounds, "rounding rounds before giving up")->capture_default_str();
   app.add_option("--tol", a->tolerance, "LP tolerance")->capture_default_str();
+  app.add_option("--coarse-tol", a->coarse_tolerance, "LP tolerance of the levels below the finest, where looser than --tol")
+      ->check(CLI::Range(0.0, 0.5))
+      ->capture_default_str();
   app.add_option("--time-limit", a->time_limit, "time limit of each LP solve, seconds");
   app.add_option("--levels", a->hierarchy.levels, "coarse-to-fine levels including the finest (0: from --coarsest-faces)")
       ->check(CLI::NonNegativeNumber)

@@ -266,3 +266,20 @@ TEST_CASE("coarse to fine: an infeasible reduced LP is widened near the proof, n
   }
   CHECK(variables[0] < variables[1]);
 }
+
+TEST_CASE("coarse to fine: a looser tolerance below the finest level costs fewer iterations there only") {
+  const Mesh x = shapes::bent_finger(10, 8, 8), y = shapes::bent_finger(60, 8, 8);
+  CoarseToFineOptions o;
+  o.hierarchy.levels = 2;
+  o.hierarchy.coarsest_faces = 40;
+  o.rounding.solver = "pdhg-cpu";
+  o.coarse_tolerance = 0.0;
+  const CoarseToFineMatcher tight(decimate(x, 80), decimate(y, 90), o);
+  o.coarse_tolerance = 1e-2;
+  const CoarseToFineMatcher loose(decimate(x, 80), decimate(y, 90), o);
+  const CoarseToFineResult a = tight.run(), b = loose.run();
+  MESSAGE("coarsest level iterations: ", a.levels[0].iterations, " at 1e-4, ", b.levels[0].iterations, " at 1e-2");
+  CHECK(b.levels[0].iterations < a.levels[0].iterations);
+  CHECK(check_graph_surface(b.finest.space, b.rounding.gamma).ok());
+  CHECK(b.levels[1].lower_bound <= b.levels[1].energy + 1e-9);
+}

@@ -20,50 +20,81 @@ void sort_unique(std::vector<int>& v) {
 }
 
 
-// Fine X faces near a proof of infeasibility: the faces on the X vertices of every variable in a
-// proof row (and on an X face's own π row). Those are the faces whose candidates ran out there.
-std::vector<int> faces_near_rows(const MatchingLp& m, const std::vector<int64_t>& rows, int margin = 0) {
-  const Mesh& X = m.space.x();
-  std::vector<char> near(X.num_vertices(), 0);
-  for (int64_t i : rows) {
-    if (i < 0 || i >= m.lp.rows()) continue;
-    const int64_t face = i - m.closedness_rows;
-    if (face >= 0 && face < X.num_faces())
-      for (int v : X.faces[face]) near[v] = 1;
-    for (uint32_t k = m.lp.a.row_ptr[i]; k < m.lp.a.row_ptr[i + 1]; ++k)
-      for (int v : m.space[col_of(m.lp.a.entry[k])].a) near[v] = 1;
+// Where a proof of infeasibility lies: the X and Y vertices of every variable in a proof row and
+// of the face of a π row.
+struct ProofPlace {
+  std::vector<char> x, y;  // per vertex
+  ProofPlace(const MatchingLp& m) : x(m.space.x().num_vertices(), 0), y(m.space.y().num_vertices(), 0) {}
+  void add(const MatchingLp& m, int64_t row) {
+    if (row < 0 || row >= m.lp.rows()) return;
+    const int64_t face = row - m.closedness_rows;
+    const int fx = m.space.x().num_faces();
+    if (face >= 0 && face < fx)
+      for (int v : m.space.x().faces[face]) x[v] = 1;
+    else if (face >= fx)
+      for (int v : m.space.y().faces[face - fx]) y[v] = 1;
+    for (uint32_t k = m.lp.a.row_ptr[row]; k < m.lp.a.row_ptr[row + 1]; ++k) {
+      const ProductTriangle t = m.space[col_of(m.lp.a.entry[k])];
+      for (int v : t.a) x[v] = 1;
+      for (int v : t.b) y[v] = 1;
+    }
   }
+};
+
+std::vector<int> faces_on(const Mesh& mesh, const std::vector<char>& vertices, int rings) {
   std::vector<int> seed;
-  for (int v = 0; v < X.num_vertices(); ++v)
-    if (near[v]) seed.push_back(v);
+  for (int v = 0; v < mesh.num_vertices(); ++v)
+    if (vertices[v]) seed.push_back(v);
   if (seed.empty()) return {};
-  return ring_faces(X, vertex_face_table(X), seed, 1 + margin);
+  return ring_faces(mesh, vertex_face_table(mesh), seed, rings);
 }
 
-// The X faces near every place where unit propagation proves a reduced LP infeasible: after each
-// contradiction the rows of every variable over the faces near it are set aside, so that the next
-// pass finds the next independent one (at most `max_places`). Empty: propagation finds none.
-std::vector<int> faces_near_conflicts(const MatchingLp& m, int max_places, int margin) {
+// The fine X faces to widen for a proof: those on its X vertices, grown by `margin` rings (the
+// faces whose candidates ran out there). With `carry_y`, also every X face of a variable that
+// touches Y within `margin` rings of its Y vertices: the X faces that could give the Y faces
+// there more preimages (needed where widening the X side alone did not help).
+std::vector<int> faces_to_widen(const MatchingLp& m, const ProofPlace& p, int margin, bool carry_y) {
   const Mesh& X = m.space.x();
-  std::vector<char> skip(m.lp.rows(), 0), face_near(X.num_faces(), 0), vertex_near(X.num_vertices(), 0);
-  for (int place = 0; place < max_places; ++place) {
+  std::vector<char> x = p.x;
+  if (carry_y) {
+    std::vector<char> y(m.space.y().num_vertices(), 0);
+    for (int f : faces_on(m.space.y(), p.y, 1 + margin))
+      for (int v : m.space.y().faces[f]) y[v] = 1;
+    for (int64_t j = 0; j < m.space.size(); ++j) {
+      const ProductTriangle t = m.space[j];
+      if (y[t.b[0]] || y[t.b[1]] || y[t.b[2]]) x[t.a[0]] = x[t.a[1]] = x[t.a[2]] = 1;
+    }
+  }
+  return faces_on(X, x, 1 + margin);
+}
+
+// Every place where unit propagation proves a reduced LP infeasible: after each contradiction
+// the rows of every variable over the X faces near it are set aside, so that the next pass finds
+// the next independent one (at most `max_places`). Returns the faces to widen for all of them
+// (empty: propagation finds no contradiction).
+std::vector<int> faces_near_conflicts(const MatchingLp& m, int max_places, int margin, bool carry_y) {
+  const Mesh& X = m.space.x();
+  ProofPlace all(m);
+  std::vector<char> skip(m.lp.rows(), 0), set_aside(X.num_vertices(), 0);
+  int places = 0;
+  for (; places < max_places; ++places) {
     const int64_t row = propagation_conflict(m.lp, skip);
     if (row < 0) break;
     skip[row] = 1;
-    for (int f : faces_near_rows(m, {row}, margin)) {
-      face_near[f] = 1;
-      for (int v : X.faces[f]) vertex_near[v] = 1;
-    }
+    ProofPlace here(m);
+    here.add(m, row);
+    all.add(m, row);
+    for (int f : faces_on(X, here.x, 1 + margin))
+      for (int v : X.faces[f]) set_aside[v] = 1;
     for (int64_t j = 0; j < m.space.size(); ++j) {
       const auto a = m.space[j].a;
-      if (vertex_near[a[0]] || vertex_near[a[1]] || vertex_near[a[2]])
+      if (set_aside[a[0]] || set_aside[a[1]] || set_aside[a[2]])
         for (uint32_t k = m.lp.at.row_ptr[j]; k < m.lp.at.row_ptr[j + 1]; ++k) skip[col_of(m.lp.at.entry[k])] = 1;
     }
   }
-  std::vector<int> out;
-  for (int f = 0; f < X.num_faces(); ++f)
-    if (face_near[f]) out.push_back(f);
-  return out;
+  if (places == 0) return {};
+  spdlog::debug("propagation: {} places of infeasibility", places);
+  return faces_to_widen(m, all, margin, carry_y);
 }
 
 }  // namespace
@@ -264,6 +295,7 @@ CoarseToFineResult CoarseToFineMatcher::run(const Progress& progress) const {
     if (fx_.size() > 0) model.set_features(select_rows(fx_, lx.input_vertex), select_rows(fy_, ly.input_vertex));
 
     std::vector<int> extra;  // local widening: more fine rings per fine X face
+    std::vector<int> last_widened;
     int local = 0;
     int ring = options_.ring;
     // One more fine ring on these faces (as far as max_ring allows); false if none could grow.
@@ -303,9 +335,17 @@ CoarseToFineResult CoarseToFineMatcher::run(const Progress& progress) const {
                    rep.variables, l > 0 ? fmt::format("{:.3g} % of the full space", kept) : "the full space",
                    l > 0 ? fmt::format(", ring {}", ring) : std::string());
       // Propagation alone proves most reduced LPs infeasible, and says where: widen there first.
-      if (l > 0 && widen_locally(faces_near_conflicts(m, 10000, options_.widen_margin))) continue;
+      if (l > 0 && options_.local_widening) {
+        std::vector<int> faces = faces_near_conflicts(m, 10000, options_.widen_margin, false);
+        const bool again = !faces.empty() && faces == last_widened;  // the X side alone did not help
+        last_widened = faces;
+        if (again) faces = faces_near_conflicts(m, 10000, options_.widen_margin, true);
+        if (widen_locally(faces)) continue;
+      }
       try {
-        RoundingResult rr = round_to_graph_surface(m.space, m.lp, m.energy, options_.rounding,
+        RoundingOptions ro = options_.rounding;
+        if (l + 1 < hx_.size()) ro.lp.tolerance = std::max(ro.lp.tolerance, options_.coarse_tolerance);
+        RoundingResult rr = round_to_graph_surface(m.space, m.lp, m.energy, ro,
                                                    [&](const RoundingRound& r) {
                                                      if (progress) progress(rep, r);
                                                    });
@@ -323,7 +363,9 @@ CoarseToFineResult CoarseToFineMatcher::run(const Progress& progress) const {
         break;
       } catch (const InfeasibleError& e) {
         if (l == 0) throw;
-        if (widen_locally(faces_near_rows(m, e.rows(), options_.widen_margin))) continue;
+        ProofPlace proof(m);
+        for (int64_t i : e.rows()) proof.add(m, i);
+        if (widen_locally(faces_to_widen(m, proof, options_.widen_margin, true))) continue;
         if (ring >= options_.max_ring) throw;
         ++rep.widenings;
         spdlog::warn("level {}: the reduced LP at ring {} is infeasible; widening to ring {}", l + 1, ring, ring + 1);

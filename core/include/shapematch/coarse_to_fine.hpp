@@ -34,6 +34,11 @@ struct CoarseToFineOptions {
   int widen_margin = 4;  // fine rings of X faces around the proof that widen with it (measured below)
   MatchingLpOptions matching;  // its features (if any) have one row per vertex of the input meshes
   RoundingOptions rounding;
+  // LP tolerance of the levels below the finest, if looser than the rounding's own. Their Γ only
+  // chooses the next level's space, so it need not be certified as tightly. Measured, FAUST_r
+  // 021-029 at 2000 faces (4 levels): 56 s against 97 s at 1e-4 everywhere, the same finest gap
+  // (0.4 %) and error 0.047 against 0.052.
+  double coarse_tolerance = 1e-3;
 };
 
 // The reduced product space of eq. (17): every product triangle (f_a, f_b) of the fine meshes
