@@ -140,6 +140,28 @@ TEST_CASE("thread pool: every chunk runs exactly once, loop after loop") {
   }
 }
 
+TEST_CASE("thread pool: a chunk that throws is rethrown to the caller after every chunk ran") {
+  for (const int threads : {1, 2, 4}) {
+    CAPTURE(threads);
+    detail::ThreadPool pool(threads);
+    for (int loop = 0; loop < 200; ++loop) {
+      std::atomic<int> ran{0};
+      const int bad = loop % 7;
+      CHECK_THROWS_AS(pool.run(7,
+                               [&](int c) {
+                                 ran.fetch_add(1);
+                                 if (c == bad) throw std::runtime_error("chunk failed");
+                               }),
+                      std::runtime_error);
+      CHECK(ran.load() == 7);
+      // The pool is still usable afterwards.
+      std::atomic<int> again{0};
+      pool.run(5, [&](int) { again.fetch_add(1); });
+      CHECK(again.load() == 5);
+    }
+  }
+}
+
 // The native backend splits rows into chunks of equal cost, sums rows in pairs and hands chunks
 // to whichever thread is free; none of that may change an iterate, only the grouping of the
 // reported sums (which split evenly by thread count, as before).

@@ -3,6 +3,8 @@
 #include "parallel.hpp"
 
 #include <chrono>
+#include <exception>
+#include <utility>
 
 namespace shapematch::detail {
 namespace {
@@ -43,8 +45,16 @@ void ThreadPool::drain(std::unique_lock<std::mutex>& lock) {
     const int c = next_++;
     const std::function<void(int)>* job = job_;
     lock.unlock();
-    (*job)(c);
+    std::exception_ptr failure;
+    try {
+      (*job)(c);
+    } catch (...) {
+      failure = std::current_exception();
+    }
     lock.lock();
+    if (failure && !error_) error_ = failure;
+    // A failed chunk still counts as finished, so that run() returns (and rethrows) only once no
+    // thread holds the job any more.
     if (finished_.fetch_add(1) + 1 == chunks_) done_.notify_one();
   }
 }
@@ -52,7 +62,15 @@ void ThreadPool::drain(std::unique_lock<std::mutex>& lock) {
 void ThreadPool::run(int chunks, const std::function<void(int)>& job) {
   if (chunks <= 0) return;
   if (workers_.empty()) {
-    for (int c = 0; c < chunks; ++c) job(c);
+    std::exception_ptr first;
+    for (int c = 0; c < chunks; ++c) {
+      try {
+        job(c);
+      } catch (...) {
+        if (!first) first = std::current_exception();
+      }
+    }
+    if (first) std::rethrow_exception(first);
     return;
   }
   std::unique_lock lock(mutex_);
@@ -73,6 +91,11 @@ void ThreadPool::run(int chunks, const std::function<void(int)>& job) {
     }
   }
   job_ = nullptr;  // a worker that wakes late finds next_ == chunks_ and goes back to waiting
+  if (error_) {
+    const std::exception_ptr e = std::exchange(error_, nullptr);
+    lock.unlock();
+    std::rethrow_exception(e);
+  }
 }
 
 void ThreadPool::work() {

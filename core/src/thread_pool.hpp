@@ -4,6 +4,7 @@
 #include <atomic>
 #include <condition_variable>
 #include <cstdint>
+#include <exception>
 #include <functional>
 #include <mutex>
 #include <thread>
@@ -22,6 +23,7 @@ public:
   // Runs job(c) once for each chunk c = 0 … chunks−1 and waits for all. Chunks go to whichever
   // thread asks first, the caller included, which starts at once: on a shared machine a worker
   // that is not scheduled delays the loop by at most the chunk it holds, not by its whole share.
+  // If chunks throw, the others still run, and the first exception is rethrown here.
   void run(int chunks, const std::function<void(int)>& job);
 
 private:
@@ -37,6 +39,7 @@ private:
   int chunks_ = 0, next_ = 0;
   std::atomic<int> finished_{0};
   std::atomic<uint64_t> generation_{0};
+  std::exception_ptr error_;  // the first exception of the current loop
   int sleeping_ = 0;
   bool stop_ = false;
 };
