@@ -365,7 +365,11 @@ CoarseToFineResult CoarseToFineMatcher::run(const Progress& progress) const {
         if (l == 0) throw;
         ProofPlace proof(m);
         for (int64_t i : e.rows()) proof.add(m, i);
-        if (widen_locally(faces_to_widen(m, proof, options_.widen_margin, true))) continue;
+        std::vector<int> faces = faces_to_widen(m, proof, options_.widen_margin, false);
+        const bool again = !faces.empty() && faces == last_widened;
+        last_widened = faces;
+        if (again) faces = faces_to_widen(m, proof, options_.widen_margin, true);
+        if (widen_locally(faces)) continue;
         if (ring >= options_.max_ring) throw;
         ++rep.widenings;
         spdlog::warn("level {}: the reduced LP at ring {} is infeasible; widening to ring {}", l + 1, ring, ring + 1);
