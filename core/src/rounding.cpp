@@ -10,7 +10,6 @@
 #include <cmath>
 #include <deque>
 #include <numeric>
-#include <optional>
 
 namespace shapematch {
 namespace {
@@ -41,7 +40,29 @@ public:
   }
 
   const FixState& state() const { return s_; }
-  void restore(const FixState& s) { s_ = s; }
+  // Every assignment since `mark()` can be taken back, propagation included, at the cost of what
+  // it changed: rounding backtracks over several rounds without keeping copies of the state.
+  size_t mark() const { return trail_.size(); }
+  void undo_to(size_t mark) {
+    while (trail_.size() > mark) {
+      const int64_t j = trail_.back();
+      trail_.pop_back();
+      const int v = s_.value[j];
+      s_.value[j] = -1;
+      --(v ? s_.ones : s_.zeros);
+      for (uint32_t k = lp_.at.row_ptr[j]; k < lp_.at.row_ptr[j + 1]; ++k) {
+        const uint32_t e = lp_.at.entry[k];
+        const int64_t i = col_of(e);
+        const bool neg = is_negative(e);
+        ++(neg ? s_.free_neg : s_.free_pos)[i];
+        if (v) {
+          const bool was = s_.rhs[i] != 0;
+          s_.rhs[i] += neg ? -1 : 1;
+          s_.unsatisfied += (s_.rhs[i] != 0) - was;
+        }
+      }
+    }
+  }
   // The row at which the last failed propagation found a contradiction.
   int64_t failed_row() const { return failed_row_; }
 
@@ -69,6 +90,7 @@ private:
   bool assign(int64_t j, int v, std::deque<int64_t>& queue) {
     if (s_.value[j] >= 0) return s_.value[j] == v;
     s_.value[j] = static_cast<int8_t>(v);
+    trail_.push_back(static_cast<uint32_t>(j));  // < 2^31 columns (build_constraints checks)
     ++(v ? s_.ones : s_.zeros);
     for (uint32_t k = lp_.at.row_ptr[j]; k < lp_.at.row_ptr[j + 1]; ++k) {
       const uint32_t e = lp_.at.entry[k];
@@ -117,6 +139,7 @@ private:
   const LpProblem& lp_;
   FixState s_;
   int64_t failed_row_ = -1;
+  std::vector<uint32_t> trail_;  // assigned variables, in order
   const std::vector<char>* skip_ = nullptr;
 };
 
@@ -162,11 +185,12 @@ Reduced reduce(const LpProblem& full, const FixState& s) {
 // Fixes the batch (largest first); a fixing that propagation proves infeasible is undone and
 // replaced by fixing fewer (halving down to the single largest), and a single variable that
 // cannot be 1 is fixed to 0 instead: each retry strictly shrinks the search space. Returns the
-// batch actually applied (`batch` itself when nothing had to be undone).
+// batch actually applied (`batch` itself when nothing had to be undone). `mark` is the fixer's
+// mark before the batch.
 std::vector<std::pair<int64_t, int>> shrink_and_fix(Fixer& fixer, std::vector<std::pair<int64_t, int>> batch,
-                                                    const FixState& before) {
+                                                    size_t mark) {
   while (!fixer.fix(batch)) {
-    fixer.restore(before);
+    fixer.undo_to(mark);
     if (batch.size() > 1) {
       batch.resize(batch.size() / 2);
     } else if (batch.front().second == 1) {
@@ -225,10 +249,11 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
 
   std::vector<double> x_full(lp.cols(), 0.0), y_full(lp.rows(), 0.0);
   struct Step {
-    FixState before;
+    size_t mark = 0;  // the fixer's mark before this fixing
+    int64_t ones = 0, zeros = 0;
     std::vector<std::pair<int64_t, int>> batch;
   };
-  std::optional<Step> last;  // the last fixing, to undo if the next LP is infeasible
+  std::vector<Step> history;  // the fixings so far, to undo when a later LP is infeasible
   for (int round = 1; fixer.state().unsatisfied > 0; ++round) {
     if (round > options.max_rounds)
       throw SolverError("rounding did not reach a binary solution in " + std::to_string(options.max_rounds) +
@@ -257,21 +282,38 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
     }
 
     if (r.status == LpStatus::Infeasible) {
-      // The last fixing left an infeasible LP that propagation could not see: undo it and fix less.
-      if (!last) throw InfeasibleError("rounding: the matching LP is infeasible", certificate_rows(r.y, red.rows));
-      fixer.restore(last->before);
+      // The last fixing left an infeasible LP that propagation could not see: undo it and fix
+      // less. Where nothing of it can go (a single variable that can be neither 1 nor 0), undo
+      // the fixing before it as well, and so on back (measured: FAUST 020-024 at 4000 faces got
+      // stuck in round 15, and the whole level was thrown away and widened).
+      if (history.empty())
+        throw InfeasibleError("rounding: the matching LP is infeasible", certificate_rows(r.y, red.rows));
       info.undone = true;
-      auto smaller = last->batch;
-      if (smaller.size() > 1) smaller.resize(smaller.size() / 2);
-      else if (smaller.front().second == 1) smaller.front().second = 0;  // the single variable cannot be 1
-      else throw InfeasibleError("rounding: no consistent fixing exists (no binary solution)");
-      smaller = shrink_and_fix(fixer, smaller, last->before);
-      info.fixed_to_one = fixer.state().ones - last->before.ones;
-      info.fixed_to_zero = fixer.state().zeros - last->before.zeros;
+      for (;;) {
+        Step& step = history.back();
+        fixer.undo_to(step.mark);
+        auto smaller = step.batch;
+        bool shrinkable = true;
+        if (smaller.size() > 1) smaller.resize(smaller.size() / 2);
+        else if (smaller.front().second == 1) smaller.front().second = 0;  // the single variable cannot be 1
+        else shrinkable = false;
+        if (shrinkable) {
+          try {
+            step.batch = shrink_and_fix(fixer, smaller, step.mark);  // if still infeasible, shrink further
+            break;
+          } catch (const InfeasibleError&) {
+            fixer.undo_to(step.mark);
+          }
+        }
+        history.pop_back();
+        if (history.empty()) throw InfeasibleError("rounding: no consistent fixing exists (no binary solution)");
+        spdlog::debug("round {}: backtracking over round {}'s fixing", round, history.size());
+      }
+      info.fixed_to_one = fixer.state().ones - history.back().ones;
+      info.fixed_to_zero = fixer.state().zeros - history.back().zeros;
       info.seconds = clock.seconds();
       result.rounds.push_back(info);
       if (progress) progress(info);
-      last->batch = smaller;  // if that is still infeasible, shrink further
       continue;
     }
     if (r.status == LpStatus::NumericalTrouble || r.x.size() != size_t(red.lp.cols()))
@@ -292,12 +334,12 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
     }
     if (batch.empty()) batch.push_back({red.cols[order.front()], 1});
 
-    last = Step{fixer.state(), {}};
-    const int64_t ones_before = last->before.ones, zeros_before = last->before.zeros;
-    last->batch = shrink_and_fix(fixer, batch, last->before);
-    info.undone = last->batch != batch;
-    info.fixed_to_one = fixer.state().ones - ones_before;
-    info.fixed_to_zero = fixer.state().zeros - zeros_before;
+    Step step{fixer.mark(), fixer.state().ones, fixer.state().zeros, {}};
+    step.batch = shrink_and_fix(fixer, batch, step.mark);
+    info.undone = step.batch != batch;
+    info.fixed_to_one = fixer.state().ones - step.ones;
+    info.fixed_to_zero = fixer.state().zeros - step.zeros;
+    history.push_back(std::move(step));
     info.seconds = clock.seconds();
     result.rounds.push_back(info);
     if (progress) progress(info);
