@@ -171,3 +171,18 @@ TEST_CASE("rounding: a batch full of clashing candidates still ends in an exact 
   CHECK(skipped);  // the clashes happened
   MESSAGE("threshold 0: ", r.rounds.size(), " rounds, gap ", r.gap);
 }
+
+TEST_CASE("rounding: an LP with no binary solution ends in InfeasibleError naming the open rows") {
+  // x0 + x1 = x1 + x2 = x2 + x0 = 1: the LP has x = 1/2, but no 0/1 point exists; fixing any
+  // variable to 1 or to 0 is refuted by propagation, with nothing earlier to undo.
+  const LpProblem odd = test::dense_lp({{1, 1, 0}, {0, 1, 1}, {1, 0, 1}}, {1, 1, 1}, {1, 1, 1});
+  const Mesh t = shapes::tetrahedron();  // a space of three variables, only for the sizes
+  const auto id = identity_matching(t);
+  const ProductSpace space = ProductSpace::from_list(t, t, {id[0], id[1], id[2]});
+  try {
+    round_to_graph_surface(space, odd, {1, 1, 1});
+    FAIL("no InfeasibleError");
+  } catch (const InfeasibleError& e) {
+    CHECK(e.rows().size() == 3);  // all three rows were open where it got stuck
+  }
+}

@@ -56,6 +56,8 @@ std::vector<int> faces_on(const Mesh& mesh, const std::vector<char>& vertices, i
 std::vector<int> faces_to_widen(const MatchingLp& m, const ProofPlace& p, int margin, bool carry_y) {
   const Mesh& X = m.space.x();
   std::vector<char> x = p.x;
+  // A proof on Y alone (a π row of Y that nothing covers) can only be met from the X side.
+  if (std::none_of(x.begin(), x.end(), [](char c) { return c != 0; })) carry_y = true;
   if (carry_y) {
     std::vector<char> y(m.space.y().num_vertices(), 0);
     for (int f : faces_on(m.space.y(), p.y, 1 + margin))
@@ -67,6 +69,10 @@ std::vector<int> faces_to_widen(const MatchingLp& m, const ProofPlace& p, int ma
   }
   return faces_on(X, x, 1 + margin);
 }
+
+// Each place costs a propagation pass and a scan of the space; past this many, widen what was
+// found and look again on the widened space.
+constexpr int kMaxConflictPlaces = 256;
 
 // Every place where unit propagation proves a reduced LP infeasible: after each contradiction
 // the rows of every variable over the X faces near it are set aside, so that the next pass finds
@@ -336,11 +342,13 @@ CoarseToFineResult CoarseToFineMatcher::run(const Progress& progress) const {
                    l > 0 ? fmt::format(", ring {}", ring) : std::string());
       // Propagation alone proves most reduced LPs infeasible, and says where: widen there first.
       if (l > 0 && options_.local_widening) {
-        std::vector<int> faces = faces_near_conflicts(m, 10000, options_.widen_margin, false);
-        const bool again = !faces.empty() && faces == last_widened;  // the X side alone did not help
-        last_widened = faces;
-        if (again) faces = faces_near_conflicts(m, 10000, options_.widen_margin, true);
-        if (widen_locally(faces)) continue;
+        std::vector<int> faces = faces_near_conflicts(m, kMaxConflictPlaces, options_.widen_margin, false);
+        if (!faces.empty()) {
+          const bool again = faces == last_widened;  // the X side alone did not help
+          last_widened = faces;
+          if (again) faces = faces_near_conflicts(m, kMaxConflictPlaces, options_.widen_margin, true);
+          if (widen_locally(faces)) continue;
+        }
       }
       try {
         RoundingOptions ro = options_.rounding;
@@ -366,9 +374,11 @@ CoarseToFineResult CoarseToFineMatcher::run(const Progress& progress) const {
         ProofPlace proof(m);
         for (int64_t i : e.rows()) proof.add(m, i);
         std::vector<int> faces = faces_to_widen(m, proof, options_.widen_margin, false);
-        const bool again = !faces.empty() && faces == last_widened;
-        last_widened = faces;
-        if (again) faces = faces_to_widen(m, proof, options_.widen_margin, true);
+        if (!faces.empty()) {
+          const bool again = faces == last_widened;
+          last_widened = faces;
+          if (again) faces = faces_to_widen(m, proof, options_.widen_margin, true);
+        }
         if (widen_locally(faces)) continue;
         if (ring >= options_.max_ring) throw;
         ++rep.widenings;

@@ -63,6 +63,13 @@ public:
       }
     }
   }
+  // Rows still short of their right-hand side: where rounding is stuck when it gives up.
+  std::vector<int64_t> unsatisfied_rows() const {
+    std::vector<int64_t> rows;
+    for (int64_t i = 0; i < static_cast<int64_t>(s_.rhs.size()); ++i)
+      if (s_.rhs[i] != 0) rows.push_back(i);
+    return rows;
+  }
   // The row at which the last failed propagation found a contradiction.
   int64_t failed_row() const { return failed_row_; }
 
@@ -254,8 +261,41 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
     std::vector<std::pair<int64_t, int>> batch;
   };
   std::vector<Step> history;  // the fixings so far, to undo when a later LP is infeasible
-  for (int round = 1; fixer.state().unsatisfied > 0; ++round) {
-    if (round > options.max_rounds)
+  int backtracks = 0;
+  // Undoes the last fixing and applies less of it; where nothing of it can go (a single variable
+  // that can be neither 1 nor 0), undoes the fixing before it as well, and so on back. Measured:
+  // FAUST 020-024 at 4000 faces got stuck this way in round 15 and lost its whole level. Gives up
+  // with the rows still open (so coarse to fine can widen there) when nothing is left to undo or
+  // after max_backtracks.
+  auto backtrack = [&]() {
+    std::vector<int64_t> open = fixer.unsatisfied_rows();  // where it got stuck
+    for (;;) {
+      if (history.empty() || ++backtracks > options.max_backtracks)
+        throw InfeasibleError(history.empty() ? "rounding: no consistent fixing exists (no binary solution)"
+                                              : "rounding: no binary solution found within " +
+                                                    std::to_string(options.max_backtracks) + " undone fixings",
+                              std::move(open));
+      Step& step = history.back();
+      fixer.undo_to(step.mark);
+      auto smaller = step.batch;
+      bool shrinkable = true;
+      if (smaller.size() > 1) smaller.resize(smaller.size() / 2);
+      else if (smaller.front().second == 1) smaller.front().second = 0;  // the single variable cannot be 1
+      else shrinkable = false;
+      if (shrinkable) {
+        try {
+          step.batch = shrink_and_fix(fixer, smaller, step.mark);  // if still infeasible, shrink further
+          return;
+        } catch (const InfeasibleError&) {
+          fixer.undo_to(step.mark);
+        }
+      }
+      history.pop_back();
+      spdlog::debug("rounding: backtracking over an earlier fixing ({} left)", history.size());
+    }
+  };
+  for (int round = 1, forward = 0; fixer.state().unsatisfied > 0; ++round) {
+    if (forward >= options.max_rounds)
       throw SolverError("rounding did not reach a binary solution in " + std::to_string(options.max_rounds) +
                         " rounds (raise --max-rounds or lower --threshold)");
     Stopwatch clock;
@@ -282,33 +322,11 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
     }
 
     if (r.status == LpStatus::Infeasible) {
-      // The last fixing left an infeasible LP that propagation could not see: undo it and fix
-      // less. Where nothing of it can go (a single variable that can be neither 1 nor 0), undo
-      // the fixing before it as well, and so on back (measured: FAUST 020-024 at 4000 faces got
-      // stuck in round 15, and the whole level was thrown away and widened).
+      // The last fixing left an infeasible LP that propagation could not see: undo it, fix less.
       if (history.empty())
         throw InfeasibleError("rounding: the matching LP is infeasible", certificate_rows(r.y, red.rows));
       info.undone = true;
-      for (;;) {
-        Step& step = history.back();
-        fixer.undo_to(step.mark);
-        auto smaller = step.batch;
-        bool shrinkable = true;
-        if (smaller.size() > 1) smaller.resize(smaller.size() / 2);
-        else if (smaller.front().second == 1) smaller.front().second = 0;  // the single variable cannot be 1
-        else shrinkable = false;
-        if (shrinkable) {
-          try {
-            step.batch = shrink_and_fix(fixer, smaller, step.mark);  // if still infeasible, shrink further
-            break;
-          } catch (const InfeasibleError&) {
-            fixer.undo_to(step.mark);
-          }
-        }
-        history.pop_back();
-        if (history.empty()) throw InfeasibleError("rounding: no consistent fixing exists (no binary solution)");
-        spdlog::debug("round {}: backtracking over round {}'s fixing", round, history.size());
-      }
+      backtrack();
       info.fixed_to_one = fixer.state().ones - history.back().ones;
       info.fixed_to_zero = fixer.state().zeros - history.back().zeros;
       info.seconds = clock.seconds();
@@ -334,12 +352,20 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
     }
     if (batch.empty()) batch.push_back({red.cols[order.front()], 1});
 
+    ++forward;
     Step step{fixer.mark(), fixer.state().ones, fixer.state().zeros, {}};
-    step.batch = shrink_and_fix(fixer, batch, step.mark);
-    info.undone = step.batch != batch;
-    info.fixed_to_one = fixer.state().ones - step.ones;
-    info.fixed_to_zero = fixer.state().zeros - step.zeros;
-    history.push_back(std::move(step));
+    const int64_t ones = step.ones, zeros = step.zeros;
+    try {
+      step.batch = shrink_and_fix(fixer, batch, step.mark);
+      info.undone = step.batch != batch;
+      history.push_back(std::move(step));
+    } catch (const InfeasibleError&) {  // not even the largest can be 1 or 0: an earlier fixing is wrong
+      fixer.undo_to(step.mark);
+      info.undone = true;
+      backtrack();
+    }
+    info.fixed_to_one = fixer.state().ones - ones;
+    info.fixed_to_zero = fixer.state().zeros - zeros;
     info.seconds = clock.seconds();
     result.rounds.push_back(info);
     if (progress) progress(info);

@@ -11,6 +11,8 @@ namespace shapematch {
 struct RoundingOptions {
   double threshold = 0.5;      // fix every variable above this to 1
   int max_rounds = 50;         // then fail with SolverError rather than return a wrong answer
+  int max_backtracks = 200;    // fixings undone after an infeasible LP (each one more, smaller LP
+                               // solve), then fail with InfeasibleError naming the open rows
   std::string solver = "pdhg-cpu";
   SolverParams lp;             // parameters of every LP solve (warm starts are filled in)
 };
