@@ -249,6 +249,7 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
   if (static_cast<int64_t>(energy.size()) != lp.cols() || space.size() != lp.cols())
     throw InvalidInputError("rounding: the space, the LP and the energies disagree in size");
   auto solver = make_solver(options.solver);
+  std::unique_ptr<LpSolver> exact_solver;  // for the small last rounds (exact_below)
   RoundingResult result;
   Fixer fixer(lp);
   if (!fixer.propagate_all())
@@ -295,9 +296,12 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
     }
   };
   for (int round = 1, forward = 0; fixer.state().unsatisfied > 0; ++round) {
+    // Out of rounds: no binary solution found in this space. An InfeasibleError with the open
+    // rows lets coarse to fine widen there rather than give up the whole run.
     if (forward >= options.max_rounds)
-      throw SolverError("rounding did not reach a binary solution in " + std::to_string(options.max_rounds) +
-                        " rounds (raise --max-rounds or lower --threshold)");
+      throw InfeasibleError("rounding did not reach a binary solution in " + std::to_string(options.max_rounds) +
+                                " rounds (raise --max-rounds or lower --threshold)",
+                            fixer.unsatisfied_rows());
     Stopwatch clock;
     const Reduced red = reduce(lp, fixer.state());
     SolverParams params = options.lp;
@@ -307,7 +311,10 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
       for (size_t j = 0; j < red.cols.size(); ++j) params.initial_x[j] = x_full[red.cols[j]];
       for (size_t i = 0; i < red.rows.size(); ++i) params.initial_y[i] = y_full[red.rows[i]];
     }
-    const LpResult r = solver->solve(red.lp, params);
+    // (Not the first round: its relaxation and bound are the chosen solver's.)
+    const bool exact = round > 1 && red.lp.cols() < options.exact_below && options.solver != "clp-dual";
+    if (exact && !exact_solver) exact_solver = make_solver("clp-dual");
+    const LpResult r = (exact ? exact_solver : solver)->solve(red.lp, params);
     RoundingRound info;
     info.round = round;
     info.variables = red.lp.cols();

@@ -10,7 +10,12 @@ namespace shapematch {
 
 struct RoundingOptions {
   double threshold = 0.5;      // fix every variable above this to 1
-  int max_rounds = 50;         // then fail with SolverError rather than return a wrong answer
+  int max_rounds = 50;         // then fail (InfeasibleError, naming the open rows) rather than
+                               // return a wrong answer
+  // Rounds after the first with fewer free variables than this use Clp's dual simplex: exact,
+  // and a vertex, so most of it is already 0/1 (0: never). The first-order solver's approximate
+  // solutions made the last few thousand variables of FAUST at 4000 faces thrash for 50 rounds.
+  int64_t exact_below = 30000;
   int max_backtracks = 200;    // fixings undone after an infeasible LP (each one more, smaller LP
                                // solve), then fail with InfeasibleError naming the open rows
   std::string solver = "pdhg-cpu";
