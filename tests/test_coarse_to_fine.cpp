@@ -13,6 +13,20 @@ using namespace shapematch;
 namespace {
 Mesh lumpy_sphere(int subdivisions, unsigned seed) { return test::lumpy_sphere(subdivisions, seed, 0.1); }
 
+// Two levels on the native solver, for the bent finger pair below.
+CoarseToFineOptions two_levels(int coarsest_faces) {
+  CoarseToFineOptions o;
+  o.hierarchy.levels = 2;
+  o.hierarchy.coarsest_faces = coarsest_faces;
+  o.rounding.solver = "pdhg-cpu";
+  return o;
+}
+
+// The finger straight and bent, decimated to different triangulations.
+CoarseToFineMatcher finger_matcher(const CoarseToFineOptions& o) {
+  return CoarseToFineMatcher(decimate(shapes::bent_finger(10, 8, 8), 80), decimate(shapes::bent_finger(60, 8, 8), 90), o);
+}
+
 std::set<int64_t> full_indices(const ProductSpace& full, const std::vector<ProductTriangle>& list) {
   std::set<int64_t> s;
   for (const auto& t : list) s.insert(full.index_in_full(t));
@@ -236,11 +250,7 @@ TEST_CASE("coarse to fine: an infeasible reduced LP is widened near the proof, n
   // Measured: at ring 0 this pair's finest reduced LP is infeasible; propagation names the
   // places, and widening 17 of 80 faces makes it feasible (the global ring 1 keeps 1.8x as many
   // variables).
-  const Mesh x = shapes::bent_finger(10, 8, 8), y = shapes::bent_finger(60, 8, 8);
-  CoarseToFineOptions o;
-  o.hierarchy.levels = 2;
-  o.hierarchy.coarsest_faces = 16;
-  o.rounding.solver = "pdhg-cpu";
+  CoarseToFineOptions o = two_levels(16);
   o.ring = 0;
   o.max_ring = 2;
   o.widen_margin = 0;
@@ -248,7 +258,7 @@ TEST_CASE("coarse to fine: an infeasible reduced LP is widened near the proof, n
   for (const bool local : {true, false}) {
     CAPTURE(local);
     o.local_widening = local;
-    const CoarseToFineMatcher matcher(decimate(x, 80), decimate(y, 90), o);
+    const CoarseToFineMatcher matcher = finger_matcher(o);  // the result refers to its meshes
     const CoarseToFineResult r = matcher.run();
     const LevelReport& l = r.levels.back();
     CHECK(check_graph_surface(r.finest.space, r.rounding.gamma).ok());
@@ -268,15 +278,11 @@ TEST_CASE("coarse to fine: an infeasible reduced LP is widened near the proof, n
 }
 
 TEST_CASE("coarse to fine: a looser tolerance below the finest level costs fewer iterations there only") {
-  const Mesh x = shapes::bent_finger(10, 8, 8), y = shapes::bent_finger(60, 8, 8);
-  CoarseToFineOptions o;
-  o.hierarchy.levels = 2;
-  o.hierarchy.coarsest_faces = 40;
-  o.rounding.solver = "pdhg-cpu";
+  CoarseToFineOptions o = two_levels(40);
   o.coarse_tolerance = 0.0;
-  const CoarseToFineMatcher tight(decimate(x, 80), decimate(y, 90), o);
+  const CoarseToFineMatcher tight = finger_matcher(o);  // the results refer to their meshes
   o.coarse_tolerance = 1e-2;
-  const CoarseToFineMatcher loose(decimate(x, 80), decimate(y, 90), o);
+  const CoarseToFineMatcher loose = finger_matcher(o);
   const CoarseToFineResult a = tight.run(), b = loose.run();
   MESSAGE("coarsest level iterations: ", a.levels[0].iterations, " at 1e-4, ", b.levels[0].iterations, " at 1e-2");
   CHECK(b.levels[0].iterations < a.levels[0].iterations);
