@@ -374,12 +374,15 @@ CoarseToFineResult CoarseToFineMatcher::run(const Progress& progress) const {
         ProofPlace proof(m);
         for (int64_t i : e.rows()) proof.add(m, i);
         std::vector<int> faces = faces_to_widen(m, proof, options_.widen_margin, false);
+        bool carried = false;
         if (!faces.empty()) {
-          const bool again = faces == last_widened;
+          carried = faces == last_widened;
           last_widened = faces;
-          if (again) faces = faces_to_widen(m, proof, options_.widen_margin, true);
+          if (carried) faces = faces_to_widen(m, proof, options_.widen_margin, true);
         }
         if (widen_locally(faces)) continue;
+        // The X faces there are at their limit: try those that map next to the Y side.
+        if (!carried && widen_locally(faces_to_widen(m, proof, options_.widen_margin, true))) continue;
         if (ring >= options_.max_ring) throw;
         ++rep.widenings;
         spdlog::warn("level {}: the reduced LP at ring {} is infeasible; widening to ring {}", l + 1, ring, ring + 1);
