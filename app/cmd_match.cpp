@@ -218,7 +218,8 @@ int run_match(const MatchArgs& args) {
                               .set("coarsest_faces", args.hierarchy.coarsest_faces)
                               .set("ring", args.ring)
                               .set("neighbourhood", args.neighbourhood)
-                              .set("widen", args.widen));
+                              .set("widen", args.widen)
+                              .set("widen_margin", args.widen_margin));
     report.set("seconds", seconds);
     report.set("peak_rss_mb", peak_rss_mb());
     report.set("round_log", rounds);
