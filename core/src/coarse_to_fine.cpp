@@ -24,7 +24,7 @@ void sort_unique(std::vector<int>& v) {
 // of the face of a π row.
 struct ProofPlace {
   std::vector<char> x, y;  // per vertex
-  ProofPlace(const MatchingLp& m) : x(m.space.x().num_vertices(), 0), y(m.space.y().num_vertices(), 0) {}
+  explicit ProofPlace(const MatchingLp& m) : x(m.space.x().num_vertices(), 0), y(m.space.y().num_vertices(), 0) {}
   void add(const MatchingLp& m, int64_t row) {
     if (row < 0 || row >= m.lp.rows()) return;
     const int64_t face = row - m.closedness_rows;
@@ -322,6 +322,18 @@ CoarseToFineResult CoarseToFineMatcher::run(const Progress& progress) const {
                    lx.mesh.num_faces());
       return true;
     };
+    // The faces to widen for a proof, from find(carry_y): the X side first, and where the same
+    // faces come back (the X side alone did not help) the Y side too. Also says which it took.
+    auto faces_for = [&](const auto& find) {
+      std::vector<int> faces = find(false);
+      bool carried = false;
+      if (!faces.empty()) {
+        carried = faces == last_widened;
+        last_widened = faces;
+        if (carried) faces = find(true);
+      }
+      return std::pair{std::move(faces), carried};
+    };
     for (;;) {
       MatchingLp m;
       if (l == 0) {
@@ -341,15 +353,11 @@ CoarseToFineResult CoarseToFineMatcher::run(const Progress& progress) const {
                    rep.variables, l > 0 ? fmt::format("{:.3g} % of the full space", kept) : "the full space",
                    l > 0 ? fmt::format(", ring {}", ring) : std::string());
       // Propagation alone proves most reduced LPs infeasible, and says where: widen there first.
-      if (l > 0 && options_.local_widening) {
-        std::vector<int> faces = faces_near_conflicts(m, kMaxConflictPlaces, options_.widen_margin, false);
-        if (!faces.empty()) {
-          const bool again = faces == last_widened;  // the X side alone did not help
-          last_widened = faces;
-          if (again) faces = faces_near_conflicts(m, kMaxConflictPlaces, options_.widen_margin, true);
-          if (widen_locally(faces)) continue;
-        }
-      }
+      if (l > 0 && options_.local_widening &&
+          widen_locally(faces_for([&](bool carry_y) {
+                          return faces_near_conflicts(m, kMaxConflictPlaces, options_.widen_margin, carry_y);
+                        }).first))
+        continue;
       try {
         RoundingOptions ro = options_.rounding;
         if (l + 1 < hx_.size()) ro.lp.tolerance = std::max(ro.lp.tolerance, options_.coarse_tolerance);
@@ -373,16 +381,11 @@ CoarseToFineResult CoarseToFineMatcher::run(const Progress& progress) const {
         if (l == 0) throw;
         ProofPlace proof(m);
         for (int64_t i : e.rows()) proof.add(m, i);
-        std::vector<int> faces = faces_to_widen(m, proof, options_.widen_margin, false);
-        bool carried = false;
-        if (!faces.empty()) {
-          carried = faces == last_widened;
-          last_widened = faces;
-          if (carried) faces = faces_to_widen(m, proof, options_.widen_margin, true);
-        }
+        auto find = [&](bool carry_y) { return faces_to_widen(m, proof, options_.widen_margin, carry_y); };
+        const auto [faces, carried] = faces_for(find);
         if (widen_locally(faces)) continue;
         // The X faces there are at their limit: try those that map next to the Y side.
-        if (!carried && widen_locally(faces_to_widen(m, proof, options_.widen_margin, true))) continue;
+        if (!carried && widen_locally(find(true))) continue;
         if (ring >= options_.max_ring) throw;
         ++rep.widenings;
         spdlog::warn("level {}: the reduced LP at ring {} is infeasible; widening to ring {}", l + 1, ring, ring + 1);
