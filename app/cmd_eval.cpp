@@ -109,7 +109,12 @@ int run_eval(const EvalArgs& args) {
   if (!fs::exists(y_file))
     throw IoError(y_file + ": cannot open (Y of " + report_path.string() +
                   "; run eval where match ran, or give --y-mesh)");
-  const Mesh y_full = load_mesh(y_file);
+  // Y as it was read for matching: with its holes closed, if they were (the added vertices come last).
+  LoadOptions as_input;
+  const JsonNode* match_options = report.get("options");
+  const JsonNode* close_holes = match_options ? match_options->get("close_holes") : nullptr;
+  as_input.close_holes = close_holes && close_holes->kind == JsonNode::Kind::Bool && close_holes->number != 0;
+  const Mesh y_full = load_mesh(y_file, as_input);
   if (y_full.num_vertices() != y_input)
     throw InvalidInputError(fmt::format("{}: {} vertices, but Y had {} when it was matched", y_file,
                                         y_full.num_vertices(), y_input));

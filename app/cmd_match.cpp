@@ -212,6 +212,7 @@ int run_match(const MatchArgs& args) {
                               .set("coarse_tolerance", co.coarse_tolerance)
                               .set("faces", args.pair.faces)
                               .set("keep_scale", args.pair.keep_scale)
+                              .set("close_holes", args.pair.close_holes)
                               .set("features", p.features)
                               .set("feature_weight", args.pair.feature_weight)
                               .set("levels", matcher.x_levels().size())

@@ -16,6 +16,8 @@ void add_pair_options(CLI::App& app, PairArgs& args) {
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   app.add_flag("--keep-scale", args.keep_scale, "do not normalise both shapes to unit area");
+  app.add_flag("--close-holes", args.close_holes,
+               "close each boundary loop with a fan around a new vertex instead of rejecting an open mesh");
   app.add_option("--bending", args.bending, "bending weight")->capture_default_str();
   app.add_option("--lame", args.lame, "Lamé parameters λ,μ of the membrane")->delimiter(',')->expected(2);
   app.add_option("--feature-weight", args.feature_weight, "weight μ of the feature term (0: none)")
@@ -45,8 +47,18 @@ MeshPair load_pair(const PairArgs& args) {
   p.y_file = args.y.empty() ? default_mesh_y() : args.y;
   LoadOptions load;
   load.normalize_area = !args.keep_scale;
-  p.x = load_mesh(p.x_file, load);
-  p.y = load_mesh(p.y_file, load);
+  load.close_holes = args.close_holes;
+  auto load_one = [&](const std::string& file) {
+    try {
+      return load_mesh(file, load);
+    } catch (const InvalidInputError& e) {
+      const std::string what = e.what();
+      if (what.find(": not closed:") == std::string::npos) throw;
+      throw InvalidInputError(what + "; --close-holes fills each hole with a fan");
+    }
+  };
+  p.x = load_one(p.x_file);
+  p.y = load_one(p.y_file);
   if (args.features_x.empty() != args.features_y.empty())
     throw InvalidInputError("give both --features-x and --features-y, or neither");
   const bool user = !args.features_x.empty();

@@ -13,6 +13,7 @@ struct PairArgs {
   std::string x, y;  // empty: the bundled pair
   int faces = 0;     // decimate both to about this many faces; 0 keeps them
   bool keep_scale = false;
+  bool close_holes = false;  // fill boundary loops instead of rejecting open meshes
   double bending = 1.0;
   std::vector<double> lame{1.0, 1.0};
   // The feature term (DESIGN.md §5): user descriptors, or the Wave Kernel Signature.

@@ -6,6 +6,7 @@
 
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -157,6 +158,56 @@ TEST_CASE("mesh: OBJ with polygons, comments, texture indices and negative indic
   CHECK(surface_area(m) == doctest::Approx(6.0));
   CHECK(signed_volume(m) == doctest::Approx(1.0));
   check_invalid(path, "face 0 has 4 vertices; only triangles are allowed", {.allow_polygons = false});
+}
+
+TEST_CASE("mesh: close_holes fills each boundary loop with a fan, keeping the file's vertices") {
+  TempDir dir;
+  const Mesh sphere = shapes::icosphere(2);
+  const int n = sphere.num_vertices();
+  auto shared = [&](int f, int g) {
+    int common = 0;
+    for (const int u : sphere.faces[f])
+      for (const int v : sphere.faces[g]) common += u == v;
+    return common;
+  };
+  auto without = [&](std::vector<int> remove) {
+    Mesh m = sphere;
+    m.faces.clear();
+    for (int f = 0; f < sphere.num_faces(); ++f)
+      if (std::find(remove.begin(), remove.end(), f) == remove.end()) m.faces.push_back(sphere.faces[f]);
+    return m;
+  };
+  // Hole A: face 0 and a face across one of its edges (a loop of four). Hole B: one face far away.
+  // Touching: face 0 and a face that shares only one vertex with it.
+  int across = -1, far = -1, corner = -1;
+  for (int f = 1; f < sphere.num_faces(); ++f) {
+    if (shared(0, f) == 2 && across < 0) across = f;
+    if (shared(0, f) == 0 && far < 0 && sphere.vertices[sphere.faces[f][0]].dot(sphere.vertices[sphere.faces[0][0]]) < -0.5)
+      far = f;
+    if (shared(0, f) == 1 && corner < 0) corner = f;
+  }
+  REQUIRE(across > 0);
+  REQUIRE(far > 0);
+  REQUIRE(corner > 0);
+  const std::string path = dir.file("open.off", off(without({0, across, far})));
+  check_invalid(path, "not closed");
+
+  MeshReport report;
+  const Mesh closed = load_mesh(path, {.normalize_area = false, .close_holes = true}, &report);
+  CHECK(report.closed_holes == 2);
+  CHECK(report.genus == 0);
+  REQUIRE(closed.num_vertices() == n + 2);
+  for (int v = 0; v < n; ++v) CHECK((closed.vertices[v] - sphere.vertices[v]).norm() < 1e-5);
+  // Hole B's new vertex is its triangle's centroid; fans of 4 and 3 faces replace the 3 removed.
+  const auto& t = sphere.faces[far];
+  const Eigen::Vector3d centroid = (sphere.vertices[t[0]] + sphere.vertices[t[1]] + sphere.vertices[t[2]]) / 3.0;
+  CHECK(((closed.vertices[n] - centroid).norm() < 1e-5) != ((closed.vertices[n + 1] - centroid).norm() < 1e-5));
+  CHECK(closed.num_faces() == sphere.num_faces() - 3 + 4 + 3);
+  CHECK(signed_volume(closed) > 0);
+
+  // Two holes that meet at a vertex cannot both get a manifold fan.
+  check_invalid(dir.file("touching.off", off(without({0, corner}))), "cannot close holes: boundary loops touch",
+                {.close_holes = true});
 }
 
 TEST_CASE("mesh: a mesh that is consistently inside out is flipped") {

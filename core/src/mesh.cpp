@@ -23,6 +23,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <numeric>
 #include <string_view>
 
@@ -430,6 +431,41 @@ void write_mesh(const Mesh& mesh, const std::string& path, const std::vector<std
   });
 }
 
+// Closes every boundary loop with a fan around a new vertex at the loop's centroid. The loops
+// come from the half-edges that have no opposite; a vertex where two of them start would make
+// the fans non-manifold, so that is an error. Loops are closed in order of their smallest
+// vertex, so equal connectivity (one animal's poses) gets equal new vertex indices.
+int close_boundary_loops(Mesh& mesh) {
+  std::map<std::pair<int, int>, int> directed;  // half-edge -> how often it occurs
+  for (const auto& f : mesh.faces)
+    for (int k = 0; k < 3; ++k) ++directed[{f[k], f[(k + 1) % 3]}];
+  // A boundary half-edge u->v has no v->u; the fan must traverse v->u.
+  std::map<int, int> next;  // v -> u for each boundary half-edge u->v
+  for (const auto& [e, count] : directed) {
+    if (count > 1 || directed.count({e.second, e.first})) continue;
+    if (!next.emplace(e.second, e.first).second)
+      fail(mesh.name, fmt::format("cannot close holes: boundary loops touch at vertex {}", e.second));
+  }
+  int loops = 0;
+  while (!next.empty()) {
+    std::vector<int> loop;
+    int v = next.begin()->first;
+    for (auto it = next.find(v); it != next.end(); it = next.find(v)) {
+      loop.push_back(v);
+      v = it->second;
+      next.erase(it);
+    }
+    if (v != loop.front()) fail(mesh.name, fmt::format("cannot close holes: the boundary at vertex {} is not a loop", v));
+    Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+    for (const int u : loop) centroid += mesh.vertices[u];
+    const int c = mesh.num_vertices();
+    mesh.vertices.push_back(centroid / static_cast<double>(loop.size()));
+    for (size_t k = 0; k < loop.size(); ++k) mesh.faces.push_back({loop[k], loop[(k + 1) % loop.size()], c});
+    ++loops;
+  }
+  return loops;
+}
+
 }  // namespace
 
 // ---- Mesh -------------------------------------------------------------------------------------
@@ -595,6 +631,8 @@ Mesh load_mesh(const std::string& path, const LoadOptions& options, MeshReport* 
   const RawMesh raw = ext == ".off" ? read_off(path) : ext == ".obj" ? read_obj(path) : read_with_openmesh(path, ext);
   int triangulated = 0;
   Mesh mesh = triangulate(raw, path, options.allow_polygons, triangulated);
+  const int closed = options.close_holes ? close_boundary_loops(mesh) : 0;
+  if (closed > 0) spdlog::warn("{}: closed {} boundary loops with a vertex each", path, closed);
   const int genus = validate_mesh(mesh);
   mesh.build_edges();
   if (signed_volume(mesh) < 0) {
@@ -605,6 +643,7 @@ Mesh load_mesh(const std::string& path, const LoadOptions& options, MeshReport* 
   if (report) {
     report->genus = genus;
     report->triangulated_faces = triangulated;
+    report->closed_holes = closed;
   }
   return mesh;
 }

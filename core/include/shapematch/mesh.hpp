@@ -41,11 +41,15 @@ struct Mesh {
 struct MeshReport {
   int genus = 0;
   int triangulated_faces = 0;  // polygons split into triangles while loading
+  int closed_holes = 0;        // boundary loops closed (LoadOptions::close_holes)
 };
 
 struct LoadOptions {
   bool normalize_area = true;  // scale to unit total area (DESIGN.md §5 "Scale")
   bool allow_polygons = true;  // triangulate polygons with a warning instead of failing
+  // Close each boundary loop with a fan around a new vertex at its centroid (appended after the
+  // file's vertices, so vertex indices of the file keep their meaning), instead of failing.
+  bool close_holes = false;
 };
 
 // Reads OFF, OBJ, PLY or STL (OFF and OBJ in double precision, PLY and STL through OpenMesh in
