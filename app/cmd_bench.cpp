@@ -507,7 +507,7 @@ struct MatchRow {
   std::string name;  // the faces asked for, or the pair
   double faces_x = kNaN, faces_y = kNaN, levels = kNaN, variables = kNaN, rounds = kNaN;
   double energy = kNaN, lower_bound = kNaN, gap = kNaN;
-  double mean_error = kNaN, median_error = kNaN, flips = kNaN;
+  double mean_error = kNaN, median_error = kNaN, symmetric_mean_error = kNaN, flips = kNaN;
   ChildRun run;
 };
 
@@ -666,7 +666,7 @@ struct PairSpec {
   std::vector<std::string> truth;  // the options of `eval` that name the ground truth
 };
 
-// One pair per line, `X Y [identity | A.vts B.vts | map FILE] [# comment]`; relative paths are
+// One pair per line, `X Y [identity | A.vts B.vts [B.sym.vts] | map FILE] [# comment]`; relative paths are
 // relative to the file, so that a pairs file can travel with its data set.
 std::vector<PairSpec> read_pairs_file(const std::string& path) {
   std::ifstream in(path);
@@ -686,8 +686,9 @@ std::vector<PairSpec> read_pairs_file(const std::string& path) {
     if (w.empty()) continue;
     const bool identity = w.size() == 2 || (w.size() == 3 && w[2] == "identity");
     const bool map = w.size() == 4 && w[2] == "map";
-    if (!identity && w.size() != 4)
-      throw InvalidInputError(fmt::format("{}:{}: expected `X Y [identity | A.vts B.vts | map FILE]`, found {} field{}",
+    const bool symmetric = w.size() == 5;
+    if (!identity && w.size() != 4 && !symmetric)
+      throw InvalidInputError(fmt::format("{}:{}: expected `X Y [identity | A.vts B.vts [B.sym.vts] | map FILE]`, found {} field{}",
                                           path, number, w.size(), w.size() == 1 ? "" : "s"));
     PairSpec p{resolve(w[0]), resolve(w[1]), {}};
     if (identity)
@@ -696,6 +697,7 @@ std::vector<PairSpec> read_pairs_file(const std::string& path) {
       p.truth = {"--gt-map", resolve(w[3])};
     else
       p.truth = {"--gt-x", resolve(w[2]), "--gt-y", resolve(w[3])};
+    if (symmetric) p.truth.insert(p.truth.end(), {"--gt-y-sym", resolve(w[4])});
     pairs.push_back(std::move(p));
   }
   if (pairs.empty()) throw InvalidInputError(path + ": no pairs (one `X Y [ground truth]` per line)");
@@ -716,7 +718,7 @@ double median_ok(const std::vector<MatchRow>& rows, double (*value)(const MatchR
 const std::vector<std::string> kPairsHeader{"pair",        "faces_x", "faces_y", "seconds",
                                             "peak_rss_mb", "energy",  "lower_bound", "gap",
                                             "rounds",      "mean_geodesic_error", "median_geodesic_error",
-                                            "orientation_flips", "status"};
+                                            "symmetric_mean_geodesic_error", "orientation_flips", "status"};
 
 // The rows plus a last one of medians; `csv` chooses full precision over readable widths.
 std::vector<std::vector<std::string>> pairs_cells(const std::vector<MatchRow>& rows, bool csv) {
@@ -727,14 +729,15 @@ std::vector<std::vector<std::string>> pairs_cells(const std::vector<MatchRow>& r
     cells.push_back({r.name, csv_int(r.faces_x), csv_int(r.faces_y), num(r.run.seconds, 6, 2),
                      num(r.run.peak_rss_mb, 5, 0), general(r.energy, 12), general(r.lower_bound, 12),
                      general(r.gap, 4), csv_int(r.rounds), num(r.mean_error, 6, 4), num(r.median_error, 6, 4),
-                     csv_int(r.flips), r.run.status});
+                     num(r.symmetric_mean_error, 6, 4), csv_int(r.flips), r.run.status});
   const auto ok = std::count_if(rows.begin(), rows.end(), [](const MatchRow& r) { return r.run.status == "ok"; });
   cells.push_back({csv ? "median" : "**median**", "", "",
                    num(median_ok(rows, [](const MatchRow& r) { return r.run.seconds; }), 6, 2),
                    num(median_ok(rows, [](const MatchRow& r) { return r.run.peak_rss_mb; }), 5, 0), "", "",
                    general(median_ok(rows, [](const MatchRow& r) { return r.gap; }), 4), "",
                    num(median_ok(rows, [](const MatchRow& r) { return r.mean_error; }), 6, 4),
-                   num(median_ok(rows, [](const MatchRow& r) { return r.median_error; }), 6, 4), "",
+                   num(median_ok(rows, [](const MatchRow& r) { return r.median_error; }), 6, 4),
+                   num(median_ok(rows, [](const MatchRow& r) { return r.symmetric_mean_error; }), 6, 4), "",
                    fmt::format("{} of {} ok", ok, rows.size())});
   return cells;
 }
@@ -759,6 +762,7 @@ void evaluate(const BenchMatchArgs& args, const PairSpec& pair, const fs::path& 
     const JsonNode result = read_json_file(json_path);
     row.mean_error = result.number_or_nan("mean_geodesic_error");
     row.median_error = result.number_or_nan("median_geodesic_error");
+    row.symmetric_mean_error = result.number_or_nan("symmetric_mean_geodesic_error");
     row.flips = result.number_or_nan("orientation_flips");
   } catch (const Error& error) {
     row.run.status = std::string("eval failed: ") + error.what();
@@ -830,7 +834,7 @@ Action add_bench_command(CLI::App& app) {
       "match", "time whole match runs at growing sizes, or match and evaluate a list of pairs (CSV, Markdown, plot)");
   auto m = std::make_shared<BenchMatchArgs>();
   auto* pair = match->add_option("--pair", m->pair, "scaling: the two meshes X Y; default: bundled asset pair")->expected(2);
-  match->add_option("--pairs", m->pairs_file, "pairs mode: a file of lines `X Y [identity | A.vts B.vts | map FILE]`")
+  match->add_option("--pairs", m->pairs_file, "pairs mode: a file of lines `X Y [identity | A.vts B.vts [B.sym.vts] | map FILE]`")
       ->excludes(pair);
   const CLI::Validator size(
       [](std::string& s) -> std::string {

@@ -1,6 +1,8 @@
 // End-to-end tests of `shapematch bench`. bench lp: the CSV has its columns and one row per solver
 // and size, the solvers agree, and the plot is made where Debian's Python has matplotlib. bench
 // match: whole match runs per size or per pair of a pairs file, where a failed pair is a row.
+#include "shapematch/mesh.hpp"
+
 #include <doctest/doctest.h>
 
 #include <algorithm>
@@ -189,9 +191,18 @@ TEST_CASE("cli: bench match --pairs matches and evaluates each pair and adds a r
   // Relative to the pairs file, which lives elsewhere than the meshes.
   const fs::path assets = fs::relative(kAssets, dir);
   const std::string x = (assets / "finger_straight.off").string(), y = (assets / "finger_bent.off").string();
+  // The second line scores the identity as .vts files, with a reversed order as the "symmetric" truth.
+  const int n = shapematch::load_mesh((fs::path(kAssets) / "finger_straight.off").string()).num_vertices();
+  std::ofstream same(dir / "same.vts"), reversed(dir / "reversed.vts");
+  for (int v = 1; v <= n; ++v) {
+    same << v << "\n";
+    reversed << n + 1 - v << "\n";
+  }
+  same.close();
+  reversed.close();
   std::ofstream(dir / "pairs.txt") << "# the bundled pair shares its connectivity: identity is the truth\n"
                                    << x << " " << y << "\n\n"
-                                   << x << " " << y << " identity\n";
+                                   << x << " " << y << " same.vts same.vts reversed.vts\n";
   REQUIRE(run_cli("bench match --pairs " + (dir / "pairs.txt").string() + " --faces 20 --out " + (dir / "out").string() +
                       " -- --backend cpu",
                   err) == 0);
@@ -199,7 +210,8 @@ TEST_CASE("cli: bench match --pairs matches and evaluates each pair and adds a r
   const auto [header, rows] = read_csv(dir / "out" / "bench_pairs.csv");
   const std::vector<std::string> expected = {"pair", "faces_x", "faces_y", "seconds", "peak_rss_mb", "energy",
                                              "lower_bound", "gap", "rounds", "mean_geodesic_error",
-                                             "median_geodesic_error", "orientation_flips", "status"};
+                                             "median_geodesic_error", "symmetric_mean_geodesic_error",
+                                             "orientation_flips", "status"};
   REQUIRE(header == expected);
   REQUIRE(rows.size() == 3);
   std::vector<double> seconds;
@@ -218,6 +230,9 @@ TEST_CASE("cli: bench match --pairs matches and evaluates each pair and adds a r
     CHECK(mean < 3);
     CHECK(median >= 0);
     CHECK(std::stoi(row.at("orientation_flips")) >= 0);
+    // Only the second line names a symmetric truth, a different one, so its error differs.
+    CHECK(row.at("symmetric_mean_geodesic_error").empty() == (i == 0));
+    if (i == 1) CHECK(std::stod(row.at("symmetric_mean_geodesic_error")) != doctest::Approx(mean));
     seconds.push_back(std::stod(row.at("seconds")));
   }
   const auto& median = rows[2];

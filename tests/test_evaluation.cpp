@@ -349,6 +349,26 @@ TEST_CASE("evaluation: shapematch eval reads a match directory through the verte
               dir);
   REQUIRE_MESSAGE(r.code == 0, r.err);
   CHECK(json_number(r.out, "mean_geodesic_error") == 0.0);
+  CHECK(r.out.find("symmetric") == std::string::npos);
+  // A symmetric ground truth is scored as well, and the better of the two named.
+  std::string reversed;
+  for (int v = 0; v < n; ++v) reversed += std::to_string(n - v) + "\n";
+  write(dir / "reversed.vts", reversed);
+  r = run_cli("eval " + out.string() + " --gt-x " + (dir / "a.vts").string() + " --gt-y " + (dir / "a.vts").string() +
+                  " --gt-y-sym " + (dir / "reversed.vts").string(),
+              dir);
+  REQUIRE_MESSAGE(r.code == 0, r.err);
+  CHECK(json_number(r.out, "mean_geodesic_error") == 0.0);
+  CHECK(json_number(r.out, "symmetric_mean_geodesic_error") > 0.1);
+  CHECK(json_number(r.out, "best_mean_geodesic_error") == 0.0);
+  CHECK(r.out.find("\"best_ground_truth\": \"direct\"") != std::string::npos);
+  r = run_cli("eval " + out.string() + " --gt-x " + (dir / "a.vts").string() + " --gt-y " +
+                  (dir / "reversed.vts").string() + " --gt-y-sym " + (dir / "a.vts").string(),
+              dir);
+  REQUIRE_MESSAGE(r.code == 0, r.err);
+  CHECK(json_number(r.out, "mean_geodesic_error") > 0.1);
+  CHECK(json_number(r.out, "best_mean_geodesic_error") == 0.0);
+  CHECK(r.out.find("\"best_ground_truth\": \"symmetric\"") != std::string::npos);
   std::string two_columns;
   for (int v = 0; v < n; v += 2) two_columns += std::to_string(v + 1) + " " + std::to_string(v + 1) + "\n";
   write(dir / "map.txt", two_columns);
@@ -368,6 +388,8 @@ TEST_CASE("evaluation: shapematch eval reads a match directory through the verte
   r = run_cli("eval " + out.string() + " --gt identity --gt-map " + (dir / "map.txt").string(), dir);
   CHECK(r.code != 0);
   r = run_cli("eval " + out.string() + " --gt-x " + (dir / "a.vts").string(), dir);
+  CHECK(r.code != 0);
+  r = run_cli("eval " + out.string() + " --gt-y-sym " + (dir / "a.vts").string(), dir);
   CHECK(r.code != 0);
 
   // Malformed inputs: exit 1 and one line naming the file.
