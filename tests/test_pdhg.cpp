@@ -4,6 +4,7 @@
 #include "shapematch/pdhg.hpp"
 #include "shapematch/shapes.hpp"
 #include "test_helpers.hpp"
+#include "parallel.hpp"
 #include "thread_pool.hpp"
 
 #include <doctest/doctest.h>
@@ -158,6 +159,23 @@ TEST_CASE("thread pool: a chunk that throws is rethrown to the caller after ever
       std::atomic<int> again{0};
       pool.run(5, [&](int) { again.fetch_add(1); });
       CHECK(again.load() == 5);
+    }
+  }
+}
+
+TEST_CASE("parallel_chunks: a chunk that throws is rethrown after every chunk ran") {
+  for (const int threads : {1, 2, 4}) {
+    for (const int bad : {0, threads - 1}) {
+      CAPTURE(threads);
+      CAPTURE(bad);
+      std::atomic<int64_t> covered{0};
+      CHECK_THROWS_AS(detail::parallel_chunks(100000, threads,
+                                              [&](int64_t b, int64_t e, int chunk) {
+                                                covered.fetch_add(e - b);
+                                                if (chunk == bad) throw std::runtime_error("chunk failed");
+                                              }),
+                      std::runtime_error);
+      CHECK(covered.load() == 100000);
     }
   }
 }

@@ -3,6 +3,7 @@
 // native PDHG kernels are uniform, so static chunks balance well and need no scheduler).
 #include <algorithm>
 #include <cstdint>
+#include <exception>
 #include <thread>
 #include <vector>
 
@@ -13,7 +14,9 @@ inline int hardware_threads() {
   return n == 0 ? 1 : static_cast<int>(n);
 }
 
-// Calls body(begin, end, chunk) for `threads` contiguous chunks of [0, n).
+// Calls body(begin, end, chunk) for `threads` contiguous chunks of [0, n). If bodies throw, every
+// chunk still runs to its end and the first chunk's exception is rethrown here (an exception
+// escaping a std::thread would terminate the process).
 template <class Body>
 void parallel_chunks(int64_t n, int threads, Body&& body) {
   if (threads <= 0) threads = hardware_threads();
@@ -22,15 +25,25 @@ void parallel_chunks(int64_t n, int threads, Body&& body) {
     body(int64_t{0}, n, 0);
     return;
   }
+  std::vector<std::exception_ptr> errors(threads);
+  auto guarded = [&body, &errors](int64_t b, int64_t e, int t) {
+    try {
+      body(b, e, t);
+    } catch (...) {
+      errors[t] = std::current_exception();
+    }
+  };
   std::vector<std::thread> pool;
   pool.reserve(threads - 1);
   const int64_t step = (n + threads - 1) / threads;
   for (int t = 1; t < threads; ++t) {
     const int64_t b = std::min(n, t * step), e = std::min(n, (t + 1) * step);
-    pool.emplace_back([&body, b, e, t] { body(b, e, t); });
+    pool.emplace_back(guarded, b, e, t);
   }
-  body(int64_t{0}, std::min(n, step), 0);
+  guarded(int64_t{0}, std::min(n, step), 0);
   for (auto& th : pool) th.join();
+  for (const auto& error : errors)
+    if (error) std::rethrow_exception(error);
 }
 
 template <class Body>
