@@ -186,3 +186,27 @@ TEST_CASE("rounding: an LP with no binary solution ends in InfeasibleError namin
     CHECK(e.rows().size() == 3);  // all three rows were open where it got stuck
   }
 }
+
+TEST_CASE("rounding: a fixing of an earlier round that leaves no binary solution is undone") {
+  // Variables a, a', x1, x2, x3. a + a' = 1; x_i + x_j + a' = 1 for the three pairs. With a = 1
+  // the x form an odd cycle whose only solution is x = 1/2; with a' = 1 all x are 0. a is free
+  // and a' costs 10, so the LP picks a = 1 (x = 1/2). Round 1 fixes a; round 2 finds that x1 can
+  // be neither 1 nor 0; only undoing round 1's fixing (a = 0) leads to the binary solution.
+  const LpProblem lp = test::dense_lp({{1, 1, 0, 0, 0}, {0, 1, 1, 1, 0}, {0, 1, 0, 1, 1}, {0, 1, 1, 0, 1}},
+                                      {1, 1, 1, 1}, {0, 10, 0, 0, 0});
+  const Mesh o = shapes::octahedron();  // a space of five variables, only for the sizes
+  const auto id = identity_matching(o);
+  const ProductSpace space = ProductSpace::from_list(o, o, {id[0], id[1], id[2], id[3], id[4]});
+  RoundingOptions options;
+  options.solver = "clp-dual";  // a vertex: x = 1/2 exactly, so round 2 has no candidate above 0.5
+  const RoundingResult r = round_to_graph_surface(space, lp, {0, 10, 0, 0, 0}, options);
+  CHECK(r.gamma == std::vector<int64_t>{1});
+  CHECK(r.energy == 10.0);
+  CHECK(r.lower_bound == doctest::Approx(0.0));
+  REQUIRE(r.rounds.size() >= 2);
+  CHECK(!r.rounds[0].undone);
+  CHECK(r.rounds[1].undone);
+  // Without backtracking over rounds the same LP ends in an error.
+  options.max_backtracks = 0;
+  CHECK_THROWS_AS(round_to_graph_surface(space, lp, {0, 10, 0, 0, 0}, options), InfeasibleError);
+}
