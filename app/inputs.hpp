@@ -14,7 +14,7 @@ struct PairArgs {
   int faces = 0;     // decimate both to about this many faces; 0 keeps them
   bool keep_scale = false;
   bool close_holes = false;  // fill boundary loops instead of rejecting open meshes
-  double bending = 1.0;
+  double bending = EnergyOptions{}.bending_weight;
   std::vector<double> lame{1.0, 1.0};
   // The feature term (DESIGN.md §5): user descriptors, or the Wave Kernel Signature.
   std::string features_x, features_y;
