@@ -28,6 +28,7 @@ struct MatchArgs {
   std::string backend = "auto";
   double threshold = 0.5;
   int max_rounds = 50;
+  double fractional_batch = RoundingOptions{}.fractional_batch;
   double tolerance = 1e-4;
   double coarse_tolerance = CoarseToFineOptions{}.coarse_tolerance;
   double time_limit = std::numeric_limits<double>::infinity();
@@ -96,6 +97,7 @@ int run_match(const MatchArgs& args) {
   ro.solver = solver_for(args);
   ro.threshold = args.threshold;
   ro.max_rounds = args.max_rounds;
+  ro.fractional_batch = args.fractional_batch;
   ro.lp.tolerance = args.tolerance;
   ro.lp.time_limit = args.time_limit;
   ro.lp.device = args.device;
@@ -208,6 +210,7 @@ int run_match(const MatchArgs& args) {
                               .set("lame_lambda", args.pair.lame.at(0))
                               .set("lame_mu", args.pair.lame.at(1))
                               .set("threshold", args.threshold)
+                              .set("fractional_batch", args.fractional_batch)
                               .set("tolerance", args.tolerance)
                               .set("coarse_tolerance", co.coarse_tolerance)
                               .set("faces", args.pair.faces)
@@ -217,6 +220,7 @@ int run_match(const MatchArgs& args) {
                               .set("feature_weight", args.pair.feature_weight)
                               .set("levels", matcher.x_levels().size())
                               .set("coarsest_faces", args.hierarchy.coarsest_faces)
+                              .set("second_faces", args.hierarchy.second_faces)
                               .set("ring", args.ring)
                               .set("neighbourhood", args.neighbourhood)
                               .set("widen", args.widen)
@@ -242,6 +246,8 @@ int run_match(const MatchArgs& args) {
                       .set("lower_bound", l.lower_bound)
                       .set("energy", l.energy)
                       .set("gap", l.gap)
+                      .set("second_start_energy", l.second_start_energy)
+                      .set("second_start_kept", l.second_start_kept)
                       .set("seconds", l.seconds)
                       .set("peak_rss_mb", l.peak_rss_mb));
     report.set("levels", levels);
@@ -269,6 +275,11 @@ Action add_match_command(CLI::App& app) {
   app.add_option("--threshold", a->threshold, "fix LP values above this to 1")
       ->check(CLI::Range(0.0, 1.0))
       ->capture_default_str();
+  app.add_option("--fractional-batch", a->fractional_batch,
+                 "where no LP value exceeds the threshold, fix the largest of up to this fraction of the open faces "
+                 "(0: the single largest)")
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str();
   app.add_option("--max-rounds", a->max_rounds, "rounding rounds before giving up")->capture_default_str();
   app.add_option("--tol", a->tolerance, "LP tolerance")->capture_default_str();
   app.add_option("--coarse-tol", a->coarse_tolerance, "LP tolerance of the levels below the finest, where looser than --tol")
@@ -280,6 +291,11 @@ Action add_match_command(CLI::App& app) {
       ->capture_default_str();
   app.add_option("--coarsest-faces", a->hierarchy.coarsest_faces, "faces of the coarsest level")
       ->check(CLI::Range(4, 1 << 30))
+      ->capture_default_str();
+  app.add_option("--second-faces", a->hierarchy.second_faces,
+                 "faces of the level above the coarsest, which is also solved over its full product space (the "
+                 "lower-energy Γ goes on); 0: off, levels geometric from the coarsest")
+      ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   app.add_option("--ring", a->ring, "neighbourhood rings of the reduced product space (eq. 17)")
       ->check(CLI::Range(0, 8))

@@ -6,6 +6,7 @@
 
 #include <doctest/doctest.h>
 
+#include <cmath>
 #include <set>
 
 using namespace shapematch;
@@ -289,4 +290,30 @@ TEST_CASE("coarse to fine: a looser tolerance below the finest level costs fewer
   CHECK(b.levels[0].iterations < a.levels[0].iterations);
   CHECK(check_graph_surface(b.finest.space, b.rounding.gamma).ok());
   CHECK(b.levels[1].lower_bound <= b.levels[1].energy + 1e-9);
+}
+
+TEST_CASE("coarse to fine: the second start solves the second level twice and keeps the lower energy") {
+  CoarseToFineOptions o;
+  o.hierarchy.coarsest_faces = 12;
+  o.hierarchy.second_faces = 24;
+  o.rounding.solver = "pdhg-cpu";
+  o.second_start = false;
+  const CoarseToFineMatcher plain_matcher = finger_matcher(o);  // the results refer to their meshes
+  REQUIRE(plain_matcher.x_levels().size() == 3);
+  const CoarseToFineResult plain = plain_matcher.run();
+  CHECK(std::isnan(plain.levels[1].second_start_energy));
+  o.second_start = true;
+  const CoarseToFineMatcher matcher = finger_matcher(o);
+  const CoarseToFineResult r = matcher.run();
+  const LevelReport& l = r.levels[1];
+  REQUIRE(std::isfinite(l.second_start_energy));
+  MESSAGE("level 2: refined ", plain.levels[1].energy, ", second start ", l.second_start_energy);
+  // The same refined solve as without the second start, then the lower of the two goes on.
+  CHECK(l.energy == doctest::Approx(std::min(plain.levels[1].energy, l.second_start_energy)).epsilon(1e-12));
+  CHECK(l.second_start_kept == (l.second_start_energy < plain.levels[1].energy));
+  if (l.second_start_kept) CHECK(l.ring == -1);
+  CHECK(std::isnan(r.levels[0].second_start_energy));
+  CHECK(std::isnan(r.levels[2].second_start_energy));
+  CHECK(check_graph_surface(r.finest.space, r.rounding.gamma).ok());
+  CHECK(satisfies_exactly(r.finest.lp, r.rounding.gamma));
 }

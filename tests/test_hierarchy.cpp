@@ -28,6 +28,20 @@ TEST_CASE("hierarchy: face counts are geometric from the coarsest level to the i
   CHECK_THROWS_AS(level_face_counts(1000, o), InvalidInputError);
 }
 
+TEST_CASE("hierarchy: a second level of given size sits above the coarsest, geometric from there") {
+  HierarchyOptions o;
+  o.coarsest_faces = 100;
+  o.second_faces = 200;
+  CHECK(level_face_counts(500, o) == std::vector<int>{100, 200, 500});
+  CHECK(level_face_counts(2000, o) == std::vector<int>{100, 200, 632, 2000});
+  CHECK(level_face_counts(200, o) == std::vector<int>{100, 200});   // the input is the second level
+  CHECK(level_face_counts(150, o) == std::vector<int>{100, 150});   // smaller than the second level
+  o.levels = 3;  // a pair's common count: one level for the coarsest, the rest above the second
+  CHECK(level_face_counts(4000, o) == std::vector<int>{100, 200, 4000});
+  o.levels = 4;
+  CHECK(level_face_counts(150, o) == std::vector<int>{100, 114, 131, 150});  // no room: plain geometric
+}
+
 TEST_CASE("hierarchy: decimation keeps a subset of the input vertices and says which") {
   const Mesh m = lumpy_sphere(3, 1);
   std::vector<int> kept;

@@ -269,8 +269,13 @@ CoarseToFineMatcher::CoarseToFineMatcher(const Mesh& x, const Mesh& y, CoarseToF
   if (ho.levels == 0)
     ho.levels = static_cast<int>(
         std::max(level_face_counts(x.num_faces(), ho).size(), level_face_counts(y.num_faces(), ho).size()));
-  hx_ = build_hierarchy(x, level_face_counts(x.num_faces(), ho));
-  hy_ = build_hierarchy(y, level_face_counts(y.num_faces(), ho));
+  const std::vector<int> cx = level_face_counts(x.num_faces(), ho), cy = level_face_counts(y.num_faces(), ho);
+  hx_ = build_hierarchy(x, cx);
+  hy_ = build_hierarchy(y, cy);
+  // A second start only where both shapes have the second level of that size (not where a small
+  // input made the levels plain geometric).
+  second_level_ = options_.second_start && ho.second_faces > 0 && cx.size() > 1 && cx[1] == ho.second_faces &&
+                  cy[1] == ho.second_faces;
   if (hx_.size() != hy_.size()) throw Error("coarse to fine: the hierarchies differ in length (a bug)");
   if (options_.matching.features_x.size() > 0 || options_.matching.features_y.size() > 0)
     set_features(std::move(options_.matching.features_x), std::move(options_.matching.features_y));
@@ -334,70 +339,127 @@ CoarseToFineResult CoarseToFineMatcher::run(const Progress& progress) const {
       }
       return std::pair{std::move(faces), carried};
     };
-    for (;;) {
-      MatchingLp m;
-      if (l == 0) {
-        m = build_matching_lp(ProductSpace::full(lx.mesh, ly.mesh), model, options_.matching.scale_costs);
-      } else {
-        rep.ring = ring;
-        m = build_matching_lp(
-            ProductSpace::from_list(lx.mesh, ly.mesh,
-                                    reduced_product_space(lx, ly, hx_.levels[l - 1].mesh, hy_.levels[l - 1].mesh,
-                                                          coarse_gamma, ring, options_.neighbourhood, extra)),
-            model, options_.matching.scale_costs);
-      }
-      rep.variables = m.lp.cols();
-      rep.constraints = m.lp.rows();
-      const double kept = 100.0 * double(rep.variables) / double(rep.full_variables);
-      spdlog::info("level {}/{}: {} × {} faces, {} variables ({}){}", l + 1, hx_.size(), rep.faces_x, rep.faces_y,
-                   rep.variables, l > 0 ? fmt::format("{:.3g} % of the full space", kept) : "the full space",
-                   l > 0 ? fmt::format(", ring {}", ring) : std::string());
-      // Propagation alone proves most reduced LPs infeasible, and says where: widen there first.
-      if (l > 0 && options_.local_widening &&
-          widen_locally(faces_for([&](bool carry_y) {
-                          return faces_near_conflicts(m, kMaxConflictPlaces, options_.widen_margin, carry_y);
-                        }).first))
-        continue;
-      try {
-        RoundingOptions ro = options_.rounding;
-        if (l + 1 < hx_.size()) ro.lp.tolerance = std::max(ro.lp.tolerance, options_.coarse_tolerance);
-        RoundingResult rr = round_to_graph_surface(m.space, m.lp, m.energy, ro,
-                                                   [&](const RoundingRound& r) {
-                                                     if (progress) progress(rep, r);
-                                                   });
-        rep.rounds = static_cast<int>(rr.rounds.size());
-        for (const auto& r : rr.rounds) rep.iterations += r.iterations;
-        rep.lower_bound = rr.lower_bound;
-        rep.energy = rr.energy;
-        rep.gap = rr.gap;
-        coarse_gamma.clear();
-        for (int64_t j : rr.gamma) coarse_gamma.push_back(m.space[j]);
-        if (l + 1 == hx_.size()) {
-          result.finest = std::move(m);
-          result.rounding = std::move(rr);
+    // The second start (CoarseToFineOptions::second_start) also rescues a level whose refined
+    // space stayed infeasible at the largest ring.
+    const bool second_start = l == 1 && second_level_;
+    bool refined = true;
+    try {
+      for (;;) {
+        MatchingLp m;
+        if (l == 0) {
+          m = build_matching_lp(ProductSpace::full(lx.mesh, ly.mesh), model, options_.matching.scale_costs);
+        } else {
+          rep.ring = ring;
+          m = build_matching_lp(
+              ProductSpace::from_list(lx.mesh, ly.mesh,
+                                      reduced_product_space(lx, ly, hx_.levels[l - 1].mesh, hy_.levels[l - 1].mesh,
+                                                            coarse_gamma, ring, options_.neighbourhood, extra)),
+              model, options_.matching.scale_costs);
         }
-        break;
-      } catch (const InfeasibleError& e) {
-        if (l == 0) throw;
-        ProofPlace proof(m);
-        for (int64_t i : e.rows()) proof.add(m, i);
-        auto find = [&](bool carry_y) { return faces_to_widen(m, proof, options_.widen_margin, carry_y); };
-        const auto [faces, carried] = faces_for(find);
-        if (widen_locally(faces)) continue;
-        // The X faces there are at their limit: try those that map next to the Y side.
-        if (!carried && widen_locally(find(true))) continue;
-        if (ring >= options_.max_ring) throw;
-        ++rep.widenings;
-        spdlog::warn("level {}: the reduced LP at ring {} is infeasible; widening to ring {}", l + 1, ring, ring + 1);
-        ++ring;
-        for (int& x : extra) x = std::max(0, std::min(x, options_.max_ring - ring));
+        rep.variables = m.lp.cols();
+        rep.constraints = m.lp.rows();
+        const double kept = 100.0 * double(rep.variables) / double(rep.full_variables);
+        spdlog::info("level {}/{}: {} × {} faces, {} variables ({}){}", l + 1, hx_.size(), rep.faces_x, rep.faces_y,
+                     rep.variables, l > 0 ? fmt::format("{:.3g} % of the full space", kept) : "the full space",
+                     l > 0 ? fmt::format(", ring {}", ring) : std::string());
+        // Propagation alone proves most reduced LPs infeasible, and says where: widen there first.
+        if (l > 0 && options_.local_widening &&
+            widen_locally(faces_for([&](bool carry_y) {
+                            return faces_near_conflicts(m, kMaxConflictPlaces, options_.widen_margin, carry_y);
+                          }).first))
+          continue;
+        try {
+          RoundingOptions ro = options_.rounding;
+          if (l + 1 < hx_.size()) ro.lp.tolerance = std::max(ro.lp.tolerance, options_.coarse_tolerance);
+          RoundingResult rr = round_to_graph_surface(m.space, m.lp, m.energy, ro,
+                                                     [&](const RoundingRound& r) {
+                                                       if (progress) progress(rep, r);
+                                                     });
+          rep.rounds = static_cast<int>(rr.rounds.size());
+          for (const auto& r : rr.rounds) rep.iterations += r.iterations;
+          rep.lower_bound = rr.lower_bound;
+          rep.energy = rr.energy;
+          rep.gap = rr.gap;
+          coarse_gamma.clear();
+          for (int64_t j : rr.gamma) coarse_gamma.push_back(m.space[j]);
+          if (l + 1 == hx_.size()) {
+            result.finest = std::move(m);
+            result.rounding = std::move(rr);
+          }
+          break;
+        } catch (const InfeasibleError& e) {
+          if (l == 0) throw;
+          ProofPlace proof(m);
+          for (int64_t i : e.rows()) proof.add(m, i);
+          auto find = [&](bool carry_y) { return faces_to_widen(m, proof, options_.widen_margin, carry_y); };
+          const auto [faces, carried] = faces_for(find);
+          if (widen_locally(faces)) continue;
+          // The X faces there are at their limit: try those that map next to the Y side.
+          if (!carried && widen_locally(find(true))) continue;
+          if (ring >= options_.max_ring) throw;
+          ++rep.widenings;
+          spdlog::warn("level {}: the reduced LP at ring {} is infeasible; widening to ring {}", l + 1, ring, ring + 1);
+          ++ring;
+          for (int& x : extra) x = std::max(0, std::min(x, options_.max_ring - ring));
+        }
       }
+    } catch (const InfeasibleError& e) {
+      if (!second_start) throw;
+      refined = false;
+      spdlog::warn("level {}: no Γ in the refined space ({}); trying the full space", l + 1, e.what());
     }
+    if (second_start) solve_second_start(l, model, refined, rep, coarse_gamma, result, progress);
     rep.seconds = clock.seconds();
     rep.peak_rss_mb = peak_rss_mb();
     result.levels.push_back(rep);
   }
   return result;
+}
+
+void CoarseToFineMatcher::solve_second_start(int l, const EnergyModel& model, bool refined, LevelReport& rep,
+                                             std::vector<ProductTriangle>& gamma, CoarseToFineResult& result,
+                                             const Progress& progress) const {
+  const MeshLevel& lx = hx_.levels[l];
+  const MeshLevel& ly = hy_.levels[l];
+  const bool finest = l + 1 == hx_.size();
+  MatchingLp m = build_matching_lp(ProductSpace::full(lx.mesh, ly.mesh), model, options_.matching.scale_costs);
+  spdlog::info("level {}: second start over the full product space, {} variables", l + 1, m.lp.cols());
+  RoundingOptions ro = options_.rounding;
+  if (!finest) ro.lp.tolerance = std::max(ro.lp.tolerance, options_.coarse_tolerance);
+  ro.fractional_batch = options_.second_start_fractional_batch;
+  LevelReport shown = rep;
+  shown.ring = -1;
+  RoundingResult rr;
+  try {
+    rr = round_to_graph_surface(m.space, m.lp, m.energy, ro, [&](const RoundingRound& r) {
+      if (progress) progress(shown, r);
+    });
+  } catch (const InfeasibleError& e) {
+    if (!refined) throw;
+    spdlog::warn("level {}: the second start found no Γ ({}); the refined one goes on", l + 1, e.what());
+    return;
+  }
+  rep.second_start_energy = rr.energy;
+  rep.second_start_kept = !refined || rr.energy < rep.energy;
+  spdlog::info("level {}: second start energy {:.6g}, refined {}: {} goes on", l + 1, rr.energy,
+               refined ? fmt::format("{:.6g}", rep.energy) : std::string("none"),
+               rep.second_start_kept ? "the second start's Γ" : "the refined Γ");
+  if (!rep.second_start_kept) return;
+  rep.ring = -1;
+  rep.variables = m.lp.cols();
+  rep.constraints = m.lp.rows();
+  rep.rounds = static_cast<int>(rr.rounds.size());
+  rep.iterations = 0;
+  for (const auto& r : rr.rounds) rep.iterations += r.iterations;
+  rep.lower_bound = rr.lower_bound;
+  rep.energy = rr.energy;
+  rep.gap = rr.gap;
+  gamma.clear();
+  for (int64_t j : rr.gamma) gamma.push_back(m.space[j]);
+  if (finest) {
+    result.finest = std::move(m);
+    result.rounding = std::move(rr);
+  }
 }
 
 }  // namespace shapematch

@@ -16,6 +16,15 @@ std::vector<int> level_face_counts(int input_faces, const HierarchyOptions& o) {
   if (o.coarsest_faces < 4) throw InvalidInputError("hierarchy: --coarsest-faces must be at least 4");
   if (o.levels < 0) throw InvalidInputError("hierarchy: --levels must not be negative");
   const int coarsest = std::min(o.coarsest_faces, input_faces);
+  if (o.second_faces > coarsest && input_faces > o.second_faces && o.levels != 1) {
+    HierarchyOptions above = o;
+    above.coarsest_faces = o.second_faces;
+    above.second_faces = 0;
+    above.levels = o.levels > 0 ? o.levels - 1 : 0;
+    std::vector<int> counts = level_face_counts(input_faces, above);
+    counts.insert(counts.begin(), coarsest);
+    return counts;
+  }
   int levels = o.levels;
   if (levels == 0) {
     if (!(o.ratio > 1.0)) throw InvalidInputError("hierarchy: the level ratio must exceed 1");

@@ -222,6 +222,36 @@ std::vector<int64_t> certificate_rows(const std::vector<double>& y, const std::v
   return out;
 }
 
+// The batch for a fractional LP (nothing above the threshold): the largest variables, each at
+// least half the largest value, none sharing a row with b ≠ 0 (a face's coverage row) with an
+// earlier one, up to `fraction` of the open faces; at least the single largest.
+std::vector<std::pair<int64_t, int>> fractional_batch(const LpProblem& lp, const Reduced& red,
+                                                      const std::vector<double>& x, const std::vector<int64_t>& order,
+                                                      double fraction) {
+  int64_t open_faces = 0;  // coverage rows still open, X and Y together
+  for (int64_t i : red.rows) open_faces += lp.b[i] != 0.0;
+  const int64_t limit = std::max<int64_t>(1, std::llround(fraction * double(open_faces) / 2.0));
+  std::vector<std::pair<int64_t, int>> batch{{red.cols[order.front()], 1}};
+  if (limit == 1) return batch;
+  std::vector<char> taken(lp.rows(), 0);
+  auto coverage_rows = [&](int64_t j, auto&& visit) {
+    for (uint32_t k = lp.at.row_ptr[j]; k < lp.at.row_ptr[j + 1]; ++k)
+      if (lp.b[col_of(lp.at.entry[k])] != 0.0) visit(col_of(lp.at.entry[k]));
+  };
+  coverage_rows(batch.front().first, [&](int64_t i) { taken[i] = 1; });
+  const double top = x[order.front()];
+  for (size_t n = 1; n < order.size() && int64_t(batch.size()) < limit; ++n) {
+    const int64_t k = order[n];
+    if (x[k] < 0.5 * top) break;
+    bool clash = false;
+    coverage_rows(red.cols[k], [&](int64_t i) { clash = clash || taken[i]; });
+    if (clash) continue;
+    coverage_rows(red.cols[k], [&](int64_t i) { taken[i] = 1; });
+    batch.push_back({red.cols[k], 1});
+  }
+  return batch;
+}
+
 }  // namespace
 
 int64_t propagation_conflict(const LpProblem& lp, const std::vector<char>& skip) {
@@ -357,7 +387,7 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
       if (r.x[k] <= options.threshold) break;
       batch.push_back({red.cols[k], 1});
     }
-    if (batch.empty()) batch.push_back({red.cols[order.front()], 1});
+    if (batch.empty()) batch = fractional_batch(lp, red, r.x, order, options.fractional_batch);
 
     ++forward;
     Step step{fixer.mark(), fixer.state().ones, fixer.state().zeros, {}};
