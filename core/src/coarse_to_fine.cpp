@@ -260,6 +260,22 @@ std::vector<ProductTriangle> reduced_product_space(const MeshLevel& fine_x, cons
   return out;
 }
 
+namespace {
+
+// A level's rounding result becomes its report's numbers and the Γ the next level refines.
+void accept(const MatchingLp& m, const RoundingResult& rr, LevelReport& rep, std::vector<ProductTriangle>& gamma) {
+  rep.rounds = static_cast<int>(rr.rounds.size());
+  rep.iterations = 0;
+  for (const auto& r : rr.rounds) rep.iterations += r.iterations;
+  rep.lower_bound = rr.lower_bound;
+  rep.energy = rr.energy;
+  rep.gap = rr.gap;
+  gamma.clear();
+  for (int64_t j : rr.gamma) gamma.push_back(m.space[j]);
+}
+
+}  // namespace
+
 CoarseToFineMatcher::CoarseToFineMatcher(const Mesh& x, const Mesh& y, CoarseToFineOptions options)
     : options_(std::move(options)) {
   if (options_.ring < 0 || options_.max_ring < options_.ring)
@@ -375,13 +391,7 @@ CoarseToFineResult CoarseToFineMatcher::run(const Progress& progress) const {
                                                      [&](const RoundingRound& r) {
                                                        if (progress) progress(rep, r);
                                                      });
-          rep.rounds = static_cast<int>(rr.rounds.size());
-          for (const auto& r : rr.rounds) rep.iterations += r.iterations;
-          rep.lower_bound = rr.lower_bound;
-          rep.energy = rr.energy;
-          rep.gap = rr.gap;
-          coarse_gamma.clear();
-          for (int64_t j : rr.gamma) coarse_gamma.push_back(m.space[j]);
+          accept(m, rr, rep, coarse_gamma);
           if (l + 1 == hx_.size()) {
             result.finest = std::move(m);
             result.rounding = std::move(rr);
@@ -448,14 +458,7 @@ void CoarseToFineMatcher::solve_second_start(int l, const EnergyModel& model, bo
   rep.ring = -1;
   rep.variables = m.lp.cols();
   rep.constraints = m.lp.rows();
-  rep.rounds = static_cast<int>(rr.rounds.size());
-  rep.iterations = 0;
-  for (const auto& r : rr.rounds) rep.iterations += r.iterations;
-  rep.lower_bound = rr.lower_bound;
-  rep.energy = rr.energy;
-  rep.gap = rr.gap;
-  gamma.clear();
-  for (int64_t j : rr.gamma) gamma.push_back(m.space[j]);
+  accept(m, rr, rep, gamma);
   if (finest) {
     result.finest = std::move(m);
     result.rounding = std::move(rr);
