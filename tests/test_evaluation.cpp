@@ -7,6 +7,7 @@
 #include "test_helpers.hpp"
 
 #include <doctest/doctest.h>
+#include <spdlog/fmt/fmt.h>
 
 #include <algorithm>
 #include <array>
@@ -418,6 +419,47 @@ TEST_CASE("evaluation: shapematch eval reads a match directory through the verte
   r = run_cli("eval " + (dir / "nothing").string(), dir);
   CHECK(r.code == 1);
   CHECK(r.err.find("not a directory") != std::string::npos);
+  fs::remove_all(dir);
+}
+
+TEST_CASE("evaluation: shapematch eval closes Y's holes again when the match did") {
+  // An open input (one face removed), matched as closed: the matched meshes have one vertex more.
+  const fs::path dir = scratch("close_holes");
+  const fs::path out = dir / "match";
+  fs::create_directories(out);
+  Mesh open = shapes::icosphere(1);
+  open.faces.pop_back();
+  std::string text = "OFF\n" + std::to_string(open.num_vertices()) + " " + std::to_string(open.num_faces()) + " 0\n";
+  for (const auto& p : open.vertices) text += fmt::format("{} {} {}\n", p.x(), p.y(), p.z());
+  for (const auto& f : open.faces) text += fmt::format("3 {} {} {}\n", f[0], f[1], f[2]);
+  write(dir / "open.off", text);
+  LoadOptions closing;
+  closing.close_holes = true;
+  const Mesh closed = load_mesh((dir / "open.off").string(), closing);
+  const int n = closed.num_vertices();
+  REQUIRE(n == open.num_vertices() + 1);
+  save_mesh(closed, (out / "x.ply").string());
+  save_mesh(closed, (out / "y.ply").string());
+  std::string ids;
+  for (int v = 0; v < n; ++v) ids += std::to_string(v) + "\n";
+  write(out / "map_x_to_y.txt", ids);
+  auto report = [&](bool close_holes) {
+    auto side = Json::object().set("file", (dir / "open.off").string()).set("vertices_input", n).set("vertices", n);
+    write(out / "report.json", Json::object()
+                                   .set("x", side)
+                                   .set("y", side)
+                                   .set("options", Json::object().set("close_holes", close_holes))
+                                   .dump());
+  };
+  report(true);
+  Run r = run_cli("eval " + out.string(), dir);
+  REQUIRE_MESSAGE(r.code == 0, r.err);
+  CHECK(json_number(r.out, "points") == n);
+  CHECK(json_number(r.out, "mean_geodesic_error") == 0.0);
+  report(false);  // Y read as it is: open, so not the mesh that was matched
+  r = run_cli("eval " + out.string(), dir);
+  CHECK(r.code == 1);
+  CHECK(r.err.find("not closed") != std::string::npos);
   fs::remove_all(dir);
 }
 
