@@ -86,6 +86,9 @@ int run_match(const MatchArgs& args) {
 
   CoarseToFineOptions co;
   co.hierarchy = args.hierarchy;
+  if (co.hierarchy.second_faces > 0 && co.hierarchy.second_faces <= co.hierarchy.coarsest_faces)
+    spdlog::warn("--second-faces {} is not above --coarsest-faces {}: no second start", co.hierarchy.second_faces,
+                 co.hierarchy.coarsest_faces);
   co.ring = args.ring;
   co.neighbourhood = args.neighbourhood == "fine" ? Neighbourhood::Fine : Neighbourhood::Coarse;
   co.max_ring = std::max(args.max_ring, args.ring);
