@@ -38,6 +38,7 @@ struct MatchArgs {
   std::string neighbourhood = "fine";
   std::string widen = "local";
   int widen_margin = CoarseToFineOptions{}.widen_margin;
+  int max_local_widenings = CoarseToFineOptions{}.max_local_widenings;
 };
 
 // auto: a GPU if there is one, else the native solver (lavapipe is for testing, not speed).
@@ -95,6 +96,7 @@ int run_match(const MatchArgs& args) {
   co.local_widening = args.widen == "local";
   co.coarse_tolerance = args.coarse_tolerance;
   co.widen_margin = args.widen_margin;
+  co.max_local_widenings = args.max_local_widenings;
   co.matching = matching_options(args.pair, p);
   RoundingOptions& ro = co.rounding;
   ro.solver = solver_for(args);
@@ -227,7 +229,8 @@ int run_match(const MatchArgs& args) {
                               .set("ring", args.ring)
                               .set("neighbourhood", args.neighbourhood)
                               .set("widen", args.widen)
-                              .set("widen_margin", args.widen_margin));
+                              .set("widen_margin", args.widen_margin)
+                              .set("max_local_widenings", args.max_local_widenings));
     report.set("seconds", seconds);
     report.set("peak_rss_mb", peak_rss_mb());
     report.set("round_log", rounds);
@@ -313,6 +316,10 @@ Action add_match_command(CLI::App& app) {
   app.add_option("--widen", a->widen,
                  "after an infeasible reduced LP: local (near the proof first, then everywhere) or global")
       ->check(CLI::IsMember({"local", "global"}))
+      ->capture_default_str();
+  app.add_option("--max-local-widenings", a->max_local_widenings,
+                 "local widenings per level before the ring widens everywhere")
+      ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   app.add_option("--widen-margin", a->widen_margin, "fine rings of faces around the proof that widen with it")
       ->check(CLI::Range(0, 64))
