@@ -321,98 +321,12 @@ CoarseToFineResult CoarseToFineMatcher::run(const Progress& progress) const {
     EnergyModel model(lx.mesh, lx.geometry, ly.mesh, ly.geometry, options_.matching.energy);
     if (fx_.size() > 0) model.set_features(select_rows(fx_, lx.input_vertex), select_rows(fy_, ly.input_vertex));
 
-    std::vector<int> extra;  // local widening: more fine rings per fine X face
-    std::vector<int> last_widened;
-    int local = 0;
-    int ring = options_.ring;
-    // One more fine ring on these faces (as far as max_ring allows); false if none could grow.
-    auto widen_locally = [&](const std::vector<int>& faces) {
-      if (!options_.local_widening || local >= options_.max_local_widenings) return false;
-      extra.resize(lx.mesh.num_faces(), 0);
-      int64_t widened = 0;
-      for (int f : faces)
-        if (ring + extra[f] < options_.max_ring) {
-          ++extra[f];
-          ++widened;
-        }
-      if (widened == 0) return false;
-      ++local;
-      ++rep.local_widenings;
-      rep.widened_faces += widened;
-      spdlog::warn("level {}: the reduced LP is infeasible; widening {} of {} faces by one ring", l + 1, widened,
-                   lx.mesh.num_faces());
-      return true;
-    };
-    // The faces to widen for a proof, from find(carry_y): the X side first, and where the same
-    // faces come back (the X side alone did not help) the Y side too. Also says which it took.
-    auto faces_for = [&](const auto& find) {
-      std::vector<int> faces = find(false);
-      bool carried = false;
-      if (!faces.empty()) {
-        carried = faces == last_widened;
-        last_widened = faces;
-        if (carried) faces = find(true);
-      }
-      return std::pair{std::move(faces), carried};
-    };
     // The second start (CoarseToFineOptions::second_start) also rescues a level whose refined
     // space stayed infeasible at the largest ring.
     const bool second_start = l == 1 && second_level_;
     bool refined = true;
     try {
-      for (;;) {
-        MatchingLp m;
-        if (l == 0) {
-          m = build_matching_lp(ProductSpace::full(lx.mesh, ly.mesh), model, options_.matching.scale_costs);
-        } else {
-          rep.ring = ring;
-          m = build_matching_lp(
-              ProductSpace::from_list(lx.mesh, ly.mesh,
-                                      reduced_product_space(lx, ly, hx_.levels[l - 1].mesh, hy_.levels[l - 1].mesh,
-                                                            coarse_gamma, ring, options_.neighbourhood, extra)),
-              model, options_.matching.scale_costs);
-        }
-        rep.variables = m.lp.cols();
-        rep.constraints = m.lp.rows();
-        const double kept = 100.0 * double(rep.variables) / double(rep.full_variables);
-        spdlog::info("level {}/{}: {} × {} faces, {} variables ({}){}", l + 1, hx_.size(), rep.faces_x, rep.faces_y,
-                     rep.variables, l > 0 ? fmt::format("{:.3g} % of the full space", kept) : "the full space",
-                     l > 0 ? fmt::format(", ring {}", ring) : std::string());
-        // Propagation alone proves most reduced LPs infeasible, and says where: widen there first.
-        if (l > 0 && options_.local_widening &&
-            widen_locally(faces_for([&](bool carry_y) {
-                            return faces_near_conflicts(m, kMaxConflictPlaces, options_.widen_margin, carry_y);
-                          }).first))
-          continue;
-        try {
-          RoundingOptions ro = options_.rounding;
-          if (l + 1 < hx_.size()) ro.lp.tolerance = std::max(ro.lp.tolerance, options_.coarse_tolerance);
-          RoundingResult rr = round_to_graph_surface(m.space, m.lp, m.energy, ro,
-                                                     [&](const RoundingRound& r) {
-                                                       if (progress) progress(rep, r);
-                                                     });
-          accept(m, rr, rep, coarse_gamma);
-          if (l + 1 == hx_.size()) {
-            result.finest = std::move(m);
-            result.rounding = std::move(rr);
-          }
-          break;
-        } catch (const InfeasibleError& e) {
-          if (l == 0) throw;
-          ProofPlace proof(m);
-          for (int64_t i : e.rows()) proof.add(m, i);
-          auto find = [&](bool carry_y) { return faces_to_widen(m, proof, options_.widen_margin, carry_y); };
-          const auto [faces, carried] = faces_for(find);
-          if (widen_locally(faces)) continue;
-          // The X faces there are at their limit: try those that map next to the Y side.
-          if (!carried && widen_locally(find(true))) continue;
-          if (ring >= options_.max_ring) throw;
-          ++rep.widenings;
-          spdlog::warn("level {}: the reduced LP at ring {} is infeasible; widening to ring {}", l + 1, ring, ring + 1);
-          ++ring;
-          for (int& x : extra) x = std::max(0, std::min(x, options_.max_ring - ring));
-        }
-      }
+      solve_refined(l, model, rep, coarse_gamma, result, progress);
     } catch (const InfeasibleError& e) {
       if (!second_start) throw;
       refined = false;
@@ -426,6 +340,104 @@ CoarseToFineResult CoarseToFineMatcher::run(const Progress& progress) const {
   return result;
 }
 
+RoundingOptions CoarseToFineMatcher::rounding_for(int l) const {
+  RoundingOptions ro = options_.rounding;
+  if (l + 1 < hx_.size()) ro.lp.tolerance = std::max(ro.lp.tolerance, options_.coarse_tolerance);
+  return ro;
+}
+
+void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelReport& rep,
+                                        std::vector<ProductTriangle>& gamma, CoarseToFineResult& result,
+                                        const Progress& progress) const {
+  const MeshLevel& lx = hx_.levels[l];
+  const MeshLevel& ly = hy_.levels[l];
+  std::vector<int> extra;  // local widening: more fine rings per fine X face
+  std::vector<int> last_widened;
+  int local = 0;
+  int ring = options_.ring;
+  // One more fine ring on these faces (as far as max_ring allows); false if none could grow.
+  auto widen_locally = [&](const std::vector<int>& faces) {
+    if (!options_.local_widening || local >= options_.max_local_widenings) return false;
+    extra.resize(lx.mesh.num_faces(), 0);
+    int64_t widened = 0;
+    for (int f : faces)
+      if (ring + extra[f] < options_.max_ring) {
+        ++extra[f];
+        ++widened;
+      }
+    if (widened == 0) return false;
+    ++local;
+    ++rep.local_widenings;
+    rep.widened_faces += widened;
+    spdlog::warn("level {}: the reduced LP is infeasible; widening {} of {} faces by one ring", l + 1, widened,
+                 lx.mesh.num_faces());
+    return true;
+  };
+  // The faces to widen for a proof, from find(carry_y): the X side first, and where the same
+  // faces come back (the X side alone did not help) the Y side too. Also says which it took.
+  auto faces_for = [&](const auto& find) {
+    std::vector<int> faces = find(false);
+    bool carried = false;
+    if (!faces.empty()) {
+      carried = faces == last_widened;
+      last_widened = faces;
+      if (carried) faces = find(true);
+    }
+    return std::pair{std::move(faces), carried};
+  };
+  for (;;) {
+    MatchingLp m;
+    if (l == 0) {
+      m = build_matching_lp(ProductSpace::full(lx.mesh, ly.mesh), model, options_.matching.scale_costs);
+    } else {
+      rep.ring = ring;
+      m = build_matching_lp(
+          ProductSpace::from_list(lx.mesh, ly.mesh,
+                                  reduced_product_space(lx, ly, hx_.levels[l - 1].mesh, hy_.levels[l - 1].mesh,
+                                                        gamma, ring, options_.neighbourhood, extra)),
+          model, options_.matching.scale_costs);
+    }
+    rep.variables = m.lp.cols();
+    rep.constraints = m.lp.rows();
+    const double kept = 100.0 * double(rep.variables) / double(rep.full_variables);
+    spdlog::info("level {}/{}: {} × {} faces, {} variables ({}){}", l + 1, hx_.size(), rep.faces_x, rep.faces_y,
+                 rep.variables, l > 0 ? fmt::format("{:.3g} % of the full space", kept) : "the full space",
+                 l > 0 ? fmt::format(", ring {}", ring) : std::string());
+    // Propagation alone proves most reduced LPs infeasible, and says where: widen there first.
+    if (l > 0 && options_.local_widening &&
+        widen_locally(faces_for([&](bool carry_y) {
+                        return faces_near_conflicts(m, kMaxConflictPlaces, options_.widen_margin, carry_y);
+                      }).first))
+      continue;
+    try {
+      RoundingResult rr = round_to_graph_surface(m.space, m.lp, m.energy, rounding_for(l),
+                                                 [&](const RoundingRound& r) {
+                                                   if (progress) progress(rep, r);
+                                                 });
+      accept(m, rr, rep, gamma);
+      if (l + 1 == hx_.size()) {
+        result.finest = std::move(m);
+        result.rounding = std::move(rr);
+      }
+      break;
+    } catch (const InfeasibleError& e) {
+      if (l == 0) throw;
+      ProofPlace proof(m);
+      for (int64_t i : e.rows()) proof.add(m, i);
+      auto find = [&](bool carry_y) { return faces_to_widen(m, proof, options_.widen_margin, carry_y); };
+      const auto [faces, carried] = faces_for(find);
+      if (widen_locally(faces)) continue;
+      // The X faces there are at their limit: try those that map next to the Y side.
+      if (!carried && widen_locally(find(true))) continue;
+      if (ring >= options_.max_ring) throw;
+      ++rep.widenings;
+      spdlog::warn("level {}: the reduced LP at ring {} is infeasible; widening to ring {}", l + 1, ring, ring + 1);
+      ++ring;
+      for (int& x : extra) x = std::max(0, std::min(x, options_.max_ring - ring));
+    }
+  }
+}
+
 void CoarseToFineMatcher::solve_second_start(int l, const EnergyModel& model, bool refined, LevelReport& rep,
                                              std::vector<ProductTriangle>& gamma, CoarseToFineResult& result,
                                              const Progress& progress) const {
@@ -434,8 +446,7 @@ void CoarseToFineMatcher::solve_second_start(int l, const EnergyModel& model, bo
   const bool finest = l + 1 == hx_.size();
   MatchingLp m = build_matching_lp(ProductSpace::full(lx.mesh, ly.mesh), model, options_.matching.scale_costs);
   spdlog::info("level {}: second start over the full product space, {} variables", l + 1, m.lp.cols());
-  RoundingOptions ro = options_.rounding;
-  if (!finest) ro.lp.tolerance = std::max(ro.lp.tolerance, options_.coarse_tolerance);
+  RoundingOptions ro = rounding_for(l);
   ro.fractional_batch = options_.second_start_fractional_batch;
   LevelReport shown = rep;
   shown.ring = -1;

@@ -109,6 +109,12 @@ public:
   CoarseToFineResult run(const Progress& progress = {}) const;
 
 private:
+  // Level l's rounding options: the coarse tolerance below the finest level.
+  RoundingOptions rounding_for(int l) const;
+  // Level l from the coarser level's Γ (the full space at l = 0), widening where it is
+  // infeasible; throws InfeasibleError when the largest ring is. Replaces `gamma` with level l's.
+  void solve_refined(int l, const EnergyModel& model, LevelReport& rep, std::vector<ProductTriangle>& gamma,
+                     CoarseToFineResult& result, const Progress& progress) const;
   // The second start at level l: the full product space, rounded; keeps whichever Γ has the
   // lower energy (or the full space's alone where `refined` is false).
   void solve_second_start(int l, const EnergyModel& model, bool refined, LevelReport& rep,
