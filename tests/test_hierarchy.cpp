@@ -4,6 +4,8 @@
 
 #include <doctest/doctest.h>
 
+#include <cmath>
+#include <limits>
 #include <set>
 
 using namespace shapematch;
@@ -109,4 +111,42 @@ TEST_CASE("hierarchy: rings grow from the element itself outwards") {
   CHECK(r1.size() <= 13);
   CHECK(r2.size() > r1.size());
   CHECK(std::includes(r2.begin(), r2.end(), r1.begin(), r1.end()));
+}
+
+TEST_CASE("hierarchy: point-to-triangle distance agrees with a dense sampling of the triangle") {
+  const Eigen::Vector3d a(0.1, -0.2, 0.3), b(1.7, 0.4, -0.1), c(0.6, 1.1, 0.5);
+  // Points around the triangle, so that every Voronoi region (corners, edges, interior) is hit.
+  std::vector<Eigen::Vector3d> points;
+  for (int i = -2; i <= 2; ++i)
+    for (int j = -2; j <= 2; ++j)
+      for (int k = -1; k <= 1; ++k) points.emplace_back(0.8 + 0.9 * i, 0.4 + 0.8 * j, 0.2 + 0.6 * k);
+  const int n = 400;
+  for (const Eigen::Vector3d& p : points) {
+    double sampled = std::numeric_limits<double>::infinity();
+    for (int i = 0; i <= n; ++i)
+      for (int j = 0; i + j <= n; ++j) {
+        const Eigen::Vector3d q = a + (b - a) * (double(i) / n) + (c - a) * (double(j) / n);
+        sampled = std::min(sampled, (p - q).squaredNorm());
+      }
+    CAPTURE(p.transpose());
+    const double d = squared_distance_to_triangle(p, a, b, c);
+    CHECK(d <= sampled + 1e-12);                            // never farther than a point of the triangle
+    CHECK(std::sqrt(sampled) - std::sqrt(d) < 5e-3);        // and a sample is about as near
+  }
+  CHECK(squared_distance_to_triangle((a + b + c) / 3, a, b, c) == doctest::Approx(0).epsilon(1e-15));
+}
+
+TEST_CASE("hierarchy: a fine face's parent is the coarse face it lies on, not the one with the nearest centroid") {
+  // A long coarse triangle and a small one beside its end; the fine face lies on the long one,
+  // near the end, where the small triangle's centroid is much nearer than the long one's.
+  Mesh coarse;
+  coarse.vertices = {{0, 0, 0}, {10, 0, 0}, {5, 0.5, 0}, {-1, -1, 0}, {0, -1, 0}};
+  coarse.faces = {{0, 1, 2}, {0, 3, 4}};
+  Mesh fine;
+  fine.vertices = {{0.8, 0.02, 0}, {1.2, 0.02, 0}, {1.0, 0.11, 0}};
+  fine.faces = {{0, 1, 2}};
+  CHECK(parent_faces(fine, coarse) == std::vector<int>{0});
+  // Turned over, no coarse face points its way; the nearest of all is still the long one.
+  fine.faces = {{0, 2, 1}};
+  CHECK(parent_faces(fine, coarse) == std::vector<int>{0});
 }

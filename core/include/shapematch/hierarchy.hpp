@@ -41,10 +41,14 @@ std::vector<int> level_face_counts(int input_faces, const HierarchyOptions& opti
 // subsets nest) and links every face to a parent.
 MeshHierarchy build_hierarchy(const Mesh& input, const std::vector<int>& face_counts);
 
-// The parent of every fine face: the coarse face nearest to its centroid among those whose
-// normal does not point away from the fine face's (so thin parts do not take parents from the
-// opposite side); the nearest of all if none qualifies.
+// The parent of every fine face: the coarse face nearest to its centroid (point-to-triangle
+// distance) among those whose normal does not point away from the fine face's (so thin parts do
+// not take parents from the opposite side); the nearest of all if none qualifies.
 std::vector<int> parent_faces(const Mesh& fine, const Mesh& coarse);
+
+// Squared distance from p to the triangle abc (closest point on its interior, edges or corners).
+double squared_distance_to_triangle(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                                    const Eigen::Vector3d& c);
 
 // The faces within `ring` rings of an element given by its vertices: ring 0 gives the faces
 // containing all of them (a face itself, an edge's two faces, a vertex's star), ring 1 the faces
