@@ -38,6 +38,7 @@ struct MatchArgs {
   std::string neighbourhood = "fine";
   std::string widen = "local";
   int widen_margin = CoarseToFineOptions{}.widen_margin;
+  int y_margin = CoarseToFineOptions{}.y_margin;
   int max_local_widenings = CoarseToFineOptions{}.max_local_widenings;
 };
 
@@ -96,6 +97,7 @@ int run_match(const MatchArgs& args) {
   co.local_widening = args.widen == "local";
   co.coarse_tolerance = args.coarse_tolerance;
   co.widen_margin = args.widen_margin;
+  co.y_margin = args.y_margin;
   co.max_local_widenings = args.max_local_widenings;
   co.matching = matching_options(args.pair, p);
   RoundingOptions& ro = co.rounding;
@@ -230,6 +232,7 @@ int run_match(const MatchArgs& args) {
                               .set("neighbourhood", args.neighbourhood)
                               .set("widen", args.widen)
                               .set("widen_margin", args.widen_margin)
+                              .set("y_margin", args.y_margin)
                               .set("max_local_widenings", args.max_local_widenings));
     report.set("seconds", seconds);
     report.set("peak_rss_mb", peak_rss_mb());
@@ -323,6 +326,10 @@ Action add_match_command(CLI::App& app) {
       ->capture_default_str();
   app.add_option("--widen-margin", a->widen_margin, "fine rings of faces around the proof that widen with it")
       ->check(CLI::Range(0, 64))
+      ->capture_default_str();
+  app.add_option("--y-margin", a->y_margin,
+                 "more fine rings on Y around every face's candidates, at every ring (fine neighbourhood)")
+      ->check(CLI::Range(0, 8))
       ->capture_default_str();
   return [a] { return run_match(*a); };
 }

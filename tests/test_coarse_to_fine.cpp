@@ -226,6 +226,27 @@ TEST_CASE("coarse to fine: extra rings grow only the chosen faces' candidates") 
                   InvalidInputError);
 }
 
+TEST_CASE("coarse to fine: a margin on Y is one more fine ring for every face, at every ring") {
+  const Mesh m = lumpy_sphere(2, 11);  // 320 faces
+  const MeshHierarchy h = build_hierarchy(m, {80, 320});
+  const MeshLevel& fine = h.levels[1];
+  const Mesh& coarse = h.levels[0].mesh;
+  const ProductSpace full = ProductSpace::full(fine.mesh, fine.mesh);
+  const auto id = identity_matching(coarse);
+  const std::vector<int> everywhere(fine.mesh.num_faces(), 1);
+  // Ring 1 with a margin of 1 = ring 1 with every face widened locally by one ring.
+  const auto margin = full_indices(full, reduced_product_space(fine, fine, coarse, coarse, id, 1, Neighbourhood::Fine, {}, 1));
+  const auto widened = full_indices(full, reduced_product_space(fine, fine, coarse, coarse, id, 1, Neighbourhood::Fine, everywhere));
+  const auto plain = full_indices(full, reduced_product_space(fine, fine, coarse, coarse, id, 1, Neighbourhood::Fine));
+  CHECK(margin == widened);
+  CHECK(margin.size() > plain.size());
+  // At ring 2 it adds to the ring's own fine rings on Y as well.
+  const auto ring2 = full_indices(full, reduced_product_space(fine, fine, coarse, coarse, id, 2, Neighbourhood::Fine));
+  const auto ring2m = full_indices(full, reduced_product_space(fine, fine, coarse, coarse, id, 2, Neighbourhood::Fine, {}, 1));
+  CHECK(std::includes(ring2m.begin(), ring2m.end(), ring2.begin(), ring2.end()));
+  CHECK(ring2m.size() > ring2.size());
+}
+
 TEST_CASE("coarse to fine: a coarse face no fine face took as parent still has a candidate") {
   const Mesh m = lumpy_sphere(2, 12);
   const MeshHierarchy h = build_hierarchy(m, {80, 320});

@@ -8,6 +8,8 @@
 
 #include <filesystem>
 #include <fstream>
+#include <numeric>
+#include <random>
 
 using namespace shapematch;
 
@@ -71,6 +73,57 @@ TEST_CASE("lp: the certified lower bound holds for arbitrary duals") {
     for (auto& v : y) v += n(rng) * (k % 5) * 0.1;
     CHECK(certified_lower_bound(m.lp, y) <= opt.objective * (1 + 1e-9));
   }
+}
+
+namespace {
+// max cᵀx over the LP's feasible set, by Clp on −c.
+double largest_objective(LpProblem p) {
+  for (double& v : p.c) v = -v;
+  const LpResult r = solve_lp(p, "clp-dual");
+  REQUIRE(r.status == LpStatus::Optimal);
+  return -r.objective / p.objective_scale;
+}
+}  // namespace
+
+TEST_CASE("lp: the objective upper bound is at least every feasible objective, and tight where rows cover") {
+  // x0 + x1 = 1 covers x0 and x1; x1 − x2 = 0 covers nothing. Bound 1·max(2, 3) + 5 = 8, and
+  // x = (0, 1, 1) reaches it.
+  const LpProblem small = dense_lp({{1, 1, 0}, {0, 1, -1}}, {1, 0}, {2, 3, 5});
+  CHECK(objective_upper_bound(small) == doctest::Approx(8.0));
+  CHECK(largest_objective(small) == doctest::Approx(8.0));
+
+  // Random LPs, some rows all +1, feasible by construction.
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  for (int trial = 0; trial < 20; ++trial) {
+    const int m = 4 + trial % 5, n = 10 + trial;
+    std::vector<std::vector<int>> rows(m, std::vector<int>(n, 0));
+    std::vector<double> xs(n), c(n), b(m, 0.0);
+    for (int j = 0; j < n; ++j) {
+      xs[j] = u(rng);
+      c[j] = 2.0 * u(rng) - 0.7;
+    }
+    for (int i = 0; i < m; ++i)
+      for (int j = 0; j < n; ++j) {
+        const double r = u(rng);
+        rows[i][j] = r < 0.6 ? 0 : (i < m / 2 || r < 0.8) ? 1 : -1;
+        b[i] += rows[i][j] * xs[j];
+      }
+    const LpProblem p = dense_lp(rows, b, c);
+    CAPTURE(trial);
+    CHECK(objective_upper_bound(p) >= largest_objective(p) - 1e-9);
+  }
+
+  // A matching LP: every product triangle lies in a face's projection row, so the bound is a
+  // sum over faces, far below the sum of all positive costs.
+  const Mesh x = shapes::octahedron();
+  const Mesh y = test::deformed(x, [](const Eigen::Vector3d& p) { return Eigen::Vector3d(1.4 * p.x(), p.y(), 0.7 * p.z()); });
+  const MatchingLp mlp = build_matching_lp(x, compute_geometry(x), y, compute_geometry(y));
+  const double bound = objective_upper_bound(mlp.lp);
+  CHECK(bound >= largest_objective(mlp.lp) - 1e-9);
+  double positive = 0.0;
+  for (double v : mlp.lp.c) positive += std::max(0.0, v);
+  CHECK(bound < positive / 5);
 }
 
 TEST_CASE("lp: MPS export and problem checks") {

@@ -108,7 +108,8 @@ std::vector<int> faces_near_conflicts(const MatchingLp& m, int max_places, int m
 std::vector<ProductTriangle> reduced_product_space(const MeshLevel& fine_x, const MeshLevel& fine_y,
                                                    const Mesh& coarse_x, const Mesh& coarse_y,
                                                    const std::vector<ProductTriangle>& coarse_gamma, int ring,
-                                                   Neighbourhood neighbourhood, const std::vector<int>& extra_rings) {
+                                                   Neighbourhood neighbourhood, const std::vector<int>& extra_rings,
+                                                   int y_margin) {
   const Mesh& X = fine_x.mesh;
   const Mesh& Y = fine_y.mesh;
   if (fine_x.parent_face.size() != size_t(X.num_faces()) || fine_y.parent_face.size() != size_t(Y.num_faces()))
@@ -160,7 +161,7 @@ std::vector<ProductTriangle> reduced_product_space(const MeshLevel& fine_x, cons
     if (neighbourhood == Neighbourhood::Fine && ring > 0 && !faces_y[c].empty()) {
       seed.clear();
       for (int f : faces_y[c]) seed.insert(seed.end(), Y.faces[f].begin(), Y.faces[f].end());
-      faces_y[c] = ring_faces(Y, vf_fine_y, seed, std::max(1, ring - 1));
+      faces_y[c] = ring_faces(Y, vf_fine_y, seed, std::max(1, ring - 1) + std::max(0, y_margin));
     }
     for (int f : faces_y[c])
       for (int i = 0; i < 3; ++i) {
@@ -394,7 +395,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
       m = build_matching_lp(
           ProductSpace::from_list(lx.mesh, ly.mesh,
                                   reduced_product_space(lx, ly, hx_.levels[l - 1].mesh, hy_.levels[l - 1].mesh,
-                                                        gamma, ring, options_.neighbourhood, extra)),
+                                                        gamma, ring, options_.neighbourhood, extra, options_.y_margin)),
           model, options_.matching.scale_costs);
     }
     rep.variables = m.lp.cols();

@@ -55,6 +55,31 @@ double certified_lower_bound(const LpProblem& p, const std::vector<double>& y) {
   return p.objective_scale * (by + std::accumulate(partial.begin(), partial.end(), 0.0));
 }
 
+double objective_upper_bound(const LpProblem& p) {
+  const int64_t m = p.rows(), n = p.cols();
+  std::vector<char> cover(m, 0);
+  for (int64_t i = 0; i < m; ++i) {
+    if (!(p.b[i] >= 0.0)) continue;
+    bool positive = true;
+    for (uint32_t k = p.a.row_ptr[i]; k < p.a.row_ptr[i + 1] && positive; ++k) positive = !is_negative(p.a.entry[k]);
+    cover[i] = positive;
+  }
+  std::vector<double> largest(m, 0.0);
+  double bound = 0.0;
+  for (int64_t j = 0; j < n; ++j) {
+    const double cost = std::max(0.0, p.c[j]);
+    int64_t row = -1;
+    for (uint32_t k = p.at.row_ptr[j]; k < p.at.row_ptr[j + 1] && row < 0; ++k)
+      if (cover[col_of(p.at.entry[k])]) row = col_of(p.at.entry[k]);
+    if (row < 0)
+      bound += cost;
+    else
+      largest[row] = std::max(largest[row], cost);
+  }
+  for (int64_t i = 0; i < m; ++i) bound += p.b[i] * largest[i];
+  return bound;
+}
+
 void evaluate_solution(const LpProblem& p, LpResult& r) {
   if (r.x.size() == size_t(p.cols())) {
     std::vector<double> ax(p.rows());

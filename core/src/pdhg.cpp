@@ -135,13 +135,14 @@ LpResult PdhgSolver::solve(const LpProblem& problem, const SolverParams& params)
   lp.col_scale.resize(n);
   lp.b.resize(m);
   lp.row_scale.resize(m);
-  double cnorm = 0.0, bnorm = 0.0, bnorm_orig = 0.0, positive_c = 0.0;
+  double cnorm = 0.0, bnorm = 0.0, bnorm_orig = 0.0;
   for (int64_t j = 0; j < n; ++j) {
     lp.c[j] = d[j] * problem.c[j];
     lp.col_scale[j] = d[j];
     cnorm += double(lp.c[j]) * lp.c[j];
-    positive_c += std::max(0.0, problem.c[j]);
   }
+  // The largest objective a feasible point can have: a dual bound above it proves infeasibility.
+  const double largest_objective = objective_upper_bound(problem);
   for (int64_t i = 0; i < m; ++i) {
     lp.b[i] = r[i] * problem.b[i];
     lp.row_scale[i] = r[i];
@@ -203,14 +204,14 @@ LpResult PdhgSolver::solve(const LpProblem& problem, const SolverParams& params)
       result.status = LpStatus::Optimal;
       break;
     }
-    // Any dual point whose bound exceeds the largest objective the box allows proves infeasibility;
-    // confirm in double precision before trusting the fp32 reduction.
-    if (dual_obj > positive_c + 1e-3 * (1.0 + positive_c)) {
+    // Any dual point whose bound exceeds the largest objective a feasible point can have proves
+    // infeasibility; confirm in double precision before trusting the fp32 reduction.
+    if (dual_obj > largest_objective + 1e-3 * (1.0 + largest_objective)) {
       std::vector<double> xh, yh;
       backend->read(xh, yh);
       std::vector<double> y(m);
       for (int64_t i = 0; i < m; ++i) y[i] = r[i] * yh[i];
-      if (certified_lower_bound(problem, y) > problem.objective_scale * positive_c) {
+      if (certified_lower_bound(problem, y) > problem.objective_scale * largest_objective) {
         result.status = LpStatus::Infeasible;
         result.y = std::move(y);
         break;

@@ -37,6 +37,10 @@ struct CoarseToFineOptions {
   // 20 s), but on 020-024 at 2000 faces it widened 1311 of 2000 faces and still left an LP that
   // PDHG needed 111 s to prove infeasible; at 0 one widening of 335 faces gave a feasible LP.
   int widen_margin = 0;
+  // More fine rings on Y at every ring (fine neighbourhood): a wider space from the start, paid
+  // for in variables, against infeasible reduced LPs whose proof PDHG must find (slow at
+  // 10 k faces).
+  int y_margin = 0;
   MatchingLpOptions matching;  // its features (if any) have one row per vertex of the input meshes
   RoundingOptions rounding;
   // LP tolerance of the levels below the finest, if looser than the rounding's own. Their Γ only
@@ -60,12 +64,14 @@ struct CoarseToFineOptions {
 // such that some (f'_a, f'_b) of the coarse Γ has χ(f_a) ∈ N(f'_a) and ψ(f_b) ∈ N(f'_b).
 // Degenerate fine elements (vertices, edges) inherit the parents of their incident faces.
 // `extra_rings` (empty, or one count per fine X face) grows a face's candidates on Y by that many
-// more fine rings: the local widening after an infeasible reduced LP. Enumerated directly: memory is linear in the number of product triangles kept.
+// more fine rings: the local widening after an infeasible reduced LP. `y_margin` (fine
+// neighbourhood only) grows every face's candidates on Y by that many fine rings at every ring.
+// Enumerated directly: memory is linear in the number of product triangles kept.
 std::vector<ProductTriangle> reduced_product_space(const MeshLevel& fine_x, const MeshLevel& fine_y,
                                                    const Mesh& coarse_x, const Mesh& coarse_y,
                                                    const std::vector<ProductTriangle>& coarse_gamma, int ring,
                                                    Neighbourhood neighbourhood,
-                                                   const std::vector<int>& extra_rings = {});
+                                                   const std::vector<int>& extra_rings = {}, int y_margin = 0);
 
 struct LevelReport {
   int level = 0;  // 0 = coarsest

@@ -80,6 +80,14 @@ LpResult solve_lp(const LpProblem& problem, const std::string& solver, const Sol
 // L(y) = bᵀy + Σ_j min(0, (c − Aᵀy)_j) in the problem's reported units (times objective_scale):
 // a lower bound on the LP optimum for ANY y because 0 ≤ x ≤ 1. Evaluated in double precision.
 double certified_lower_bound(const LpProblem& problem, const std::vector<double>& y);
+
+// An upper bound on cᵀx over every feasible x (0 ≤ x ≤ 1, A x = b), in the problem's own units
+// (not times objective_scale). A row with only +1 entries and b_i ≥ 0 caps the sum of its
+// columns at b_i, so the columns assigned to it add at most b_i times their largest positive
+// cost; a column in no such row adds its own positive cost. Any y with L(y) above it proves the
+// LP infeasible. On matching LPs every column lies in a face's projection row, which makes this
+// about the number of faces times a typical cost, not the sum over all product triangles.
+double objective_upper_bound(const LpProblem& problem);
 // Fills residual and gap fields of `result` from its x and y, in double precision.
 void evaluate_solution(const LpProblem& problem, LpResult& result);
 
