@@ -268,3 +268,42 @@ TEST_CASE("pdhg-cpu: iterates are bitwise the same on any number of threads") {
     CHECK(std::abs(st.residual2 - s1.residual2) <= 1e-12 * s1.residual2);
   }
 }
+
+TEST_CASE("pdhg-cpu: a diverging infeasible LP stops early when asked, with the dual's growth as its ray") {
+  // x0 + x1 = 1 and x0 + x1 = 1.5: each row alone is satisfiable, together they are not. With
+  // large costs, the dual bound needs a long way to pass the largest feasible objective.
+  const LpProblem p = from_rows(3, {{{0, 1}, {1, 1}}, {{0, 1}, {1, 1}, {2, -1}}}, {1, 1.5}, {800, 900, 1e4});
+  SolverParams params = tight();
+  params.max_iterations = 50000;
+  const LpResult proof = solve_lp(p, "pdhg-cpu", params);
+  REQUIRE(proof.status == LpStatus::Infeasible);  // without the option: a proof, however long
+  params.stop_on_divergence = true;
+  const LpResult r = solve_lp(p, "pdhg-cpu", params);
+  CHECK(r.status == LpStatus::Diverging);
+  CHECK(r.iterations < proof.iterations);
+  REQUIRE(r.y.size() == 2);
+  // The ray of this LP is (−1, +1): both rows, opposite signs.
+  CHECK(r.y[0] < 0);
+  CHECK(r.y[1] > 0);
+  CHECK(std::abs(r.y[0] + r.y[1]) < 0.2 * std::abs(r.y[1]));
+  CHECK(std::string(to_string(r.status)) == "diverging");
+}
+
+TEST_CASE("pdhg-cpu: feasible LPs never stop as diverging") {
+  std::mt19937 rng(5);
+  SolverParams params = tight(1e-8);
+  params.stop_on_divergence = true;
+  int64_t longest = 0;
+  for (int trial = 0; trial < 4; ++trial) {
+    const LpProblem p = random_lp(40 + 10 * trial, 150 + 30 * trial, 3, rng);
+    CAPTURE(trial);
+    const LpResult r = solve_lp(p, "pdhg-cpu", params);
+    CHECK(r.status == LpStatus::Optimal);
+    longest = std::max(longest, r.iterations);
+  }
+  CHECK(longest > 2048);  // the watch looked at least once (its window is 1024 iterations)
+  const Mesh x = shapes::icosphere(1);
+  const Mesh y = test::deformed(x, [](const Eigen::Vector3d& q) { return Eigen::Vector3d(1.5 * q.x(), q.y(), 0.7 * q.z()); });
+  const MatchingLp m = build_matching_lp(x, compute_geometry(x), y, compute_geometry(y));
+  CHECK(solve_lp(m.lp, "pdhg-cpu", params).status == LpStatus::Optimal);
+}

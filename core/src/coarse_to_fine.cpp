@@ -356,8 +356,9 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
   std::vector<int> last_widened;
   int local = 0;
   int ring = options_.ring;
+  bool trust_divergence = true;
   // One more fine ring on these faces (as far as max_ring allows); false if none could grow.
-  auto widen_locally = [&](const std::vector<int>& faces) {
+  auto widen_locally = [&](const std::vector<int>& faces, const char* why = "infeasible") {
     if (!options_.local_widening || local >= options_.max_local_widenings) return false;
     extra.resize(lx.mesh.num_faces(), 0);
     int64_t widened = 0;
@@ -370,7 +371,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
     ++local;
     ++rep.local_widenings;
     rep.widened_faces += widened;
-    spdlog::warn("level {}: the reduced LP is infeasible; widening {} of {} faces by one ring", l + 1, widened,
+    spdlog::warn("level {}: the reduced LP is {}; widening {} of {} faces by one ring", l + 1, why, widened,
                  lx.mesh.num_faces());
     return true;
   };
@@ -411,7 +412,12 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
                       }).first))
       continue;
     try {
-      RoundingResult rr = round_to_graph_surface(m.space, m.lp, m.energy, rounding_for(l),
+      RoundingOptions ro = rounding_for(l);
+      // While local widenings remain, a diverging first LP is reason enough to widen (it only
+      // adds variables); the last attempts wait for a proof.
+      ro.lp.stop_on_divergence =
+          trust_divergence && l > 0 && options_.local_widening && local < options_.max_local_widenings;
+      RoundingResult rr = round_to_graph_surface(m.space, m.lp, m.energy, ro,
                                                  [&](const RoundingRound& r) {
                                                    if (progress) progress(rep, r);
                                                  });
@@ -426,10 +432,15 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
       ProofPlace proof(m);
       for (int64_t i : e.rows()) proof.add(m, i);
       auto find = [&](bool carry_y) { return faces_to_widen(m, proof, options_.widen_margin, carry_y); };
+      const char* why = e.certified() ? "infeasible" : "probably infeasible (PDHG diverging)";
       const auto [faces, carried] = faces_for(find);
-      if (widen_locally(faces)) continue;
+      if (widen_locally(faces, why)) continue;
       // The X faces there are at their limit: try those that map next to the Y side.
-      if (!carried && widen_locally(find(true))) continue;
+      if (!carried && widen_locally(find(true), why)) continue;
+      if (!e.certified()) {  // nothing left to widen locally on a suspicion: solve for a proof
+        trust_divergence = false;
+        continue;
+      }
       if (ring >= options_.max_ring) throw;
       ++rep.widenings;
       spdlog::warn("level {}: the reduced LP at ring {} is infeasible; widening to ring {}", l + 1, ring, ring + 1);

@@ -29,6 +29,7 @@ const char* to_string(LpStatus status) {
     case LpStatus::IterationLimit: return "iteration_limit";
     case LpStatus::TimeLimit: return "time_limit";
     case LpStatus::NumericalTrouble: return "numerical_trouble";
+    case LpStatus::Diverging: return "diverging";
   }
   return "unknown";
 }

@@ -171,6 +171,11 @@ LpResult PdhgSolver::solve(const LpProblem& problem, const SolverParams& params)
 
   int64_t total = 0, k = 0;
   double restart_base = -1.0, previous = std::numeric_limits<double>::infinity();
+  // Divergence watch (params.stop_on_divergence): the iterate at the start of each window.
+  constexpr int64_t kDivergenceWindow = 1024;
+  int64_t window_end = kDivergenceWindow;
+  std::vector<double> window_y;
+  double window_primal = 0.0, window_dual = 0.0;
   int restarts = 0;
   result.status = LpStatus::IterationLimit;
   while (true) {
@@ -218,6 +223,29 @@ LpResult PdhgSolver::solve(const LpProblem& problem, const SolverParams& params)
       }
     }
 
+    // An infeasible LP's primal residual stalls while its dual bound climbs without limit. Where
+    // that held over a whole window (measured on a 10 k-face reduced matching LP: residual flat
+    // at 2e-2 while the bound rose from 35 to 48 in 1024 iterations; feasible LPs of that size
+    // cut their residual 20x in such a window), stop and return the dual's growth over it.
+    if (params.stop_on_divergence && total >= window_end) {
+      std::vector<double> xh, yh;
+      backend->read(xh, yh);
+      const double scale = 1.0 + std::abs(s.cx);
+      if (!window_y.empty() && primal > 100.0 * params.tolerance && primal >= 0.8 * window_primal &&
+          dual_obj - s.cx > 0.1 * scale && dual_obj - window_dual > 0.05 * scale) {
+        result.status = LpStatus::Diverging;
+        result.y.resize(m);
+        for (int64_t i = 0; i < m; ++i) result.y[i] = r[i] * (yh[i] - window_y[i]);
+        result.x.resize(n);
+        for (int64_t j = 0; j < n; ++j) result.x[j] = d[j] * xh[j];
+        break;
+      }
+      window_y = std::move(yh);
+      window_primal = primal;
+      window_dual = dual_obj;
+      window_end = total + kDivergenceWindow;
+    }
+
     // Restarts on the fixed-point residual (cuPDLPx): sufficient decay, necessary decay without
     // progress, or a long stretch since the last restart.
     if (restart_base < 0.0) {
@@ -240,7 +268,9 @@ LpResult PdhgSolver::solve(const LpProblem& problem, const SolverParams& params)
     previous = fixed_point;
   }
 
-  if (result.status != LpStatus::Infeasible) {
+  if (result.status == LpStatus::Diverging) {
+    result.lower_bound = certified_lower_bound(problem, result.y);  // valid for any y, if weak
+  } else if (result.status != LpStatus::Infeasible) {
     std::vector<double> xh, yh;
     backend->read(xh, yh);
     result.x.resize(n);

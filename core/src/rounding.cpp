@@ -335,6 +335,8 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
     Stopwatch clock;
     const Reduced red = reduce(lp, fixer.state());
     SolverParams params = options.lp;
+    // After a fixing, an infeasible LP undoes it: that needs a proof, not a suspicion.
+    if (round > 1) params.stop_on_divergence = false;
     if (round > 1) {
       params.initial_x.resize(red.cols.size());
       params.initial_y.resize(red.rows.size());
@@ -358,6 +360,9 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
       result.first_lp.lower_bound += lp.objective_scale * red.fixed_cost;
     }
 
+    if (r.status == LpStatus::Diverging)  // only asked for in round 1 (above)
+      throw InfeasibleError("rounding: the matching LP is probably infeasible (PDHG diverging)",
+                            certificate_rows(r.y, red.rows), false);
     if (r.status == LpStatus::Infeasible) {
       // The last fixing left an infeasible LP that propagation could not see: undo it, fix less.
       if (history.empty())

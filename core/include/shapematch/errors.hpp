@@ -36,13 +36,17 @@ public:
 class InfeasibleError : public SolverError {
 public:
   using SolverError::SolverError;
-  InfeasibleError(const std::string& what, std::vector<int64_t> rows) : SolverError(what), rows_(std::move(rows)) {}
+  InfeasibleError(const std::string& what, std::vector<int64_t> rows, bool certified = true)
+      : SolverError(what), rows_(std::move(rows)), certified_(certified) {}
   // Rows of the problem's constraint system where the proof lies (the support of a Farkas
   // certificate, or the row propagation emptied), so a caller can widen there; may be empty.
   const std::vector<int64_t>& rows() const { return rows_; }
+  // False where the LP only behaved like an infeasible one (LpStatus::Diverging).
+  bool certified() const { return certified_; }
 
 private:
   std::vector<int64_t> rows_;
+  bool certified_ = true;
 };
 
 // No usable Vulkan device, out of device memory, a failed Vulkan call.

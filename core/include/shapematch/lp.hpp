@@ -31,6 +31,10 @@ enum class LpStatus {
   IterationLimit,
   TimeLimit,
   NumericalTrouble,
+  // Not certified (first-order methods, only with SolverParams::stop_on_divergence): the primal
+  // residual stalled while the dual bound kept rising past the objective, the way an infeasible
+  // LP behaves. `y` is the dual's growth over the last window: about a Farkas ray.
+  Diverging,
 };
 const char* to_string(LpStatus status);
 
@@ -41,6 +45,11 @@ struct SolverParams {
   int threads = 0;                // 0 = all hardware threads
   int device = -1;                // Vulkan device index, -1 = preferred
   bool verbose = false;
+  // Stop early with LpStatus::Diverging when the iterates behave like an infeasible LP's (see
+  // there). For callers that only need to know where to enlarge an LP, not a proof: PDHG's
+  // certificate of infeasibility takes long to emerge (a 10 k-face reduced matching LP: its dual
+  // bound rose by 1.4 every 64 iterations towards a threshold in the thousands).
+  bool stop_on_divergence = false;
   // Warm start (first-order methods): both empty or of the right sizes.
   std::vector<double> initial_x;
   std::vector<double> initial_y;
