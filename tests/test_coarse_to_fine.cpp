@@ -198,7 +198,7 @@ TEST_CASE("coarse to fine: features must have one row per input vertex") {
   CHECK_NOTHROW(matcher.set_features(Eigen::MatrixXd::Zero(m.num_vertices(), 2), Eigen::MatrixXd::Zero(m.num_vertices(), 2)));
 }
 
-TEST_CASE("coarse to fine: extra rings grow only the chosen faces' candidates") {
+TEST_CASE("coarse to fine: extra rings grow only the chosen faces' candidates, a margin on Y every face's") {
   const Mesh m = lumpy_sphere(2, 11);  // 320 faces
   const MeshHierarchy h = build_hierarchy(m, {80, 320});
   const MeshLevel& fine = h.levels[1];
@@ -224,20 +224,12 @@ TEST_CASE("coarse to fine: extra rings grow only the chosen faces' candidates") 
   // A list of the wrong size is an error, not a silent partial widening.
   CHECK_THROWS_AS(reduced_product_space(fine, fine, coarse, coarse, id, 1, Neighbourhood::Fine, {1, 2}),
                   InvalidInputError);
-}
 
-TEST_CASE("coarse to fine: a margin on Y is one more fine ring for every face, at every ring") {
-  const Mesh m = lumpy_sphere(2, 11);  // 320 faces
-  const MeshHierarchy h = build_hierarchy(m, {80, 320});
-  const MeshLevel& fine = h.levels[1];
-  const Mesh& coarse = h.levels[0].mesh;
-  const ProductSpace full = ProductSpace::full(fine.mesh, fine.mesh);
-  const auto id = identity_matching(coarse);
+  // A margin on Y is one more fine ring for every face, at every ring.
   const std::vector<int> everywhere(fine.mesh.num_faces(), 1);
   // Ring 1 with a margin of 1 = ring 1 with every face widened locally by one ring.
   const auto margin = full_indices(full, reduced_product_space(fine, fine, coarse, coarse, id, 1, Neighbourhood::Fine, {}, 1));
   const auto widened = full_indices(full, reduced_product_space(fine, fine, coarse, coarse, id, 1, Neighbourhood::Fine, everywhere));
-  const auto plain = full_indices(full, reduced_product_space(fine, fine, coarse, coarse, id, 1, Neighbourhood::Fine));
   CHECK(margin == widened);
   CHECK(margin.size() > plain.size());
   // At ring 2 it adds to the ring's own fine rings on Y as well.
