@@ -335,9 +335,9 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
     Stopwatch clock;
     const Reduced red = reduce(lp, fixer.state());
     SolverParams params = options.lp;
-    // After a fixing, an infeasible LP undoes it: that needs a proof, not a suspicion.
-    if (round > 1) params.stop_on_divergence = false;
     if (round > 1) {
+      // After a fixing, an infeasible LP undoes it: that needs a proof, not a suspicion.
+      params.stop_on_divergence = false;
       params.initial_x.resize(red.cols.size());
       params.initial_y.resize(red.rows.size());
       for (size_t j = 0; j < red.cols.size(); ++j) params.initial_x[j] = x_full[red.cols[j]];
