@@ -1,6 +1,7 @@
 #version 450
 // PDHG dual step over rows i (core/src/pdhg_backend.hpp): gathers the extrapolated xr through A,
-// then the Halpern update of y and yr = r·y, fused. On the last iteration of a batch it also keeps
+// then the Halpern update of y and yr = r·y, fused. Rows longer than long_row are left to
+// pdhg_dual_long.comp. On the last iteration of a batch it also keeps
 // ŷ, r·ŷ (for the evaluation) and per-workgroup partial sums of (ŷ − y)².
 // Buffers are reached by device address, as in pdhg_primal.comp.
 #extension GL_EXT_buffer_reference : require
@@ -16,7 +17,7 @@ layout(push_constant) uniform Push {
   uint64_t a_entry;   // A entries: address of uint[nnz]
   Doubles xr, b, r, y, y0, yr, yhat, ys, partial;
   double sigma, gamma, w;  // doubles before the uints: the block stays within 128 bytes
-  uint m, last;
+  uint m, last, long_row;
 } pc;
 
 shared double sums[64];  // one per subgroup: subgroups of at least 4 invocations (checked on the host)
@@ -49,10 +50,12 @@ void main() {
   // A grid wider than the per-dimension workgroup limit continues in y (vk::dispatch_grid).
   const uint i = gl_GlobalInvocationID.x + gl_GlobalInvocationID.y * gl_NumWorkGroups.x * 256u;
   double change = 0.0lf;
-  if (i < pc.m) {
+  const uint begin = i < pc.m ? pc.a_ptr.v[i] : 0u;
+  const uint end = i < pc.m ? pc.a_ptr.v[i + 1u] : 0u;
+  if (i < pc.m && end - begin <= pc.long_row) {
     const double ri = pc.r.v[i];
     const double yi = pc.y.v[i];
-    const double yh = yi + pc.sigma * (pc.b.v[i] - ri * gather(pc.a_entry, pc.a_ptr.v[i], pc.a_ptr.v[i + 1u], pc.xr));
+    const double yh = yi + pc.sigma * (pc.b.v[i] - ri * gather(pc.a_entry, begin, end, pc.xr));
     const double y = pc.w * ((1.0lf + pc.gamma) * yh - pc.gamma * yi) + (1.0lf - pc.w) * pc.y0.v[i];
     pc.y.v[i] = y;
     pc.yr.v[i] = ri * y;

@@ -1,6 +1,7 @@
 #version 450
 // Batch statistics over rows i, in original units (core/src/pdhg_backend.hpp): per-workgroup
 // partial sums of ((A x)_i − b_i)² with x = d·x̂ (kept by the primal kernel), and of bᵀy = b̃ᵀŷ.
+// The residuals of rows longer than long_row are pdhg_eval_rows_long.comp's.
 #extension GL_EXT_buffer_reference : require
 #extension GL_KHR_shader_subgroup_arithmetic : require
 #extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
@@ -13,7 +14,7 @@ layout(push_constant) uniform Push {
   Words a_ptr;
   uint64_t a_entry;
   Doubles xs, b, r, yhat, residual_out, by_out;
-  uint m;
+  uint m, long_row;
 } pc;
 
 shared dvec2 sums[64];  // one per subgroup: subgroups of at least 4 invocations (checked on the host)
@@ -48,7 +49,8 @@ void main() {
   dvec2 terms = dvec2(0.0lf);
   if (i < pc.m) {
     const double bi = pc.b.v[i];
-    const double residual = gather(pc.a_entry, pc.a_ptr.v[i], pc.a_ptr.v[i + 1u], pc.xs) - bi / pc.r.v[i];
+    const uint begin = pc.a_ptr.v[i], end = pc.a_ptr.v[i + 1u];
+    const double residual = end - begin <= pc.long_row ? gather(pc.a_entry, begin, end, pc.xs) - bi / pc.r.v[i] : 0.0lf;
     terms = dvec2(residual * residual, bi * pc.yhat.v[i]);
   }
   const dvec2 s = workgroup_sum(terms);

@@ -28,8 +28,10 @@ struct RandomLp {
   detail::ScaledLp lp;
   std::vector<double> x, y;
 
-  // rows x cols with 0..max_per_row entries per row (empty rows and columns occur).
-  RandomLp(int64_t rows, int64_t cols, int max_per_row, uint32_t seed) {
+  // rows x cols with 0..max_per_row entries per row (empty rows and columns occur); every
+  // long_every-th row has the next of long_lengths entries instead.
+  RandomLp(int64_t rows, int64_t cols, int max_per_row, uint32_t seed, const std::vector<int>& long_lengths = {},
+           int64_t long_every = 0) {
     std::minstd_rand rng(seed);  // fast enough for the 40M-entry case
     std::uniform_int_distribution<int> count(0, max_per_row);
     std::uniform_int_distribution<uint32_t> col(0, static_cast<uint32_t>(cols - 1));
@@ -40,7 +42,8 @@ struct RandomLp {
     a.entry.reserve(size_t(rows) * max_per_row / 2 + 16);
     a.row_ptr.push_back(0);
     for (int64_t r = 0; r < rows; ++r) {
-      for (int k = count(rng); k > 0; --k) a.entry.push_back(col(rng) | (u(rng) < 0.5 ? SignedCsr::kNegative : 0u));
+      const bool longer = long_every > 0 && r % long_every == 3;
+      for (int k = longer ? long_lengths[size_t(r / long_every) % long_lengths.size()] : count(rng); k > 0; --k) a.entry.push_back(col(rng) | (u(rng) < 0.5 ? SignedCsr::kNegative : 0u));
       a.row_ptr.push_back(static_cast<uint32_t>(a.entry.size()));
     }
     at = transpose(a);
@@ -155,6 +158,23 @@ TEST_CASE("pdhg-vulkan: every kernel equals the CPU backend on a small random pr
       CAPTURE(gamma);
       compare_backends(p, detail::Step{0.3, 0.2, gamma}, 7);
     }
+  }
+}
+
+// Rows of A above kLongRow entries go to the long-row kernels (a workgroup per row, the lanes'
+// partial sums added pairwise), the others to the row kernels; both must give the CPU's values.
+// Rows of exactly kLongRow and kLongRow + 1 entries sit on either side of the split.
+TEST_CASE("pdhg-vulkan: long rows of A equal the CPU backend") {
+  if (!test::vulkan_wanted()) return;
+  constexpr int kLong = int(detail::kLongRow), kLanes = int(detail::kLongLanes);
+  const RandomLp p(700, 3000, 8, 5, {kLong, kLong + 1, 300, 20 * kLanes, 20 * kLanes + 7, 2017}, 50);
+  int64_t long_rows = 0;
+  for (int64_t i = 0; i < p.a.rows; ++i) long_rows += p.a.row_ptr[i + 1] - p.a.row_ptr[i] > detail::kLongRow;
+  CAPTURE(long_rows);
+  REQUIRE(long_rows >= 10);
+  for (const double gamma : {1.0, 0.5}) {
+    CAPTURE(gamma);
+    compare_backends(p, detail::Step{0.05, 0.05, gamma}, 7);
   }
 }
 

@@ -21,6 +21,7 @@
 //   and then evaluate, at (x̂, ŷ), in the ORIGINAL units (x = D_c x̂, y = D_r ŷ):
 //     Σ_i ((A x)_i − b_i)²,  cᵀx = Σ c̃_j x̂_j,  bᵀy = Σ b̃_i ŷ_i,  Σ_j min(0, c_j − (Aᵀy)_j).
 //   restart: x⁰ ← x ← x̂, y⁰ ← y ← ŷ (and yr), returning Σ(x̂−x⁰_old)², Σ(ŷ−y⁰_old)².
+// Every Σ over a row adds in entry order, except over a long row of A (kLongRow below).
 #include "shapematch/sparse.hpp"
 
 #include <memory>
@@ -28,6 +29,16 @@
 #include <vector>
 
 namespace shapematch::detail {
+
+// A row of A with more than kLongRow entries (in a matching LP the projection rows: thousands of
+// entries, against at most ~32 elsewhere) is summed in kLongLanes interleaved partial sums, lane
+// l taking entries l, l + kLongLanes, l + 2·kLongLanes, … in order, which are then added
+// pairwise: lane l += lane l + h for h = kLongLanes/2, …, 2, 1; the row's sum is lane 0. A GPU
+// spreads such a row over a workgroup instead of leaving one invocation a chain of thousands
+// of dependent gathers that the whole step waits for (measured on an H100: docs/benchmarks.md);
+// the CPU adds in the same order, so both backends still compute the same iterates.
+inline constexpr uint32_t kLongRow = 256;
+inline constexpr uint32_t kLongLanes = 64;  // local_size_x of pdhg_*_long.comp
 
 struct ScaledLp {
   const SignedCsr* a = nullptr;   // m x n

@@ -3,6 +3,7 @@
 #include "thread_pool.hpp"
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <cmath>
 
@@ -31,6 +32,24 @@ inline double signed_gather(const SignedCsr& m, int64_t row, const double* v) {
   return signed_gather(m.entry.data(), m.row_ptr[row], m.row_ptr[row + 1], v);
 }
 
+// The sum over a long row of A in kLongLanes interleaved partial sums and their pairwise tree
+// (pdhg_backend.hpp), in the order of pdhg_dual_long.comp. Independent chains also suit a CPU.
+inline double long_row_sum(const uint32_t* e, uint32_t n, const double* v) {
+  std::array<double, kLongLanes> s{};
+  uint32_t t = 0;
+  for (; t + kLongLanes <= n; t += kLongLanes)
+    for (uint32_t l = 0; l < kLongLanes; ++l) s[l] += signed_value(e[t + l], v);
+  for (uint32_t l = 0; t + l < n; ++l) s[l] += signed_value(e[t + l], v);
+  for (uint32_t h = kLongLanes / 2; h > 0; h /= 2)
+    for (uint32_t l = 0; l < h; ++l) s[l] += s[l + h];
+  return s[0];
+}
+
+// A row sum of A: entry order, or the long-row order above kLongRow entries.
+inline double a_row_sum(const uint32_t* entry, uint32_t begin, uint32_t end, const double* v) {
+  return end - begin > kLongRow ? long_row_sum(entry + begin, end - begin, v) : signed_gather(entry, begin, end, v);
+}
+
 // Two rows' sums at once, each in its own entry order (so the same values as signed_gather). A
 // row's sum is a chain of dependent additions behind gathers; two interleaved chains ran 14 %
 // faster per thread (four: no further gain).
@@ -48,18 +67,24 @@ inline void signed_gather2(const uint32_t* e0, uint32_t n0, const uint32_t* e1, 
   s1 = b;
 }
 
-// update(row, Σ ±v over the row) for rows [begin, end), two rows at a time (signed_gather2).
-template <class Update>
+// update(row, Σ ±v over the row) for rows [begin, end), two rows at a time (signed_gather2);
+// RowsOfA: long rows in the long-row order (a_row_sum).
+template <bool RowsOfA, class Update>
 inline void for_each_row_sum(const uint32_t* ptr, const uint32_t* entry, const double* v, int64_t begin, int64_t end,
                              Update&& update) {
   int64_t i = begin;
   for (; i + 1 < end; i += 2) {
+    if (RowsOfA && (ptr[i + 1] - ptr[i] > kLongRow || ptr[i + 2] - ptr[i + 1] > kLongRow)) {
+      update(i, a_row_sum(entry, ptr[i], ptr[i + 1], v));
+      update(i + 1, a_row_sum(entry, ptr[i + 1], ptr[i + 2], v));
+      continue;
+    }
     double s0, s1;
     signed_gather2(entry + ptr[i], ptr[i + 1] - ptr[i], entry + ptr[i + 1], ptr[i + 2] - ptr[i + 1], v, s0, s1);
     update(i, s0);
     update(i + 1, s1);
   }
-  if (i < end) update(i, signed_gather(entry, ptr[i], ptr[i + 1], v));
+  if (i < end) update(i, RowsOfA ? a_row_sum(entry, ptr[i], ptr[i + 1], v) : signed_gather(entry, ptr[i], ptr[i + 1], v));
 }
 
 // clamp(v, 0, hi) for hi > 0, equal to std::clamp (−0 and NaN pass through) but without the
@@ -203,7 +228,7 @@ private:
         dx2 += (xh - xj) * (xh - xj);
       }
     };
-    for_each_row_sum(ptr, entry, yr, begin, end, update);
+    for_each_row_sum<false>(ptr, entry, yr, begin, end, update);
     return dx2;
   }
 
@@ -238,7 +263,7 @@ private:
         dy2 += (yh - yi) * (yh - yi);
       }
     };
-    for_each_row_sum(ptr, entry, xr, begin, end, update);
+    for_each_row_sum<true>(ptr, entry, xr, begin, end, update);
     return dy2;
   }
 
@@ -258,7 +283,7 @@ private:
     pool_.run(T, [&](int t) {
       double res = 0.0, by = 0.0;
       for (int64_t i = m_ * t / T, e = m_ * (t + 1) / T; i < e; ++i) {
-        const double ri = double(signed_gather(a, i, scratch_x_.data())) - double(lp_->b[i]) / r[i];
+        const double ri = a_row_sum(a.entry.data(), a.row_ptr[i], a.row_ptr[i + 1], scratch_x_.data()) - lp_->b[i] / r[i];
         res += ri * ri;
         by += double(lp_->b[i]) * yhat_[i];
       }

@@ -13,8 +13,10 @@
 #include "vk/pipeline.hpp"
 #include "vk/sequence.hpp"
 
+#include "pdhg_dual_long_spv.hpp"
 #include "pdhg_dual_spv.hpp"
 #include "pdhg_eval_cols_spv.hpp"
+#include "pdhg_eval_rows_long_spv.hpp"
 #include "pdhg_eval_rows_spv.hpp"
 #include "pdhg_primal_spv.hpp"
 #include "pdhg_restart_cols_spv.hpp"
@@ -43,12 +45,22 @@ struct PrimalPush {
 struct DualPush {
   uint64_t a_ptr, a_entry, xr, b, r, y, y0, yr, yhat, ys, partial;
   double sigma, gamma, w;
-  uint32_t m, last;
+  uint32_t m, last, long_row;
+};
+struct DualLongPush {
+  uint64_t a_ptr, a_entry, rows, xr, b, r, y, y0, yr, yhat, ys, partial;
+  double sigma, gamma, w;
+  uint32_t count, last;
 };
 struct EvalRowsPush {
   uint64_t a_ptr, a_entry, xs, b, r, yhat, residual_out, by_out;
-  uint32_t m;
+  uint32_t m, long_row;
 };
+struct EvalRowsLongPush {
+  uint64_t a_ptr, a_entry, rows, xs, b, r, residual_out;
+  uint32_t count;
+};
+static_assert(sizeof(DualLongPush) <= 128, "the push-constant block every device offers");
 struct EvalColsPush {
   uint64_t at_ptr, at_entry, ys, c, d, xhat, cx_out, negative_out;
   uint32_t n;
@@ -76,13 +88,14 @@ const vk::Context& capable(const vk::Context& context) {
 
 uint32_t groups_in(const std::array<uint32_t, 3>& grid) { return grid[0] * grid[1] * grid[2]; }
 
-// Partial sums: one slot of `groups` doubles per reduced quantity, each written by one kernel.
+// Partial sums: one slot per reduced quantity, of one double per workgroup that adds to it
+// (the long-row kernels' after the row kernels').
 enum Slot { kDx2, kCx, kNegative, kDy2, kResidual, kBy, kSlots };
 
-// The problem on the device: A and Aᵀ, the column vectors (xs = d·x̂ and xr are scratch), the
-// row vectors (ys = r·ŷ is scratch) and the partial sums.
+// The problem on the device: A and Aᵀ, A's long rows, the column vectors (xs = d·x̂ and xr are
+// scratch), the row vectors (ys = r·ŷ is scratch) and the partial sums.
 struct DeviceProblem {
-  vk::Buffer a_ptr, a_entry, at_ptr, at_entry;
+  vk::Buffer a_ptr, a_entry, at_ptr, at_entry, long_rows;
   vk::Buffer c, d, x, x0, xhat, xs, xr;
   vk::Buffer b, r, y, y0, yr, yhat, ys;
   vk::Buffer partial;
@@ -94,7 +107,9 @@ public:
       : context_(device_index),
         primal_(capable(context_), spv::pdhg_primal, 0, sizeof(PrimalPush)),
         dual_(context_, spv::pdhg_dual, 0, sizeof(DualPush)),
+        dual_long_(context_, spv::pdhg_dual_long, 0, sizeof(DualLongPush)),
         eval_rows_(context_, spv::pdhg_eval_rows, 0, sizeof(EvalRowsPush)),
+        eval_rows_long_(context_, spv::pdhg_eval_rows_long, 0, sizeof(EvalRowsLongPush)),
         eval_cols_(context_, spv::pdhg_eval_cols, 0, sizeof(EvalColsPush)),
         restart_cols_(context_, spv::pdhg_restart_cols, 0, sizeof(RestartColsPush)),
         restart_rows_(context_, spv::pdhg_restart_rows, 0, sizeof(RestartRowsPush)) {}
@@ -115,10 +130,17 @@ public:
         lp.b.size() != size_t(m_) || lp.row_scale.size() != size_t(m_) || y.size() != size_t(m_))
       throw InvalidInputError("pdhg-vulkan: inconsistent problem of " + std::to_string(m_) + " x " +
                               std::to_string(n_));
+    std::vector<uint32_t> long_rows;
+    for (int64_t i = 0; i < m_; ++i)
+      if (a.row_ptr[i + 1] - a.row_ptr[i] > kLongRow) long_rows.push_back(uint32_t(i));
+    long_count_ = uint32_t(long_rows.size());
+    long_rows.push_back(0);  // never read; keeps the buffer non-empty
     col_grid_ = context_.grid(uint64_t(n_), kLocalSize);
     row_grid_ = context_.grid(uint64_t(m_), kLocalSize);
+    long_grid_ = context_.grid(uint64_t(long_count_) * kLongLanes, kLongLanes);
     col_groups_ = groups_in(col_grid_);
     row_groups_ = groups_in(row_grid_);
+    stride_ = std::max(col_groups_, row_groups_ + long_count_);
     check_memory(a, at);
 
     const auto u32 = [&](const std::vector<uint32_t>& v) {
@@ -130,14 +152,13 @@ public:
     const auto scratch = [&](int64_t size) { return context_.addressed_buffer(uint64_t(size) * sizeof(double)); };
     std::vector<double> yr(m_);
     for (int64_t i = 0; i < m_; ++i) yr[i] = lp.row_scale[i] * y[i];
-    const uint32_t stride = std::max(col_groups_, row_groups_);
     // x̂, ŷ start at the start point, so that read() before any iteration returns it.
     // Braced initialisation runs in member order, so the first failed allocation stops the rest.
-    problem_.emplace(DeviceProblem{u32(a.row_ptr), u32(a.entry), u32(at.row_ptr), u32(at.entry),
+    problem_.emplace(DeviceProblem{u32(a.row_ptr), u32(a.entry), u32(at.row_ptr), u32(at.entry), u32(long_rows),
                                    f64(lp.c), f64(lp.col_scale), f64(x), f64(x), f64(x), scratch(n_),
                                    scratch(n_), f64(lp.b), f64(lp.row_scale), f64(y), f64(y), f64(yr),
-                                   f64(y), scratch(m_), scratch(int64_t(kSlots) * stride)});
-    partials_.resize(size_t(kSlots) * stride);
+                                   f64(y), scratch(m_), scratch(int64_t(kSlots) * stride_)});
+    partials_.resize(size_t(kSlots) * stride_);
   }
 
   BatchStats iterate(int count, int64_t k0, const Step& step) override {
@@ -158,13 +179,27 @@ public:
                         DualPush{p.a_ptr.address(), p.a_entry.address(), p.xr.address(), p.b.address(),
                                  p.r.address(), p.y.address(), p.y0.address(), p.yr.address(),
                                  p.yhat.address(), p.ys.address(), slot(kDy2), step.sigma, step.gamma, w,
-                                 uint32_t(m_), last},
+                                 uint32_t(m_), last, kLongRow},
                         row_grid_);
+      if (long_count_ > 0)
+        sequence.dispatch(dual_long_,
+                          DualLongPush{p.a_ptr.address(), p.a_entry.address(), p.long_rows.address(), p.xr.address(),
+                                       p.b.address(), p.r.address(), p.y.address(), p.y0.address(), p.yr.address(),
+                                       p.yhat.address(), p.ys.address(), slot(kDy2, row_groups_), step.sigma,
+                                       step.gamma, w, long_count_, last},
+                          long_grid_);
     }
     sequence.dispatch(eval_rows_,
                       EvalRowsPush{p.a_ptr.address(), p.a_entry.address(), p.xs.address(), p.b.address(),
-                                   p.r.address(), p.yhat.address(), slot(kResidual), slot(kBy), uint32_t(m_)},
+                                   p.r.address(), p.yhat.address(), slot(kResidual), slot(kBy), uint32_t(m_),
+                                   kLongRow},
                       row_grid_);
+    if (long_count_ > 0)
+      sequence.dispatch(eval_rows_long_,
+                        EvalRowsLongPush{p.a_ptr.address(), p.a_entry.address(), p.long_rows.address(),
+                                         p.xs.address(), p.b.address(), p.r.address(),
+                                         slot(kResidual, row_groups_), long_count_},
+                        long_grid_);
     sequence.dispatch(eval_cols_,
                       EvalColsPush{p.at_ptr.address(), p.at_entry.address(), p.ys.address(), p.c.address(),
                                    p.d.address(), p.xhat.address(), slot(kCx), slot(kNegative), uint32_t(n_)},
@@ -173,8 +208,8 @@ public:
     download_partials();
     BatchStats stats;
     stats.dx2 = sum(kDx2, col_groups_);
-    stats.dy2 = sum(kDy2, row_groups_);
-    stats.residual2 = sum(kResidual, row_groups_);
+    stats.dy2 = sum(kDy2, row_groups_ + long_count_);
+    stats.residual2 = sum(kResidual, row_groups_ + long_count_);
     stats.by = sum(kBy, row_groups_);
     stats.cx = sum(kCx, col_groups_);
     stats.reduced_neg = sum(kNegative, col_groups_);
@@ -207,8 +242,8 @@ private:
   // allocation halfway through the uploads.
   void check_memory(const SignedCsr& a, const SignedCsr& at) const {
     const uint64_t bytes = 4 * (a.row_ptr.size() + a.entry.size() + at.row_ptr.size() + at.entry.size()) +
-                           8 * (7 * uint64_t(n_) + 7 * uint64_t(m_) +
-                                uint64_t(kSlots) * std::max(col_groups_, row_groups_));
+                           4 * uint64_t(long_count_ + 1) +
+                           8 * (7 * uint64_t(n_) + 7 * uint64_t(m_) + uint64_t(kSlots) * stride_);
     const uint64_t available = context_.limits().device_local_bytes;
     if (bytes > available)
       throw DeviceError("pdhg-vulkan: the problem (" + std::to_string(m_) + " x " + std::to_string(n_) + ", " +
@@ -222,8 +257,9 @@ private:
     return *problem_;
   }
 
-  uint64_t slot(Slot s) const {
-    return problem_->partial.address() + uint64_t(s) * std::max(col_groups_, row_groups_) * sizeof(double);
+  // Slot s, from its `first` workgroup on.
+  uint64_t slot(Slot s, uint32_t first = 0) const {
+    return problem_->partial.address() + (uint64_t(s) * stride_ + first) * sizeof(double);
   }
 
   void download_partials() {
@@ -231,16 +267,17 @@ private:
   }
 
   double sum(Slot s, uint32_t groups) const {
-    const auto begin = partials_.begin() + ptrdiff_t(s) * std::max(col_groups_, row_groups_);
+    const auto begin = partials_.begin() + ptrdiff_t(s) * stride_;
     return std::accumulate(begin, begin + groups, 0.0);
   }
 
   vk::Context context_;
-  vk::ComputePipeline primal_, dual_, eval_rows_, eval_cols_, restart_cols_, restart_rows_;
+  vk::ComputePipeline primal_, dual_, dual_long_, eval_rows_, eval_rows_long_, eval_cols_, restart_cols_, restart_rows_;
   std::optional<DeviceProblem> problem_;
   int64_t n_ = 0, m_ = 0;
-  std::array<uint32_t, 3> col_grid_{}, row_grid_{};
-  uint32_t col_groups_ = 0, row_groups_ = 0;
+  std::array<uint32_t, 3> col_grid_{}, row_grid_{}, long_grid_{};
+  uint32_t col_groups_ = 0, row_groups_ = 0, long_count_ = 0;
+  uint32_t stride_ = 0;  // doubles per slot of partial sums
   std::vector<double> partials_;
 };
 
