@@ -93,6 +93,22 @@ TEST_CASE("Vulkan: list_devices and choose_device") {
   CHECK(context.limits().max_group_count[0] >= 65535u);
 }
 
+// Contexts come and go (one per LP solve) over one process-wide instance: NVIDIA's driver failed
+// vkCreateInstance after some dozens of create/destroy cycles in one process.
+TEST_CASE("Vulkan: contexts made one after another share the process's instance") {
+  if (!test::vulkan_wanted()) return;
+  const VkInstance instance = vk::shared_instance();
+  REQUIRE(instance != VK_NULL_HANDLE);
+  for (int k = 0; k < 3; ++k) {
+    vk::Context context;
+    CHECK(list_devices().size() >= 1);
+    const std::vector<uint32_t> words{1, 2, 3, uint32_t(k)};
+    const vk::Buffer buffer = context.upload(std::span<const uint32_t>(words));
+    CHECK(context.download<uint32_t>(buffer, words.size()) == words);
+  }
+  CHECK(vk::shared_instance() == instance);
+}
+
 TEST_CASE("Vulkan: dispatch grid stays within the workgroup count limits") {
   const std::array<uint32_t, 3> max{10, 10, 10};
   CHECK(vk::dispatch_grid(0, 256, max) == std::array<uint32_t, 3>{0, 1, 1});

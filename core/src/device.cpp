@@ -5,9 +5,8 @@
 namespace shapematch {
 
 std::vector<DeviceInfo> list_devices() {
-  const vk::Instance instance = vk::create_instance();
   std::vector<DeviceInfo> infos;
-  for (const vk::PhysicalDevice& device : vk::compute_devices(instance.get()))
+  for (const vk::PhysicalDevice& device : vk::compute_devices(vk::shared_instance()))
     infos.push_back(device.info);
   return infos;
 }

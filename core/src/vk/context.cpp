@@ -77,8 +77,6 @@ void describe(VkPhysicalDevice physical, int index, DeviceInfo& info, Limits& li
   info.subgroup_size = limits.subgroup_size;
 }
 
-}  // namespace
-
 Instance create_instance() {
   uint32_t loader_version = VK_API_VERSION_1_0;
   check(vkEnumerateInstanceVersion(&loader_version), "vkEnumerateInstanceVersion");
@@ -96,6 +94,13 @@ Instance create_instance() {
                       "install one or point VK_ICD_FILENAMES at an ICD such as lavapipe");
   check(result, "vkCreateInstance");
   return Instance(instance);
+}
+
+}  // namespace
+
+VkInstance shared_instance() {
+  static const Instance instance = create_instance();  // a failure throws and is retried next call
+  return instance.get();
 }
 
 std::vector<PhysicalDevice> compute_devices(VkInstance instance) {
@@ -150,8 +155,8 @@ std::array<uint32_t, 3> dispatch_grid(uint64_t threads, uint32_t local_size,
   return {max_groups[0], static_cast<uint32_t>(rows), 1};
 }
 
-Context::Context(int requested_index, Transfers transfers) : instance_(create_instance()) {
-  const std::vector<PhysicalDevice> devices = compute_devices(instance_.get());
+Context::Context(int requested_index, Transfers transfers) {
+  const std::vector<PhysicalDevice> devices = compute_devices(shared_instance());
   std::vector<DeviceInfo> infos;
   for (const PhysicalDevice& d : devices) infos.push_back(d.info);
   const PhysicalDevice& chosen = devices[pick_device(infos, requested_index)];

@@ -37,7 +37,12 @@ struct PhysicalDevice {
   DeviceInfo info;
   Limits limits;
 };
-Instance create_instance();
+// The process's one VkInstance, created at the first call and kept until exit. NVIDIA's driver
+// went wrong after repeated create/destroy cycles in one process: seen on an H100 (driver
+// 580.159), vkCreateInstance failed with VK_ERROR_INCOMPATIBLE_DRIVER after some dozens of
+// LP solves, each of which had made and destroyed its own instance; others report subgroup
+// builtins corrupted after ~11 cycles. Devices are still made per Context.
+VkInstance shared_instance();
 std::vector<PhysicalDevice> compute_devices(VkInstance instance);
 // Index into devices: requested_index if valid, else (for < 0) discrete > integrated >
 // virtual > cpu > other, first of its kind. Throws DeviceError when nothing fits.
@@ -128,7 +133,6 @@ private:
                      VkMemoryPropertyFlags preferred, bool map);
   Buffer device_buffer(uint64_t bytes, VkBufferUsageFlags extra_usage);
 
-  Instance instance_;  // declared before device_ so that the device is destroyed first
   Device device_;
   VkPhysicalDevice physical_ = VK_NULL_HANDLE;
   VkQueue queue_ = VK_NULL_HANDLE;
