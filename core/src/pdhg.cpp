@@ -166,6 +166,7 @@ LpResult PdhgSolver::solve(const LpProblem& problem, const SolverParams& params)
                                                   : detail::make_vulkan_backend(params.device);
   result.device = backend->device();
   backend->load(lp, x0, y0);
+  result.setup_seconds = clock.seconds();
   spdlog::debug("{}: {} x {}, ‖Ã‖ ≈ {:.4g}, step {:.4g}, primal weight {:.4g}, on {}", name(), m, n, norm, eta,
                 omega, result.device);
 
