@@ -10,11 +10,15 @@
 
 #include <doctest/doctest.h>
 
+#include <cerrno>
 #include <cmath>
 #include <cstdlib>
 #include <numeric>
 #include <random>
 #include <string>
+
+#include <sys/wait.h>
+#include <unistd.h>
 
 using namespace shapematch;
 
@@ -106,6 +110,32 @@ TEST_CASE("Vulkan: contexts made one after another share the process's instance"
     const vk::Buffer buffer = context.upload(std::span<const uint32_t>(words));
     CHECK(context.download<uint32_t>(buffer, words.size()) == words);
   }
+  CHECK(vk::shared_instance() == instance);
+
+  // A forked child (bench lp solves in one) must not use the parent's instance: it makes its own.
+  const pid_t pid = fork();
+  REQUIRE(pid >= 0);
+  if (pid == 0) {
+    int code = 0;
+    try {
+      if (vk::shared_instance() == instance) {
+        code = 2;
+      } else {
+        vk::Context context;
+        const std::vector<uint32_t> words{7, 8, 9};
+        const vk::Buffer buffer = context.upload(std::span<const uint32_t>(words));
+        if (context.download<uint32_t>(buffer, words.size()) != words) code = 3;
+      }
+    } catch (...) {
+      code = 4;
+    }
+    _exit(code);
+  }
+  int status = 0;
+  while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+  }
+  REQUIRE(WIFEXITED(status));
+  CHECK(WEXITSTATUS(status) == 0);  // 2: the parent's instance, 3: wrong data, 4: an exception
   CHECK(vk::shared_instance() == instance);
 }
 

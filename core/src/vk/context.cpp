@@ -2,7 +2,10 @@
 
 #include <algorithm>
 #include <cstring>
+#include <mutex>
 #include <string>
+
+#include <unistd.h>
 
 #include "shapematch/errors.hpp"
 #include "vk/check.hpp"
@@ -99,7 +102,19 @@ Instance create_instance() {
 }  // namespace
 
 VkInstance shared_instance() {
-  static const Instance instance = create_instance();  // a failure throws and is retried next call
+  static std::mutex mutex;
+  static Instance instance;
+  static pid_t owner = 0;
+  const std::lock_guard<std::mutex> lock(mutex);
+  if (instance.get() && owner != getpid()) {
+    // A forked child inherits the handle but not the driver's threads and files behind it: it
+    // makes its own and leaves the parent's alone (destroying it here would be just as invalid).
+    instance.release();
+  }
+  if (!instance.get()) {
+    instance = create_instance();  // a failure throws and is tried again at the next call
+    owner = getpid();
+  }
   return instance.get();
 }
 

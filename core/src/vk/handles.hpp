@@ -24,6 +24,8 @@ public:
   ~RootHandle() { reset(); }
 
   T get() const { return handle_; }
+  // Gives the handle up without destroying it.
+  T release() { return std::exchange(handle_, nullptr); }
 
 private:
   void reset() {
