@@ -20,7 +20,7 @@ void add_pair_options(CLI::App& app, PairArgs& args) {
                "close each boundary loop with a fan around a new vertex instead of rejecting an open mesh");
   app.add_option("--bending", args.bending, "bending weight")->capture_default_str();
   app.add_option("--lame", args.lame, "Lamé parameters λ,μ of the membrane")->delimiter(',')->expected(2);
-  app.add_option("--feature-weight", args.feature_weight, "weight μ of the feature term (0: none)")
+  app.add_option("--feature-weight", args.feature_weight, "weight μ of the feature term (0: off)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   app.add_option("--degenerate-penalty", args.degenerate_penalty,
