@@ -46,7 +46,8 @@ int run_lp(const LpArgs& args) {
   out.set("objective", r.objective).set("lower_bound", r.lower_bound);
   out.set("primal_residual", r.primal_residual).set("dual_residual", r.dual_residual).set("gap", r.gap);
   out.set("iterations", r.iterations);
-  out.set("seconds", r.seconds).set("setup_seconds", r.setup_seconds).set("build_seconds", build_seconds).set("total_seconds", total.seconds());
+  out.set("seconds", r.seconds).set("setup_seconds", r.setup_seconds);
+  out.set("build_seconds", build_seconds).set("total_seconds", total.seconds());
   out.set("peak_rss_mb", peak_rss_mb());
   const std::string text = out.dump();
   std::cout << text << std::endl;
