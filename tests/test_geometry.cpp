@@ -93,6 +93,32 @@ TEST_CASE("geometry: vertex normals point outwards with unit length") {
   }
 }
 
+TEST_CASE("geometry: a face's image is judged by the mesh's orientation, other triangles by its normals") {
+  const Mesh m = shapes::icosphere(2);
+  Geometry g = compute_geometry(m);
+  REQUIRE(g.halfedge_face.size() == 2 * m.edges.size());
+  // Two corners of face 0 and a vertex two rings away: not a face, judged by the normals.
+  const auto& f0 = m.faces[0];
+  int far = -1;
+  for (int v = 0; v < m.num_vertices() && far < 0; ++v)
+    if ((m.vertices[v] - m.vertices[f0[2]]).norm() > 0.4 && (m.vertices[v] - m.vertices[f0[0]]).norm() < 0.6 &&
+        m.edge_index(v, f0[0]) < 0 && m.edge_index(v, f0[1]) < 0)
+      far = v;
+  REQUIRE(far >= 0);
+  const int other = image_orientation(m, g, f0[0], f0[1], far);
+  REQUIRE(other != 0);
+  // A fold: vertex normals that disagree with the faces (decimation makes some). Faces keep their
+  // orientation (each face is its own identity image); the other triangle follows the normals.
+  for (auto& n : g.vertex_normal) n = -n;
+  for (const auto& f : m.faces) {
+    CHECK(image_orientation(m, g, f[0], f[1], f[2]) == 1);
+    CHECK(image_orientation(m, g, f[1], f[2], f[0]) == 1);
+    CHECK(image_orientation(m, g, f[2], f[1], f[0]) == -1);
+  }
+  CHECK(image_orientation(m, g, f0[0], f0[1], far) == -other);
+  CHECK(image_orientation(m, g, f0[0], f0[0], far) == 0);
+}
+
 TEST_CASE("geometry: mean curvature of an icosphere converges to 1/r") {
   const double r = 2.0;
   // At s = 1 every vertex star is regular and H is exact; from s = 2 on the error shrinks ~4x

@@ -60,6 +60,13 @@ Geometry compute_geometry(const Mesh& mesh) {
     }
   }
   for (auto& n : g.vertex_normal) n.normalize();
+  g.halfedge_face.assign(2 * static_cast<size_t>(mesh.num_edges()), -1);
+  if (mesh.num_edges() > 0)
+    for (int f = 0; f < nf; ++f)
+      for (int i = 0; i < 3; ++i) {
+        const int d = mesh.directed_edge_index(mesh.faces[f][i], mesh.faces[f][(i + 1) % 3]);
+        if (d >= 0) g.halfedge_face[d] = f;
+      }
 
   g.cotan_laplacian.resize(nv, nv);
   g.cotan_laplacian.setFromTriplets(triplets.begin(), triplets.end());
@@ -77,6 +84,15 @@ int image_orientation(const Mesh& y, const Geometry& gy, int a, int b, int c) {
   const Eigen::Vector3d ab = y.vertices[b] - y.vertices[a], ac = y.vertices[c] - y.vertices[a];
   const Eigen::Vector3d normal = ab.cross(ac);
   if (a == b || b == c || c == a || normal.norm() <= 1e-12 * (ab.squaredNorm() + ac.squaredNorm())) return 0;
+  // The face on the left of a->b (right of b->a) has c as its third corner: (a, b, c) is that face.
+  auto third_is_c = [&](int u, int v) {
+    const int d = y.directed_edge_index(u, v);
+    if (d < 0 || static_cast<size_t>(d) >= gy.halfedge_face.size() || gy.halfedge_face[d] < 0) return false;
+    const auto& f = y.faces[gy.halfedge_face[d]];
+    return f[0] == c || f[1] == c || f[2] == c;
+  };
+  if (third_is_c(a, b)) return 1;
+  if (third_is_c(b, a)) return -1;
   return normal.dot(gy.vertex_normal[a] + gy.vertex_normal[b] + gy.vertex_normal[c]) < 0 ? -1 : 1;
 }
 
