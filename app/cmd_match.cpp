@@ -142,8 +142,9 @@ int run_match(const MatchArgs& args) {
                  theorem.discontinuous_edges_y);
   const VertexMaps maps = vertex_maps(m.space, rr.gamma);
   seconds.set("verify", stage.seconds());
-  spdlog::info("energy {:.6g}, lower bound {:.6g}, gap {:.2f} %, {} rounds, verified", rr.energy, rr.lower_bound,
-               100 * rr.gap, rr.rounds.size());
+  spdlog::info("energy {:.6g}, lower bound {:.6g}, gap {:.2f} %, {} rounds{}, verified", rr.energy, rr.lower_bound,
+               100 * rr.gap, rr.rounds.size(),
+               rr.pockets_closed > 0 ? fmt::format(", {} pockets closed", rr.pockets_closed) : std::string());
 
   stage.reset();
   fs::path out = fs::absolute(args.out).lexically_normal();
@@ -210,7 +211,8 @@ int run_match(const MatchArgs& args) {
                                .set("discontinuous_vertices_x", theorem.discontinuous_vertices_x)
                                .set("discontinuous_vertices_y", theorem.discontinuous_vertices_y)
                                .set("discontinuous_edges_x", theorem.discontinuous_edges_x)
-                               .set("discontinuous_edges_y", theorem.discontinuous_edges_y));
+                               .set("discontinuous_edges_y", theorem.discontinuous_edges_y)
+                               .set("pockets_closed", rr.pockets_closed));
     report.set("graph_surface_triangles", static_cast<int64_t>(rr.gamma.size()));
     report.set("options", Json::object()
                               .set("bending", args.pair.bending)

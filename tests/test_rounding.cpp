@@ -1,3 +1,4 @@
+#include "shapematch/constraints.hpp"
 #include "shapematch/errors.hpp"
 #include "shapematch/matching.hpp"
 #include "shapematch/rounding.hpp"
@@ -5,6 +6,9 @@
 #include "test_helpers.hpp"
 
 #include <doctest/doctest.h>
+
+#include <map>
+#include <numeric>
 
 using namespace shapematch;
 
@@ -209,4 +213,90 @@ TEST_CASE("rounding: a fixing of an earlier round that leaves no binary solution
   // Without backtracking over rounds the same LP ends in an error.
   options.max_backtracks = 0;
   CHECK_THROWS_AS(round_to_graph_surface(space, lp, {0, 10, 0, 0, 0}, options), InfeasibleError);
+}
+
+namespace {
+
+// A x of a 0/1 vector, keyed by what each row means: the product edge (closedness) or the face
+// (coverage), so that two lists of product triangles can be compared row by row.
+std::map<std::pair<int, int64_t>, int64_t> boundary_and_coverage(const Mesh& x, const Mesh& y,
+                                                                 const std::vector<ProductTriangle>& list) {
+  const ConstraintSystem cs = build_constraints(ProductSpace::from_list(x, y, list));
+  std::map<std::pair<int, int64_t>, int64_t> out;
+  for (int64_t i = 0; i < cs.a.rows; ++i) {
+    int64_t sum = 0;
+    for (uint32_t k = cs.a.row_ptr[i]; k < cs.a.row_ptr[i + 1]; ++k) sum += is_negative(cs.a.entry[k]) ? -1 : 1;
+    const std::pair<int, int64_t> key = i < cs.closedness_rows ? std::pair<int, int64_t>{0, cs.row_edge[i]}
+                                                               : std::pair<int, int64_t>{1, i - cs.closedness_rows};
+    if (sum != 0) out[key] = sum;
+  }
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE("rounding: a pocket is replaced by its fan collapsed onto the rim vertex, with the same A x") {
+  // The tear found at 2000 faces on FAUST_r: an edge u-w of X stretched over the whole fan around
+  // a vertex c of Y, u paired with c and with nothing near c otherwise.
+  const Mesh x = shapes::icosphere(1);
+  const Mesh& y = x;
+  const ProductSpace space = ProductSpace::full(x, y);
+  const int c = 0;
+  const auto [u, w] = x.edges[7];
+  REQUIRE(u != c);
+  REQUIRE(w != c);
+  std::vector<ProductTriangle> pocket, collapsed, mirror_pocket, mirror_collapsed;
+  for (int g = 0; g < y.num_faces(); ++g) {
+    const auto& f = y.faces[g];
+    const int r = f[0] == c ? 0 : f[1] == c ? 1 : f[2] == c ? 2 : -1;
+    if (r < 0) continue;
+    const std::array<int, 3> from_c{f[r], f[(r + 1) % 3], f[(r + 2) % 3]};
+    pocket.push_back({{u, w, w}, from_c, -1, g});
+    collapsed.push_back({{w, w, w}, f, -1, g});
+    // X and Y swapped: an edge of Y over the fan of X around c.
+    mirror_pocket.push_back({from_c, {u, w, w}, g, -1});
+    mirror_collapsed.push_back({f, {w, w, w}, g, -1});
+  }
+  REQUIRE(pocket.size() == 5);  // the icosphere's vertex 0 has five faces
+  CHECK(boundary_and_coverage(x, y, pocket) == boundary_and_coverage(x, y, collapsed));
+  CHECK(boundary_and_coverage(x, y, mirror_pocket) == boundary_and_coverage(x, y, mirror_collapsed));
+
+  auto indices = [&](const std::vector<ProductTriangle>& list) {
+    std::vector<int64_t> out;
+    for (const auto& t : list) out.push_back(space.index_in_full(t));
+    std::sort(out.begin(), out.end());
+    return out;
+  };
+  int64_t closed = -1;
+  CHECK(close_pockets(space, indices(pocket), &closed) == indices(collapsed));
+  CHECK(closed == 1);
+  CHECK(close_pockets(space, indices(mirror_pocket), &closed) == indices(mirror_collapsed));
+  CHECK(closed == 1);
+  // Both at once, and the same through a listed space (the replacements found by scanning it).
+  std::vector<ProductTriangle> both = pocket, both_collapsed = collapsed;
+  both.insert(both.end(), mirror_pocket.begin(), mirror_pocket.end());
+  both_collapsed.insert(both_collapsed.end(), mirror_collapsed.begin(), mirror_collapsed.end());
+  std::vector<ProductTriangle> listed = both;
+  listed.insert(listed.end(), both_collapsed.begin(), both_collapsed.end());
+  const ProductSpace small = ProductSpace::from_list(x, y, listed);
+  std::vector<int64_t> first(both.size());
+  std::iota(first.begin(), first.end(), 0);
+  std::vector<int64_t> second(both.size());
+  std::iota(second.begin(), second.end(), int64_t(both.size()));
+  CHECK(close_pockets(small, first, &closed) == second);
+  CHECK(closed == 2);
+  // Without the replacement in the space, nothing changes.
+  const ProductSpace without = ProductSpace::from_list(x, y, both);
+  CHECK(close_pockets(without, first, &closed) == first);
+  CHECK(closed == 0);
+
+  // Not a tear when u meets c elsewhere (here: u blown up onto a face at c).
+  std::vector<ProductTriangle> meets = pocket;
+  meets.push_back({{u, u, u}, collapsed[0].b, -1, collapsed[0].fb});
+  CHECK(close_pockets(space, indices(meets), &closed) == indices(meets));
+  CHECK(closed == 0);
+  // Not a whole fan: the rim's boundary would not match.
+  std::vector<ProductTriangle> part(pocket.begin(), pocket.end() - 1);
+  CHECK(close_pockets(space, indices(part), &closed) == indices(part));
+  CHECK(closed == 0);
 }

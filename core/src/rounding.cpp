@@ -10,6 +10,7 @@
 #include <cmath>
 #include <deque>
 #include <numeric>
+#include <unordered_map>
 
 namespace shapematch {
 namespace {
@@ -261,6 +262,105 @@ int64_t propagation_conflict(const LpProblem& lp, const std::vector<char>& skip)
   return fixer.propagate_all(skip.empty() ? nullptr : &skip) ? -1 : fixer.failed_row();
 }
 
+std::vector<int64_t> close_pockets(const ProductSpace& space, const std::vector<int64_t>& gamma, int64_t* closed) {
+  const Mesh& X = space.x();
+  const Mesh& Y = space.y();
+  // One pass for both sides: `side` 0 looks at ET triangles (an edge of X over faces of Y), 1 at
+  // TE (an edge of Y over faces of X), in canonical form (tail, head, head) with the tail at 0.
+  struct Key {
+    int side, u, w, c;
+    bool operator==(const Key&) const = default;
+  };
+  struct KeyHash {
+    size_t operator()(const Key& k) const {
+      return std::hash<int64_t>()((int64_t(k.side) << 62) ^ (int64_t(k.u) << 40) ^ (int64_t(k.w) << 20) ^ k.c);
+    }
+  };
+  std::unordered_map<Key, std::vector<int64_t>, KeyHash> groups;  // Γ's members of each candidate pocket
+  for (int64_t j : gamma) {
+    const ProductTriangle t = space[j];
+    if (t.fa < 0 && t.fb >= 0 && t.a[0] != t.a[1] && t.a[1] == t.a[2])
+      groups[{0, t.a[0], t.a[1], t.b[0]}].push_back(j);
+    else if (t.fb < 0 && t.fa >= 0 && t.b[0] != t.b[1] && t.b[1] == t.b[2])
+      groups[{1, t.b[0], t.b[1], t.a[0]}].push_back(j);
+  }
+  if (closed) *closed = 0;
+  if (groups.empty()) return gamma;
+  auto faces_around = [](const Mesh& m) {
+    std::vector<int> count(m.num_vertices(), 0);
+    for (const auto& f : m.faces)
+      for (int v : f) ++count[v];
+    return count;
+  };
+  const std::vector<int> valence_x = faces_around(X), valence_y = faces_around(Y);
+  // Pairs (u, c) that Γ relates outside the candidate's own triangles: then it is no tear.
+  std::unordered_map<int64_t, int> paired[2];  // side -> (u, c) -> number of triangles relating them
+  for (int64_t j : gamma) {
+    const ProductTriangle t = space[j];
+    for (int i = 0; i < 3; ++i) {
+      if ((i > 0 && t.a[i] == t.a[0] && t.b[i] == t.b[0]) || (i > 1 && t.a[i] == t.a[1] && t.b[i] == t.b[1])) continue;
+      ++paired[0][int64_t(t.a[i]) * Y.num_vertices() + t.b[i]];
+      ++paired[1][int64_t(t.b[i]) * X.num_vertices() + t.a[i]];
+    }
+  }
+  // The replacement of each pocket's triangles: the fan collapsed onto w.
+  struct Swap {
+    int64_t from;
+    ProductTriangle to;
+    int64_t to_index = -1;
+  };
+  std::vector<std::vector<Swap>> pockets;
+  for (const auto& [k, members] : groups) {
+    const std::vector<int>& valence = k.side == 0 ? valence_y : valence_x;
+    if (static_cast<int>(members.size()) != valence[k.c]) continue;  // not the whole fan around c
+    const int64_t key = k.side == 0 ? int64_t(k.u) * Y.num_vertices() + k.c : int64_t(k.u) * X.num_vertices() + k.c;
+    if (paired[k.side].at(key) != static_cast<int>(members.size())) continue;  // u meets c elsewhere too
+    std::vector<Swap> pocket;
+    for (int64_t j : members) {
+      const ProductTriangle t = space[j];
+      if (k.side == 0) pocket.push_back({j, {{k.w, k.w, k.w}, Y.faces[t.fb], -1, t.fb}});
+      else pocket.push_back({j, {X.faces[t.fa], {k.w, k.w, k.w}, t.fa, -1}});
+    }
+    pockets.push_back(std::move(pocket));
+  }
+  if (pockets.empty()) return gamma;
+  // Where the replacements are: by formula in the full space, by one scan of a listed space.
+  if (space.is_full()) {
+    for (auto& pocket : pockets)
+      for (Swap& s : pocket) s.to_index = space.index_in_full(s.to);
+  } else {
+    auto key_of = [&](const ProductTriangle& t) {  // a VT or TV triangle by its vertex and face
+      return t.fb >= 0 ? int64_t(t.a[0]) * Y.num_faces() + t.fb : -1 - (int64_t(t.b[0]) * X.num_faces() + t.fa);
+    };
+    std::unordered_map<int64_t, Swap*> wanted;
+    for (auto& pocket : pockets)
+      for (Swap& s : pocket) wanted[key_of(s.to)] = &s;
+    for (int64_t j = 0; j < space.size(); ++j) {
+      const ProductTriangle t = space[j];
+      const bool vt = t.fa < 0 && t.a[0] == t.a[1] && t.a[1] == t.a[2];
+      const bool tv = t.fb < 0 && t.b[0] == t.b[1] && t.b[1] == t.b[2];
+      if (!vt && !tv) continue;
+      const auto it = wanted.find(key_of(t));
+      if (it != wanted.end() && t == it->second->to) it->second->to_index = j;
+    }
+  }
+  // A pocket is replaced whole or not at all (a reduced space may lack part of its replacement).
+  std::unordered_map<int64_t, int64_t> replace;  // old index -> new index
+  for (const auto& pocket : pockets) {
+    if (std::any_of(pocket.begin(), pocket.end(), [](const Swap& s) { return s.to_index < 0; })) continue;
+    for (const Swap& s : pocket) replace[s.from] = s.to_index;
+    if (closed) ++*closed;
+  }
+  std::vector<int64_t> out;
+  out.reserve(gamma.size());
+  for (int64_t j : gamma) {
+    const auto it = replace.find(j);
+    out.push_back(it == replace.end() ? j : it->second);
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
 bool satisfies_exactly(const LpProblem& lp, const std::vector<int64_t>& gamma) {
   std::vector<int64_t> ax(lp.rows(), 0);
   for (int64_t j : gamma) {
@@ -419,6 +519,12 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
     if (s.value[j] == 1) result.gamma.push_back(j);
   if (!satisfies_exactly(lp, result.gamma))
     throw SolverError("rounding produced a Γ that violates A x = b (a bug); nothing was written");
+  if (options.close_pockets) {
+    result.gamma = close_pockets(space, result.gamma, &result.pockets_closed);
+    if (result.pockets_closed > 0 && !satisfies_exactly(lp, result.gamma))
+      throw SolverError("closing pockets broke A x = b (a bug); nothing was written");
+    if (result.pockets_closed > 0) spdlog::debug("rounding: closed {} pockets", result.pockets_closed);
+  }
   for (int64_t j : result.gamma) result.energy += energy[j];
   if (result.rounds.empty()) {  // propagation alone decided everything (tiny problems)
     result.first_lp = solver->solve(lp, options.lp);

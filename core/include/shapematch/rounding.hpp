@@ -23,6 +23,8 @@ struct RoundingOptions {
   // largest value (0: the single largest). Measured both ways on that pair only: 5.5 against
   // 12.5 minutes, but a worse Γ (docs/architecture.md).
   double fractional_batch = 0.125;
+  // Replace the "pockets" that A x = b admits but Theorem 1 does not foresee (close_pockets).
+  bool close_pockets = true;
   int max_backtracks = 200;    // fixings undone after an infeasible LP (each one more, smaller LP
                                // solve), then fail with InfeasibleError naming the open rows
   std::string solver = "pdhg-cpu";
@@ -45,6 +47,7 @@ struct RoundingRound {
 struct RoundingResult {
   std::vector<int64_t> gamma;  // selected variables (indices into the space), sorted
   double energy = 0.0;         // Σ energy of Γ, unscaled
+  int64_t pockets_closed = 0;  // pockets replaced after rounding (close_pockets)
   double lower_bound = 0.0;    // certified bound of the first LP
   double gap = 0.0;            // (energy − bound) / |bound|
   LpResult first_lp;           // the relaxation before any fixing
@@ -59,6 +62,17 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
 // Unit propagation of A x = b over binary x with nothing fixed, leaving out the rows marked in
 // `skip` (empty: none): the row where it finds a contradiction, or -1 if it finds none.
 int64_t propagation_conflict(const LpProblem& lp, const std::vector<char>& skip = {});
+
+// A pocket: an edge u-w of X stretched over the whole fan of faces around a vertex c of Y, with
+// u paired to c and w to the fan's rim (product triangles (u, w, w) x (c, b1, b2)), where nothing
+// else pairs u with c. It satisfies A x = b, but relates u to c apart from the rest of u's
+// fibre: a tear (Theorem 1 says A x = b rules tears out; it does not). Measured on FAUST_r
+// 020-024 at 2000 faces: every torn vertex of X was the tip of such a pocket. The same fan
+// collapsed onto w alone ((w, w, w) x (c, b1, b2)) has the same boundary and covers the same
+// faces, and tears nothing; likewise with X and Y swapped. Replaces every pocket whose
+// replacement is in the space; returns the new Γ (sorted) and counts the pockets in `closed`.
+std::vector<int64_t> close_pockets(const ProductSpace& space, const std::vector<int64_t>& gamma,
+                                   int64_t* closed = nullptr);
 
 // A x = b checked exactly in integers for the 0/1 vector with ones at `gamma`.
 bool satisfies_exactly(const LpProblem& lp, const std::vector<int64_t>& gamma);
