@@ -300,3 +300,46 @@ TEST_CASE("rounding: a pocket is replaced by its fan collapsed onto the rim vert
   CHECK(close_pockets(space, indices(part), &closed) == indices(part));
   CHECK(closed == 0);
 }
+
+TEST_CASE("rounding: a pocket with two tips (an edge over the star of an edge) is replaced too") {
+  // Measured on FAUST_r at 2000 faces after the one-tip pockets were closed: the rest had two
+  // adjacent tips. u is paired with both ends of the edge c-d of Y, w with the star's rim.
+  const Mesh x = shapes::icosphere(1);
+  const Mesh& y = x;
+  const ProductSpace space = ProductSpace::full(x, y);
+  const auto [c, d] = y.edges[0];
+  int u = -1, w = -1;
+  for (const auto& e : x.edges)
+    if (e[0] != c && e[0] != d && e[1] != c && e[1] != d) {
+      u = e[0], w = e[1];
+      break;
+    }
+  REQUIRE(u >= 0);
+  std::vector<ProductTriangle> pocket, collapsed;
+  for (int g = 0; g < y.num_faces(); ++g) {
+    const auto& f = y.faces[g];
+    int tips = 0;
+    for (int v : f) tips += v == c || v == d;
+    if (tips == 0) continue;
+    // Canonical form: the single one of the two X vertices first, the face rotated to match.
+    for (int r = 0; r < 3; ++r) {
+      const std::array<int, 3> b{f[r], f[(r + 1) % 3], f[(r + 2) % 3]};
+      const bool first_is_tip = b[0] == c || b[0] == d;
+      if (tips == 1 && first_is_tip) pocket.push_back({{u, w, w}, b, -1, g});
+      if (tips == 2 && !first_is_tip) pocket.push_back({{w, u, u}, b, -1, g});
+    }
+    collapsed.push_back({{w, w, w}, f, -1, g});
+  }
+  REQUIRE(pocket.size() == collapsed.size());
+  REQUIRE(pocket.size() >= 8);  // two vertices of valence 5 or 6 that share two faces
+  CHECK(boundary_and_coverage(x, y, pocket) == boundary_and_coverage(x, y, collapsed));
+  auto indices = [&](const std::vector<ProductTriangle>& list) {
+    std::vector<int64_t> out;
+    for (const auto& t : list) out.push_back(space.index_in_full(t));
+    std::sort(out.begin(), out.end());
+    return out;
+  };
+  int64_t closed = -1;
+  CHECK(close_pockets(space, indices(pocket), &closed) == indices(collapsed));
+  CHECK(closed == 1);
+}

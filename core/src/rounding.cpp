@@ -9,7 +9,9 @@
 #include <algorithm>
 #include <cmath>
 #include <deque>
+#include <map>
 #include <numeric>
+#include <set>
 #include <unordered_map>
 
 namespace shapematch {
@@ -263,92 +265,137 @@ int64_t propagation_conflict(const LpProblem& lp, const std::vector<char>& skip)
 }
 
 std::vector<int64_t> close_pockets(const ProductSpace& space, const std::vector<int64_t>& gamma, int64_t* closed) {
+  if (closed) *closed = 0;
   const Mesh& X = space.x();
   const Mesh& Y = space.y();
-  // One pass for both sides: `side` 0 looks at ET triangles (an edge of X over faces of Y), 1 at
-  // TE (an edge of Y over faces of X), in canonical form (tail, head, head) with the tail at 0.
-  struct Key {
-    int side, u, w, c;
-    bool operator==(const Key&) const = default;
+  // Side 0: ET triangles, an edge of X over faces of Y; side 1: TE, an edge of Y over faces of X.
+  // In canonical form the edge part is (tail, head, head) and the fan part a face from some corner.
+  struct Part {
+    std::array<int, 3> edge, fan;
+    int face;
   };
-  struct KeyHash {
-    size_t operator()(const Key& k) const {
-      return std::hash<int64_t>()((int64_t(k.side) << 62) ^ (int64_t(k.u) << 40) ^ (int64_t(k.w) << 20) ^ k.c);
-    }
+  auto part = [](const ProductTriangle& t, int side) {
+    return side == 0 ? Part{t.a, t.b, t.fb} : Part{t.b, t.a, t.fa};
   };
-  std::unordered_map<Key, std::vector<int64_t>, KeyHash> groups;  // Γ's members of each candidate pocket
-  for (int64_t j : gamma) {
-    const ProductTriangle t = space[j];
-    if (t.fa < 0 && t.fb >= 0 && t.a[0] != t.a[1] && t.a[1] == t.a[2])
-      groups[{0, t.a[0], t.a[1], t.b[0]}].push_back(j);
-    else if (t.fb < 0 && t.fa >= 0 && t.b[0] != t.b[1] && t.b[1] == t.b[2])
-      groups[{1, t.b[0], t.b[1], t.a[0]}].push_back(j);
-  }
-  if (closed) *closed = 0;
-  if (groups.empty()) return gamma;
-  auto faces_around = [](const Mesh& m) {
-    std::vector<int> count(m.num_vertices(), 0);
-    for (const auto& f : m.faces)
-      for (int v : f) ++count[v];
-    return count;
+  auto is_edge_over_face = [](const ProductTriangle& t, int side) {
+    const auto& e = side == 0 ? t.a : t.b;
+    return (side == 0 ? t.fa < 0 && t.fb >= 0 : t.fb < 0 && t.fa >= 0) && e[0] != e[1] && e[1] == e[2];
   };
-  const std::vector<int> valence_x = faces_around(X), valence_y = faces_around(Y);
-  // Pairs (u, c) that Γ relates outside the candidate's own triangles: then it is no tear.
-  std::unordered_map<int64_t, int> paired[2];  // side -> (u, c) -> number of triangles relating them
-  for (int64_t j : gamma) {
-    const ProductTriangle t = space[j];
-    for (int i = 0; i < 3; ++i) {
-      if ((i > 0 && t.a[i] == t.a[0] && t.b[i] == t.b[0]) || (i > 1 && t.a[i] == t.a[1] && t.b[i] == t.b[1])) continue;
-      ++paired[0][int64_t(t.a[i]) * Y.num_vertices() + t.b[i]];
-      ++paired[1][int64_t(t.b[i]) * X.num_vertices() + t.a[i]];
-    }
-  }
-  // The replacement of each pocket's triangles: the fan collapsed onto w.
-  struct Swap {
-    int64_t from;
-    ProductTriangle to;
-    int64_t to_index = -1;
+  struct Pocket {
+    int side, w;
+    std::vector<int64_t> members;  // indices into the space
+    std::vector<int64_t> to;       // their replacements, -1 until found
   };
-  std::vector<std::vector<Swap>> pockets;
-  for (const auto& [k, members] : groups) {
-    const std::vector<int>& valence = k.side == 0 ? valence_y : valence_x;
-    if (static_cast<int>(members.size()) != valence[k.c]) continue;  // not the whole fan around c
-    const int64_t key = k.side == 0 ? int64_t(k.u) * Y.num_vertices() + k.c : int64_t(k.u) * X.num_vertices() + k.c;
-    if (paired[k.side].at(key) != static_cast<int>(members.size())) continue;  // u meets c elsewhere too
-    std::vector<Swap> pocket;
-    for (int64_t j : members) {
+  std::vector<Pocket> pockets;
+  for (int side = 0; side < 2; ++side) {
+    const Mesh& E = side == 0 ? X : Y;  // where the stretched edge lies
+    const Mesh& F = side == 0 ? Y : X;  // where the fan lies
+    std::map<std::pair<int, int>, std::vector<int64_t>> by_edge;  // undirected edge -> Γ's triangles over it
+    // Pairs (edge-side vertex, fan-side vertex) related by Γ, counted once per triangle.
+    std::unordered_map<int64_t, int> paired;
+    auto pair_key = [&](int e, int f) { return int64_t(e) * F.num_vertices() + f; };
+    for (int64_t j : gamma) {
       const ProductTriangle t = space[j];
-      if (k.side == 0) pocket.push_back({j, {{k.w, k.w, k.w}, Y.faces[t.fb], -1, t.fb}});
-      else pocket.push_back({j, {X.faces[t.fa], {k.w, k.w, k.w}, t.fa, -1}});
+      const Part p = part(t, side);
+      for (int i = 0; i < 3; ++i) {
+        bool seen = false;
+        for (int k = 0; k < i; ++k) seen = seen || (p.edge[k] == p.edge[i] && p.fan[k] == p.fan[i]);
+        if (!seen) ++paired[pair_key(p.edge[i], p.fan[i])];
+      }
+      if (is_edge_over_face(t, side))
+        by_edge[{std::min(p.edge[0], p.edge[1]), std::max(p.edge[0], p.edge[1])}].push_back(j);
     }
-    pockets.push_back(std::move(pocket));
+    if (by_edge.empty()) continue;
+    std::vector<std::vector<int>> faces_at(F.num_vertices());
+    for (int f = 0; f < F.num_faces(); ++f)
+      for (int v : F.faces[f]) faces_at[v].push_back(f);
+    for (const auto& [edge, over] : by_edge) {
+      for (const int u : {edge.first, edge.second}) {
+        const int w = u == edge.first ? edge.second : edge.first;
+        // The tips: fan-side vertices paired with u; a pocket is one connected set K of them.
+        std::map<int, std::vector<int64_t>> at_tip;  // tip -> triangles pairing u with it
+        for (int64_t j : over) {
+          const Part p = part(space[j], side);
+          for (int i = 0; i < 3; ++i)
+            if (p.edge[i] == u) at_tip[p.fan[i]].push_back(j);
+        }
+        std::set<int> left;
+        for (const auto& [tip, js] : at_tip) left.insert(tip);
+        while (!left.empty()) {
+          std::vector<int> k{*left.begin()};
+          left.erase(left.begin());
+          for (size_t n = 0; n < k.size(); ++n)  // grow K along F's edges within the tips
+            for (int f : faces_at[k[n]])
+              for (int v : F.faces[f])
+                if (left.erase(v)) k.push_back(v);
+          const std::set<int> kset(k.begin(), k.end());
+          std::set<int64_t> members;
+          for (int v : k) members.insert(at_tip[v].begin(), at_tip[v].end());
+          // The pocket must be the whole star of K, and pair w only with vertices outside K.
+          std::set<int> star;
+          for (int v : k) star.insert(faces_at[v].begin(), faces_at[v].end());
+          bool ok = members.size() == star.size();
+          for (int64_t j : members) {
+            const Part p = part(space[j], side);
+            ok = ok && star.count(p.face);
+            for (int i = 0; i < 3; ++i) ok = ok && (p.edge[i] == u) == (kset.count(p.fan[i]) > 0);
+          }
+          // A tear only: nothing outside the pocket pairs u with K.
+          for (int v : k) {
+            int inside = 0;
+            for (int64_t j : members) {
+              const Part p = part(space[j], side);
+              for (int i = 0; i < 3; ++i)
+                if (p.edge[i] == u && p.fan[i] == v) {
+                  ++inside;
+                  break;
+                }
+            }
+            ok = ok && paired.at(pair_key(u, v)) == inside;
+          }
+          if (ok) pockets.push_back({side, w, {members.begin(), members.end()}, {}});
+        }
+      }
+    }
   }
   if (pockets.empty()) return gamma;
-  // Where the replacements are: by formula in the full space, by one scan of a listed space.
+  // The replacement of each member: its face with the whole fan on w, (w, w, w) x face.
+  auto replacement = [&](const Pocket& pk, int64_t j) {
+    const ProductTriangle t = space[j];
+    return pk.side == 0 ? ProductTriangle{{pk.w, pk.w, pk.w}, Y.faces[t.fb], -1, t.fb}
+                        : ProductTriangle{X.faces[t.fa], {pk.w, pk.w, pk.w}, t.fa, -1};
+  };
+  for (auto& pk : pockets) pk.to.assign(pk.members.size(), -1);
   if (space.is_full()) {
-    for (auto& pocket : pockets)
-      for (Swap& s : pocket) s.to_index = space.index_in_full(s.to);
-  } else {
+    for (auto& pk : pockets)
+      for (size_t n = 0; n < pk.members.size(); ++n) pk.to[n] = space.index_in_full(replacement(pk, pk.members[n]));
+  } else {  // one scan of the listed space
     auto key_of = [&](const ProductTriangle& t) {  // a VT or TV triangle by its vertex and face
       return t.fb >= 0 ? int64_t(t.a[0]) * Y.num_faces() + t.fb : -1 - (int64_t(t.b[0]) * X.num_faces() + t.fa);
     };
-    std::unordered_map<int64_t, Swap*> wanted;
-    for (auto& pocket : pockets)
-      for (Swap& s : pocket) wanted[key_of(s.to)] = &s;
+    std::unordered_map<int64_t, std::pair<ProductTriangle, int64_t*>> wanted;
+    for (auto& pk : pockets)
+      for (size_t n = 0; n < pk.members.size(); ++n) {
+        const ProductTriangle r = replacement(pk, pk.members[n]);
+        wanted[key_of(r)] = {r, &pk.to[n]};
+      }
     for (int64_t j = 0; j < space.size(); ++j) {
       const ProductTriangle t = space[j];
       const bool vt = t.fa < 0 && t.a[0] == t.a[1] && t.a[1] == t.a[2];
       const bool tv = t.fb < 0 && t.b[0] == t.b[1] && t.b[1] == t.b[2];
       if (!vt && !tv) continue;
       const auto it = wanted.find(key_of(t));
-      if (it != wanted.end() && t == it->second->to) it->second->to_index = j;
+      if (it != wanted.end() && t == it->second.first) *it->second.second = j;
     }
   }
-  // A pocket is replaced whole or not at all (a reduced space may lack part of its replacement).
+  // A pocket is replaced whole or not at all (a reduced space may lack part of its replacement);
+  // two pockets never share a triangle (each face is covered once), but be sure.
   std::unordered_map<int64_t, int64_t> replace;  // old index -> new index
-  for (const auto& pocket : pockets) {
-    if (std::any_of(pocket.begin(), pocket.end(), [](const Swap& s) { return s.to_index < 0; })) continue;
-    for (const Swap& s : pocket) replace[s.from] = s.to_index;
+  for (const auto& pk : pockets) {
+    bool ok = std::none_of(pk.to.begin(), pk.to.end(), [](int64_t i) { return i < 0; });
+    for (int64_t j : pk.members) ok = ok && !replace.count(j);
+    if (!ok) continue;
+    for (size_t n = 0; n < pk.members.size(); ++n) replace[pk.members[n]] = pk.to[n];
     if (closed) ++*closed;
   }
   std::vector<int64_t> out;

@@ -63,14 +63,15 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
 // `skip` (empty: none): the row where it finds a contradiction, or -1 if it finds none.
 int64_t propagation_conflict(const LpProblem& lp, const std::vector<char>& skip = {});
 
-// A pocket: an edge u-w of X stretched over the whole fan of faces around a vertex c of Y, with
-// u paired to c and w to the fan's rim (product triangles (u, w, w) x (c, b1, b2)), where nothing
-// else pairs u with c. It satisfies A x = b, but relates u to c apart from the rest of u's
-// fibre: a tear (Theorem 1 says A x = b rules tears out; it does not). Measured on FAUST_r
-// 020-024 at 2000 faces: every torn vertex of X was the tip of such a pocket. The same fan
-// collapsed onto w alone ((w, w, w) x (c, b1, b2)) has the same boundary and covers the same
-// faces, and tears nothing; likewise with X and Y swapped. Replaces every pocket whose
-// replacement is in the space; returns the new Γ (sorted) and counts the pockets in `closed`.
+// A pocket: an edge u-w of X stretched over the whole star of a connected set K of vertices of
+// Y, u paired with exactly K and w with the star's rim (product triangles (u, w, w) x (k, b1, b2)
+// and (w, u, u) x (r, k1, k2)), where nothing else pairs u with K. It satisfies A x = b, but
+// relates u to K apart from the rest of u's fibre: a tear (Theorem 1 says A x = b rules tears
+// out; it does not). The same star collapsed onto w ((w, w, w) x each face) has the same
+// boundary and covers the same faces, and tears nothing; likewise with X and Y swapped.
+// Measured on FAUST_r 020-024 at 2000 faces (Γ saved by match): 15 pockets, torn vertices
+// 6 + 6 -> 0 + 1, with one tip (12) and two. Replaces every pocket whose replacement is in the
+// space; returns the new Γ (sorted) and counts the pockets in `closed`.
 std::vector<int64_t> close_pockets(const ProductSpace& space, const std::vector<int64_t>& gamma,
                                    int64_t* closed = nullptr);
 
