@@ -29,6 +29,7 @@ struct MatchArgs {
   double threshold = 0.5;
   int max_rounds = 50;
   double fractional_batch = RoundingOptions{}.fractional_batch;
+  bool close_pockets = RoundingOptions{}.close_pockets;
   double tolerance = 1e-4;
   double coarse_tolerance = CoarseToFineOptions{}.coarse_tolerance;
   double time_limit = std::numeric_limits<double>::infinity();
@@ -105,6 +106,7 @@ int run_match(const MatchArgs& args) {
   ro.threshold = args.threshold;
   ro.max_rounds = args.max_rounds;
   ro.fractional_batch = args.fractional_batch;
+  ro.close_pockets = args.close_pockets;
   ro.lp.tolerance = args.tolerance;
   ro.lp.time_limit = args.time_limit;
   ro.lp.device = args.device;
@@ -220,6 +222,7 @@ int run_match(const MatchArgs& args) {
                               .set("lame_mu", args.pair.lame.at(1))
                               .set("threshold", args.threshold)
                               .set("fractional_batch", args.fractional_batch)
+                              .set("close_pockets", args.close_pockets)
                               .set("tolerance", args.tolerance)
                               .set("coarse_tolerance", co.coarse_tolerance)
                               .set("faces", args.pair.faces)
@@ -286,6 +289,8 @@ Action add_match_command(CLI::App& app) {
   app.add_option("--threshold", a->threshold, "fix LP values above this to 1")
       ->check(CLI::Range(0.0, 1.0))
       ->capture_default_str();
+  app.add_flag("--close-pockets", a->close_pockets,
+               "replace each pocket (an edge stretched over a whole star, a tear that A x = b admits) by the star collapsed onto one vertex: continuous, but costs energy");
   app.add_option("--fractional-batch", a->fractional_batch,
                  "where no LP value exceeds the threshold, fix the largest of up to this fraction of the open faces "
                  "(0: the single largest)")
