@@ -233,6 +233,14 @@ std::map<std::pair<int, int64_t>, int64_t> boundary_and_coverage(const Mesh& x, 
   return out;
 }
 
+// The indices of product triangles in a full space, sorted like a Γ.
+std::vector<int64_t> sorted_indices(const ProductSpace& space, const std::vector<ProductTriangle>& list) {
+  std::vector<int64_t> out;
+  for (const auto& t : list) out.push_back(space.index_in_full(t));
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
 }  // namespace
 
 TEST_CASE("rounding: a pocket is replaced by its fan collapsed onto the rim vertex, with the same A x") {
@@ -261,12 +269,7 @@ TEST_CASE("rounding: a pocket is replaced by its fan collapsed onto the rim vert
   CHECK(boundary_and_coverage(x, y, pocket) == boundary_and_coverage(x, y, collapsed));
   CHECK(boundary_and_coverage(x, y, mirror_pocket) == boundary_and_coverage(x, y, mirror_collapsed));
 
-  auto indices = [&](const std::vector<ProductTriangle>& list) {
-    std::vector<int64_t> out;
-    for (const auto& t : list) out.push_back(space.index_in_full(t));
-    std::sort(out.begin(), out.end());
-    return out;
-  };
+  auto indices = [&](const std::vector<ProductTriangle>& list) { return sorted_indices(space, list); };
   int64_t closed = -1;
   CHECK(close_pockets(space, indices(pocket), &closed) == indices(collapsed));
   CHECK(closed == 1);
@@ -333,12 +336,7 @@ TEST_CASE("rounding: a pocket with two tips (an edge over the star of an edge) i
   REQUIRE(pocket.size() == collapsed.size());
   REQUIRE(pocket.size() >= 8);  // two vertices of valence 5 or 6 that share two faces
   CHECK(boundary_and_coverage(x, y, pocket) == boundary_and_coverage(x, y, collapsed));
-  auto indices = [&](const std::vector<ProductTriangle>& list) {
-    std::vector<int64_t> out;
-    for (const auto& t : list) out.push_back(space.index_in_full(t));
-    std::sort(out.begin(), out.end());
-    return out;
-  };
+  auto indices = [&](const std::vector<ProductTriangle>& list) { return sorted_indices(space, list); };
   int64_t closed = -1;
   CHECK(close_pockets(space, indices(pocket), &closed) == indices(collapsed));
   CHECK(closed == 1);

@@ -288,8 +288,7 @@ std::vector<int64_t> close_pockets(const ProductSpace& space, const std::vector<
   };
   std::vector<Pocket> pockets;
   for (int side = 0; side < 2; ++side) {
-    const Mesh& E = side == 0 ? X : Y;  // where the stretched edge lies
-    const Mesh& F = side == 0 ? Y : X;  // where the fan lies
+    const Mesh& F = side == 0 ? Y : X;  // where the fan lies (the edge lies on the other)
     std::map<std::pair<int, int>, std::vector<int64_t>> by_edge;  // undirected edge -> Γ's triangles over it
     // Pairs (edge-side vertex, fan-side vertex) related by Γ, counted once per triangle.
     std::unordered_map<int64_t, int> paired;
