@@ -119,6 +119,20 @@ TEST_CASE("cli: match writes a verified, complete output directory, or nothing")
   CHECK(fs::file_size(out / "match.png") > 10000);
   CHECK(fs::exists(out / "x.ply"));
   CHECK(fs::exists(out / "y.ply"));
+  CHECK(report.find("\"close_pockets\": false") != std::string::npos);  // off by default
+  CHECK(json_number(report, "pockets_closed") == 0);
+
+  // --close-pockets reaches the rounding and the report (no pocket at 30 faces; the repair
+  // itself is tested in test_rounding).
+  const fs::path closed = out.string() + "_pockets";
+  r = run("match --faces 30 --backend cpu --close-pockets -o " + closed.string());
+  REQUIRE(r.code == 0);
+  std::ifstream fc(closed / "report.json");
+  const std::string with((std::istreambuf_iterator<char>(fc)), {});
+  CHECK(with.find("\"close_pockets\": true") != std::string::npos);
+  CHECK(json_number(with, "pockets_closed") >= 0);
+  CHECK(with.find("\"verified\": true") != std::string::npos);
+  fs::remove_all(closed);
 
   // A failing run leaves the previous output untouched and no temporary directory behind.
   const fs::path bad = write_temp("open2.off", "OFF\n4 3 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n");
