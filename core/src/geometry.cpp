@@ -61,12 +61,11 @@ Geometry compute_geometry(const Mesh& mesh) {
   }
   for (auto& n : g.vertex_normal) n.normalize();
   g.halfedge_face.assign(2 * static_cast<size_t>(mesh.num_edges()), -1);
-  if (mesh.num_edges() > 0)
-    for (int f = 0; f < nf; ++f)
-      for (int i = 0; i < 3; ++i) {
-        const int d = mesh.directed_edge_index(mesh.faces[f][i], mesh.faces[f][(i + 1) % 3]);
-        if (d >= 0) g.halfedge_face[d] = f;
-      }
+  for (int f = 0; f < nf; ++f)
+    for (int i = 0; i < 3; ++i) {
+      const int d = mesh.directed_edge_index(mesh.faces[f][i], mesh.faces[f][(i + 1) % 3]);
+      if (d >= 0) g.halfedge_face[d] = f;  // -1 where the mesh's edges are not built
+    }
 
   g.cotan_laplacian.resize(nv, nv);
   g.cotan_laplacian.setFromTriplets(triplets.begin(), triplets.end());
