@@ -5,6 +5,7 @@
 #include "shapematch/evaluation.hpp"
 #include "shapematch/files.hpp"
 #include "shapematch/json.hpp"
+#include "shapematch/point_map.hpp"
 #include "shapematch/system.hpp"
 
 #include <spdlog/fmt/fmt.h>
@@ -146,6 +147,24 @@ int run_eval(const EvalArgs& args) {
   if (!args.gt_y_sym.empty())
     symmetric = geodesic_errors(y_full, phi, read_vts_ground_truth(args.gt_x, args.gt_y_sym, x_input, y_input), options);
   const OrientationFlips flips = count_orientation_flips(xm, ym, map);
+  // The point map (written by match since it has one): the same scores for points, whose
+  // corners are vertices of the matched Y, i.e. input vertices of Y.
+  const fs::path points_path = dir / "map_x_to_y_points.txt";
+  std::optional<GeodesicErrors> point_errors;
+  std::optional<OrientationFlips> point_flips;
+  if (fs::exists(points_path)) {
+    const std::vector<SurfacePoint> points = read_point_map(points_path.string(), ym);
+    if (static_cast<int>(points.size()) != xm.num_vertices())
+      throw InvalidInputError(fmt::format("{}: {} lines, but x.ply has {} vertices", points_path.string(),
+                                          points.size(), xm.num_vertices()));
+    std::vector<MappedPoint> phi_points(x_input);
+    for (int v = 0; v < xm.num_vertices(); ++v) {
+      const auto& f = ym.faces[points[v].face];
+      phi_points[x_ids[v]] = {{y_ids[f[0]], y_ids[f[1]], y_ids[f[2]]}, points[v].bary};
+    }
+    point_errors = geodesic_errors(y_full, phi_points, truth, options);
+    point_flips = count_orientation_flips(xm, ym, points);
+  }
 
   std::string csv = "threshold,fraction\n";
   Json pck = Json::array();
@@ -180,6 +199,13 @@ int run_eval(const EvalArgs& args) {
       .set("degenerate_faces", flips.degenerate)
       .set("geodesic_solves", errors.geodesic_solves)
       .set("seconds", total.seconds());
+  if (point_errors)
+    out.set("point_map", Json::object()
+                             .set("mean_geodesic_error", point_errors->mean)
+                             .set("median_geodesic_error", point_errors->median)
+                             .set("auc", point_errors->auc)
+                             .set("orientation_flips", point_flips->flips)
+                             .set("degenerate_faces", point_flips->degenerate));
   if (symmetric) {
     const bool sym_better = symmetric->mean < errors.mean;
     out.set("symmetric_ground_truth", args.gt_x + " <-> " + args.gt_y_sym)
@@ -192,6 +218,10 @@ int run_eval(const EvalArgs& args) {
   spdlog::info("mean geodesic error {:.4f} (median {:.4f}) over {} points, AUC {:.3f}; {} of {} faces flipped, {} "
                "degenerate",
                errors.mean, errors.median, errors.points, errors.auc, flips.flips, flips.faces, flips.degenerate);
+  if (point_errors)
+    spdlog::info("point map: mean geodesic error {:.4f} (median {:.4f}); {} of {} faces flipped, {} degenerate",
+                 point_errors->mean, point_errors->median, point_flips->flips, point_flips->faces,
+                 point_flips->degenerate);
   if (symmetric)
     spdlog::info("against the symmetric ground truth: mean {:.4f} (median {:.4f})", symmetric->mean, symmetric->median);
   return 0;

@@ -5,7 +5,9 @@
 #include "shapematch/device.hpp"
 #include "shapematch/errors.hpp"
 #include "shapematch/json.hpp"
+#include "shapematch/evaluation.hpp"
 #include "shapematch/matching.hpp"
+#include "shapematch/point_map.hpp"
 #include "shapematch/render.hpp"
 #include "shapematch/rounding.hpp"
 #include "shapematch/system.hpp"
@@ -144,6 +146,14 @@ int run_match(const MatchArgs& args) {
                  theorem.discontinuous_edges_y);
   const VertexMaps maps = vertex_maps(m.space, rr.gamma);
   seconds.set("verify", stage.seconds());
+  stage.reset();
+  // Points follow Γ where one partner vertex cannot (a vertex blown up, an edge stretched).
+  const PointMaps points = point_maps(m.space, rr.gamma, maps);
+  const OrientationFlips vertex_flips = count_orientation_flips(x, y, maps.x_to_y);
+  const OrientationFlips point_flips = count_orientation_flips(x, y, points.x_to_y);
+  seconds.set("point_maps", stage.seconds());
+  spdlog::info("faces of X inverted by the vertex map: {} ({} degenerate); by the point map: {} ({} degenerate)",
+               vertex_flips.flips, vertex_flips.degenerate, point_flips.flips, point_flips.degenerate);
   spdlog::info("energy {:.6g}, lower bound {:.6g}, gap {:.2f} %, {} rounds{}, verified", rr.energy, rr.lower_bound,
                100 * rr.gap, rr.rounds.size(),
                rr.pockets_closed > 0 ? fmt::format(", {} pockets closed", rr.pockets_closed) : std::string());
@@ -156,6 +166,8 @@ int run_match(const MatchArgs& args) {
   try {
     write_file_atomic((tmp / "map_x_to_y.txt").string(), lines(maps.x_to_y));
     write_file_atomic((tmp / "map_y_to_x.txt").string(), lines(maps.y_to_x));
+    write_file_atomic((tmp / "map_x_to_y_points.txt").string(), point_map_text(points.x_to_y));
+    write_file_atomic((tmp / "map_y_to_x_points.txt").string(), point_map_text(points.y_to_x));
     write_file_atomic((tmp / "x_vertex_ids.txt").string(), lines(p.x_ids));
     write_file_atomic((tmp / "y_vertex_ids.txt").string(), lines(p.y_ids));
     std::ostringstream gs;
@@ -216,6 +228,12 @@ int run_match(const MatchArgs& args) {
                                .set("discontinuous_edges_y", theorem.discontinuous_edges_y)
                                .set("pockets_closed", rr.pockets_closed));
     report.set("graph_surface_triangles", static_cast<int64_t>(rr.gamma.size()));
+    auto flips_json = [](const OrientationFlips& f) {
+      return Json::object().set("faces", f.faces).set("inverted", f.flips).set("degenerate", f.degenerate);
+    };
+    report.set("maps", Json::object()
+                           .set("vertex_x_to_y", flips_json(vertex_flips))
+                           .set("point_x_to_y", flips_json(point_flips)));
     report.set("options", Json::object()
                               .set("bending", args.pair.bending)
                               .set("lame_lambda", args.pair.lame.at(0))

@@ -111,6 +111,9 @@ TEST_CASE("cli: match writes a verified, complete output directory, or nothing")
     return static_cast<double>(std::count(std::istreambuf_iterator<char>(in), {}, '\n'));
   };
   CHECK(count_lines(out / "map_x_to_y.txt") == vx);
+  CHECK(count_lines(out / "map_x_to_y_points.txt") == vx);
+  CHECK(count_lines(out / "map_y_to_x_points.txt") == count_lines(out / "map_y_to_x.txt"));
+  CHECK(report.find("\"point_x_to_y\"") != std::string::npos);
   CHECK(count_lines(out / "graph_surface.txt") == json_number(report, "graph_surface_triangles"));
   std::ifstream png(out / "match.png", std::ios::binary);
   char sig[8] = {};
@@ -163,4 +166,10 @@ TEST_CASE("cli: the bundled pair matches sensibly" * doctest::test_suite("slow")
   REQUIRE_MESSAGE(r.code == 0, r.err);
   CHECK(json_number(r.out, "mean_geodesic_error") < 0.15);
   CHECK(json_number(r.out, "orientation_flips") == 0);
+  // The point map: scored the same way, no worse for orientation, and close in error.
+  const size_t at = r.out.find("\"point_map\"");
+  REQUIRE(at != std::string::npos);
+  const std::string points = r.out.substr(at);
+  CHECK(json_number(points, "orientation_flips") == 0);
+  CHECK(json_number(points, "mean_geodesic_error") < 0.15);
 }

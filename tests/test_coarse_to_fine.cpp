@@ -1,6 +1,7 @@
 #include "shapematch/coarse_to_fine.hpp"
 #include "shapematch/errors.hpp"
 #include "shapematch/evaluation.hpp"
+#include "shapematch/point_map.hpp"
 #include "shapematch/shapes.hpp"
 #include "test_helpers.hpp"
 
@@ -154,6 +155,10 @@ TEST_CASE("coarse to fine: a deformed pair with different triangulations ends ve
     MESSAGE("inverted faces: ", untangled, " untangled, ", first, " first partners");
     CHECK(untangled_x <= first_x);  // never worse, in either direction
     CHECK(untangled_y <= first_y);
+    // Points never invert more than the vertex maps they start from.
+    const PointMaps points = point_maps(r.finest.space, r.rounding.gamma, maps);
+    CHECK(count_orientation_flips(fx, fy, points.x_to_y).flips <= untangled_x);
+    CHECK(count_orientation_flips(fy, fx, points.y_to_x).flips <= untangled_y);
     flips_untangled += untangled;
     flips_first += first;
     for (const auto& l : r.levels) {

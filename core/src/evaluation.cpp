@@ -135,31 +135,52 @@ double pck_auc(const std::vector<std::array<double, 2>>& pck) {
 
 GeodesicErrors geodesic_errors(const Mesh& y, const std::vector<int>& phi, const GroundTruth& truth,
                                const EvaluationOptions& options) {
+  std::vector<MappedPoint> points(phi.size());
+  for (size_t v = 0; v < phi.size(); ++v) points[v] = {{phi[v], phi[v], phi[v]}, {1.0, 0.0, 0.0}};
+  return geodesic_errors(y, points, truth, options);
+}
+
+GeodesicErrors geodesic_errors(const Mesh& y, const std::vector<MappedPoint>& phi, const GroundTruth& truth,
+                               const EvaluationOptions& options) {
   const int ny = y.num_vertices();
   GeodesicErrors r;
+  // A pair whose prediction misses the truth: distances from `source` to up to three targets,
+  // weighted.
   struct Pending {
-    int source, target;
+    int source;
+    std::array<int, 3> targets;
+    std::array<double, 3> weights;
+    int n;
     size_t point;
   };
-  std::vector<Pending> pending;  // pairs whose prediction misses the truth
+  std::vector<Pending> pending;
   std::vector<char> is_pred(ny, 0), is_true(ny, 0);
   int distinct_pred = 0, distinct_true = 0;
+  bool all_vertices = true;
   for (const GroundTruthPair& p : truth) {
     if (p.x < 0 || p.x >= static_cast<int>(phi.size()) || p.y < 0 || p.y >= ny)
       throw InvalidInputError("evaluation: ground-truth pair (" + std::to_string(p.x) + ", " + std::to_string(p.y) +
                               ") is outside the map (" + std::to_string(phi.size()) + " X vertices) or Y (" +
                               std::to_string(ny) + " vertices)");
-    const int predicted = phi[p.x];
-    if (predicted < 0) continue;
-    if (predicted >= ny)
-      throw InvalidInputError("evaluation: the map sends X vertex " + std::to_string(p.x) + " to " +
-                              std::to_string(predicted) + ", but Y has " + std::to_string(ny) + " vertices");
-    const size_t point = r.errors.size();
+    const MappedPoint& m = phi[p.x];
+    if (m.corners[0] < 0) continue;
+    Pending q{p.y, {}, {}, 0, r.errors.size()};
+    for (int i = 0; i < 3; ++i) {
+      if (m.bary[i] <= 0) continue;
+      if (m.corners[i] < 0 || m.corners[i] >= ny)
+        throw InvalidInputError("evaluation: the map sends X vertex " + std::to_string(p.x) + " to vertex " +
+                                std::to_string(m.corners[i]) + ", but Y has " + std::to_string(ny) + " vertices");
+      q.targets[q.n] = m.corners[i];
+      q.weights[q.n++] = m.bary[i];
+    }
+    if (q.n == 0) throw InvalidInputError("evaluation: X vertex " + std::to_string(p.x) + " maps to a point without weights");
     r.errors.push_back(0.0);
-    if (predicted == p.y) continue;  // exactly zero: no solve needed
-    pending.push_back({predicted, p.y, point});
-    if (!is_pred[predicted]) is_pred[predicted] = 1, ++distinct_pred;
+    if (q.n == 1 && q.targets[0] == p.y) continue;  // exactly zero: no solve needed
+    all_vertices = all_vertices && q.n == 1;
+    for (int i = 0; i < q.n; ++i)
+      if (!is_pred[q.targets[i]]) is_pred[q.targets[i]] = 1, ++distinct_pred;
     if (!is_true[p.y]) is_true[p.y] = 1, ++distinct_true;
+    pending.push_back(q);
   }
   r.points = static_cast<int>(r.errors.size());
   if (r.points == 0)
@@ -167,9 +188,10 @@ GeodesicErrors geodesic_errors(const Mesh& y, const std::vector<int>& phi, const
                             " ground-truth pairs has an X vertex with an image under the map");
 
   if (!pending.empty()) {
-    // March from whichever side has fewer distinct vertices (distances are nearly symmetric).
-    if (distinct_true < distinct_pred)
-      for (Pending& p : pending) std::swap(p.source, p.target);
+    // A vertex map may march from whichever side has fewer distinct vertices (distances are
+    // nearly symmetric); points march from the truth.
+    if (all_vertices && distinct_pred < distinct_true)
+      for (Pending& p : pending) std::swap(p.source, p.targets[0]);
     std::sort(pending.begin(), pending.end(), [](const Pending& a, const Pending& b) { return a.source < b.source; });
     std::vector<size_t> group_begin;
     for (size_t i = 0; i < pending.size(); ++i)
@@ -188,10 +210,15 @@ GeodesicErrors geodesic_errors(const Mesh& y, const std::vector<int>& phi, const
         std::vector<int> targets;
         for (size_t g; (g = next++) < groups;) {
           targets.clear();
-          for (size_t i = group_begin[g]; i < group_begin[g + 1]; ++i) targets.push_back(pending[i].target);
-          const std::vector<double> d = geodesic.to_vertices(pending[group_begin[g]].source, targets);
           for (size_t i = group_begin[g]; i < group_begin[g + 1]; ++i)
-            r.errors[pending[i].point] = d[i - group_begin[g]] * scale;
+            targets.insert(targets.end(), pending[i].targets.begin(), pending[i].targets.begin() + pending[i].n);
+          const std::vector<double> d = geodesic.to_vertices(pending[group_begin[g]].source, targets);
+          size_t k = 0;
+          for (size_t i = group_begin[g]; i < group_begin[g + 1]; ++i) {
+            double e = 0;
+            for (int t = 0; t < pending[i].n; ++t) e += pending[i].weights[t] * d[k++];
+            r.errors[pending[i].point] = e * scale;
+          }
         }
       } catch (...) {
         next = groups;
@@ -218,6 +245,25 @@ GeodesicErrors geodesic_errors(const Mesh& y, const std::vector<int>& phi, const
   if (sorted.size() % 2 == 0) r.median = (r.median + *std::max_element(sorted.begin(), sorted.begin() + half)) / 2;
   r.pck = pck_curve(r.errors, options.pck_max, options.pck_step);
   r.auc = pck_auc(r.pck);
+  return r;
+}
+
+OrientationFlips count_orientation_flips(const Mesh& x, const Mesh& y, const std::vector<SurfacePoint>& map_x_to_y) {
+  if (static_cast<int>(map_x_to_y.size()) != x.num_vertices())
+    throw InvalidInputError("orientation flips: the point map has " + std::to_string(map_x_to_y.size()) +
+                            " entries, X has " + std::to_string(x.num_vertices()) + " vertices");
+  for (const SurfacePoint& p : map_x_to_y)
+    if (p.face < 0 || p.face >= y.num_faces())
+      throw InvalidInputError("orientation flips: the point map names face " + std::to_string(p.face) +
+                              ", but Y has " + std::to_string(y.num_faces()) + " faces");
+  const Geometry gy = compute_geometry(y);
+  OrientationFlips r;
+  r.faces = x.num_faces();
+  for (const auto& f : x.faces) {
+    const int o = image_orientation(y, gy, map_x_to_y[f[0]], map_x_to_y[f[1]], map_x_to_y[f[2]]);
+    r.degenerate += o == 0;
+    r.flips += o < 0;
+  }
   return r;
 }
 

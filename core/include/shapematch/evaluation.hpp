@@ -2,6 +2,7 @@
 // Evaluation of a vertex map against ground truth (DESIGN.md §9): geodesic errors on the
 // full-resolution Y normalised by √area(Y), the PCK curve, and orientation flips.
 #include "shapematch/mesh.hpp"
+#include "shapematch/point_map.hpp"
 
 #include <array>
 #include <string>
@@ -54,6 +55,20 @@ struct GeodesicErrors {
 GeodesicErrors geodesic_errors(const Mesh& y, const std::vector<int>& phi, const GroundTruth& truth,
                                const EvaluationOptions& options = {});
 
+// A predicted point on Y for the point-map version: the corners of a face of Y (vertex indices of
+// the mesh given to geodesic_errors) and barycentric weights; corners[0] < 0 where the map says
+// nothing.
+struct MappedPoint {
+  std::array<int, 3> corners{-1, -1, -1};
+  std::array<double, 3> bary{};
+};
+
+// The same for points: the distance from a point inside a face is interpolated linearly from its
+// corners' distances (at most one edge length too long, and exact at the corners). Marches from
+// the true vertices.
+GeodesicErrors geodesic_errors(const Mesh& y, const std::vector<MappedPoint>& phi, const GroundTruth& truth,
+                               const EvaluationOptions& options = {});
+
 // The PCK curve of `errors` at thresholds 0, step, …, max, and its normalised area (trapezoids).
 std::vector<std::array<double, 2>> pck_curve(const std::vector<double>& errors, double max, double step);
 double pck_auc(const std::vector<std::array<double, 2>>& pck);
@@ -67,5 +82,7 @@ struct OrientationFlips {
 // Carries every face of X through `map_x_to_y` (one vertex of Y per vertex of X) and compares the
 // image triangle's normal with the area-weighted vertex normals of Y at its three corners.
 OrientationFlips count_orientation_flips(const Mesh& x, const Mesh& y, const std::vector<int>& map_x_to_y);
+// The same for a point map (one point of Y per vertex of X), judged by image_orientation of points.
+OrientationFlips count_orientation_flips(const Mesh& x, const Mesh& y, const std::vector<SurfacePoint>& map_x_to_y);
 
 }  // namespace shapematch

@@ -1,0 +1,64 @@
+#pragma once
+// Point maps read off Γ: every vertex of one shape to a point on the other (a face and
+// barycentric coordinates), not just to a vertex. Γ relates a vertex to a whole set of the other
+// shape where it blows the vertex up (a face) or stretches an edge (an edge); one partner vertex
+// cannot follow that and inverts faces around it, a point inside the set, or next to it, can.
+#include "shapematch/geometry.hpp"
+#include "shapematch/mesh.hpp"
+#include "shapematch/product_space.hpp"
+#include "shapematch/rounding.hpp"
+
+#include <array>
+#include <string>
+#include <vector>
+
+namespace shapematch {
+
+// A point on a mesh: barycentric coordinates (non-negative, summing to 1) in one of its faces.
+struct SurfacePoint {
+  int face = -1;
+  std::array<double, 3> bary{};
+};
+
+// The point at vertex v (in the first face of `vertex_faces[v]`).
+SurfacePoint vertex_point(const Mesh& mesh, const std::vector<std::vector<int>>& vertex_faces, int v);
+// The vertex a point sits on, or -1 where it is inside an edge or a face.
+int point_vertex(const Mesh& mesh, const SurfacePoint& p);
+Eigen::Vector3d point_position(const Mesh& mesh, const SurfacePoint& p);
+
+// The orientation of the triangle of three points on y: +1 kept, -1 inverted, 0 degenerate. Three
+// vertices are judged as image_orientation does; three points in one face of y in that face's
+// plane; any other triangle against y's vertex normals interpolated at its corners.
+int image_orientation(const Mesh& y, const Geometry& gy, const SurfacePoint& a, const SurfacePoint& b,
+                      const SurfacePoint& c);
+
+struct PointMapOptions {
+  // Where a vertex's faces still map to inverted triangles from every point of its fibre, it may
+  // move to points of the faces within this many rings of its fibre.
+  int max_ring = 5;
+  // Interior points tried per face: barycentric (i, j, k) / samples with i, j, k >= 1.
+  int samples = 8;
+  int max_sweeps = 20;
+};
+
+struct PointMaps {
+  std::vector<SurfacePoint> x_to_y;  // one point of Y per vertex of X
+  std::vector<SurfacePoint> y_to_x;  // one point of X per vertex of Y
+};
+
+// Starts from `start` (vertex_maps' partners) and moves, one vertex at a time while that inverts
+// fewer faces (then leaves fewer degenerate), first within the vertex's fibre (its partner
+// vertices, points of the edges it is stretched along, points of the faces it is blown up over),
+// then, for faces still inverted, to points of faces up to PointMapOptions::max_ring rings around
+// the fibre, then, for degenerate images, up to two rings. Never inverts more faces than `start`.
+PointMaps point_maps(const ProductSpace& space, const std::vector<int64_t>& gamma, const VertexMaps& start,
+                     const PointMapOptions& options = {});
+
+// `face b0 b1 b2` per line (0-based face of the target mesh).
+std::string point_map_text(const std::vector<SurfacePoint>& map);
+// Reads point_map_text's format; each line's face must be a face of `target` and its
+// coordinates finite, >= -1e-9 and summing to 1 within 1e-6. Throws IoError /
+// InvalidInputError "<path>: line N: <problem>".
+std::vector<SurfacePoint> read_point_map(const std::string& path, const Mesh& target);
+
+}  // namespace shapematch

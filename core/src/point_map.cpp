@@ -1,0 +1,342 @@
+#include "shapematch/point_map.hpp"
+
+#include "shapematch/errors.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <limits>
+#include <sstream>
+
+namespace shapematch {
+
+SurfacePoint vertex_point(const Mesh& mesh, const std::vector<std::vector<int>>& vertex_faces, int v) {
+  SurfacePoint p;
+  p.face = vertex_faces[v].front();
+  for (int i = 0; i < 3; ++i)
+    if (mesh.faces[p.face][i] == v) p.bary[i] = 1.0;
+  return p;
+}
+
+int point_vertex(const Mesh& mesh, const SurfacePoint& p) {
+  for (int i = 0; i < 3; ++i)
+    if (p.bary[i] >= 1.0) return mesh.faces[p.face][i];
+  return -1;
+}
+
+Eigen::Vector3d point_position(const Mesh& mesh, const SurfacePoint& p) {
+  const auto& f = mesh.faces[p.face];
+  return p.bary[0] * mesh.vertices[f[0]] + p.bary[1] * mesh.vertices[f[1]] + p.bary[2] * mesh.vertices[f[2]];
+}
+
+namespace {
+
+// The vertices whose weight in p is not zero.
+int support(const Mesh& mesh, const SurfacePoint& p, std::array<int, 3>& out) {
+  int n = 0;
+  for (int i = 0; i < 3; ++i)
+    if (p.bary[i] > 0) out[n++] = mesh.faces[p.face][i];
+  return n;
+}
+
+// The face of y with exactly the vertices u, v, w (any order), or -1.
+int face_with(const Mesh& y, const Geometry& gy, int u, int v, int w) {
+  for (int d : {y.directed_edge_index(u, v), y.directed_edge_index(v, u)}) {
+    if (d < 0 || gy.halfedge_face[d] < 0) continue;
+    const auto& f = y.faces[gy.halfedge_face[d]];
+    if (f[0] == w || f[1] == w || f[2] == w) return gy.halfedge_face[d];
+  }
+  return -1;
+}
+
+Eigen::Vector3d point_normal(const Mesh& y, const Geometry& gy, const SurfacePoint& p) {
+  const auto& f = y.faces[p.face];
+  return p.bary[0] * gy.vertex_normal[f[0]] + p.bary[1] * gy.vertex_normal[f[1]] + p.bary[2] * gy.vertex_normal[f[2]];
+}
+
+}  // namespace
+
+int image_orientation(const Mesh& y, const Geometry& gy, const SurfacePoint& a, const SurfacePoint& b,
+                      const SurfacePoint& c) {
+  const int va = point_vertex(y, a), vb = point_vertex(y, b), vc = point_vertex(y, c);
+  if (va >= 0 && vb >= 0 && vc >= 0) return image_orientation(y, gy, va, vb, vc);
+  const Eigen::Vector3d pa = point_position(y, a), ab = point_position(y, b) - pa, ac = point_position(y, c) - pa;
+  const Eigen::Vector3d normal = ab.cross(ac);
+  const double scale = ab.squaredNorm() + ac.squaredNorm();
+  if (normal.norm() <= 1e-12 * scale) return 0;
+  // All three in one face (their supports together are at most its three corners): its plane.
+  std::array<int, 9> all{};
+  std::array<int, 3> s{};
+  int n = 0;
+  for (const SurfacePoint* p : {&a, &b, &c}) {
+    const int k = support(y, *p, s);
+    for (int i = 0; i < k; ++i)
+      if (std::find(all.begin(), all.begin() + n, s[i]) == all.begin() + n) all[n++] = s[i];
+  }
+  if (n == 3) {
+    const int f = face_with(y, gy, all[0], all[1], all[2]);
+    if (f >= 0) {
+      const auto& t = y.faces[f];
+      const Eigen::Vector3d fn = (y.vertices[t[1]] - y.vertices[t[0]]).cross(y.vertices[t[2]] - y.vertices[t[0]]);
+      const double side = normal.dot(fn.normalized());
+      if (std::abs(side) <= 1e-9 * normal.norm()) return 0;
+      return side < 0 ? -1 : 1;
+    }
+  }
+  return normal.dot(point_normal(y, gy, a) + point_normal(y, gy, b) + point_normal(y, gy, c)) < 0 ? -1 : 1;
+}
+
+namespace {
+
+// Γ's relation of one shape's vertices to the other shape, by dimension.
+struct Fibres {
+  std::vector<std::vector<int>> vertices;
+  std::vector<std::vector<std::array<int, 2>>> edges;  // stretched along (sorted ends)
+  std::vector<std::vector<int>> faces;                 // blown up over
+};
+
+template <class T>
+void sort_unique(std::vector<T>& v) {
+  std::sort(v.begin(), v.end());
+  v.erase(std::unique(v.begin(), v.end()), v.end());
+}
+
+// `from_a`: the fibres of X's vertices (a tuples), else of Y's (b tuples).
+Fibres fibres(const ProductSpace& space, const std::vector<int64_t>& gamma, bool from_a) {
+  const int n = from_a ? space.x().num_vertices() : space.y().num_vertices();
+  Fibres fb;
+  fb.vertices.resize(n);
+  fb.edges.resize(n);
+  fb.faces.resize(n);
+  for (int64_t j : gamma) {
+    const ProductTriangle t = space[j];
+    const auto& a = from_a ? t.a : t.b;
+    const auto& b = from_a ? t.b : t.a;
+    const int other_face = from_a ? t.fb : t.fa;
+    for (int i = 0; i < 3; ++i) fb.vertices[a[i]].push_back(b[i]);
+    if (a[0] == a[1] && a[1] == a[2]) {
+      if (other_face >= 0) fb.faces[a[0]].push_back(other_face);
+      continue;
+    }
+    for (int i = 0; i < 3; ++i)
+      for (int k = i + 1; k < 3; ++k)
+        if (a[i] == a[k] && b[i] != b[k]) fb.edges[a[i]].push_back({std::min(b[i], b[k]), std::max(b[i], b[k])});
+  }
+  for (int v = 0; v < n; ++v) {
+    sort_unique(fb.vertices[v]);
+    sort_unique(fb.edges[v]);
+    sort_unique(fb.faces[v]);
+  }
+  return fb;
+}
+
+class SideMap {
+public:
+  SideMap(const Mesh& from, const Mesh& to, const PointMapOptions& options)
+      : from_(from), to_(to), g_(compute_geometry(to)), options_(options), from_faces_(from.num_vertices()),
+        to_faces_(to.num_vertices()) {
+    for (int f = 0; f < from.num_faces(); ++f)
+      for (int v : from.faces[f]) from_faces_[v].push_back(f);
+    for (int f = 0; f < to.num_faces(); ++f)
+      for (int v : to.faces[f]) to_faces_[v].push_back(f);
+    const int s = std::max(options.samples, 3);
+    for (int i = 1; i < s; ++i)
+      for (int j = 1; i + j < s; ++j) grid_.push_back({double(i) / s, double(j) / s, double(s - i - j) / s});
+  }
+
+  std::vector<SurfacePoint> run(const Fibres& fb, const std::vector<int>& start) {
+    p_.resize(start.size());
+    for (size_t v = 0; v < start.size(); ++v) p_[v] = vertex_point(to_, to_faces_, start[v]);
+    // 1. Within the fibre, for vertices of inverted or degenerate images.
+    for (int sweep = 0; sweep < options_.max_sweeps; ++sweep) {
+      bool changed = false;
+      for (int v = 0; v < from_.num_vertices(); ++v) {
+        if (star_is_fine(v, false)) continue;
+        changed = try_points(v, fibre_points(fb, v), false) || changed;
+      }
+      if (!changed) break;
+    }
+    // 2. Around the fibre: inverted images, ring by ring; then degenerate ones, up to two rings.
+    for (int degenerate = 0; degenerate < 2; ++degenerate)
+      for (int ring = 1; ring <= (degenerate ? std::min(2, options_.max_ring) : options_.max_ring); ++ring)
+        for (int sweep = 0; sweep < options_.max_sweeps; ++sweep) {
+          bool changed = false;
+          for (int v = 0; v < from_.num_vertices(); ++v) {
+            if (star_is_fine(v, degenerate)) continue;
+            changed = try_points(v, ring_points(fb, v, ring), degenerate) || changed;
+          }
+          if (!changed) break;
+        }
+    return p_;
+  }
+
+private:
+  int orientation(int f) const {
+    const auto& t = from_.faces[f];
+    return image_orientation(to_, g_, p_[t[0]], p_[t[1]], p_[t[2]]);
+  }
+  // No inverted image in v's star (and, when `degenerate`, no degenerate one either).
+  bool star_is_fine(int v, bool degenerate) const {
+    for (int f : from_faces_[v]) {
+      const int o = orientation(f);
+      if (o < 0 || (degenerate && o == 0)) return false;
+    }
+    return true;
+  }
+  // An inverted image outweighs any number of degenerate ones.
+  int64_t cost(int v) const {
+    int64_t c = 0;
+    for (int f : from_faces_[v]) {
+      const int o = orientation(f);
+      c += o < 0 ? 1000 : o == 0 ? 1 : 0;
+    }
+    return c;
+  }
+  // The worst shape in v's star: area over the sum of squared sides (a tie-break).
+  double quality(int v) const {
+    double q = std::numeric_limits<double>::infinity();
+    for (int f : from_faces_[v]) {
+      const auto& t = from_.faces[f];
+      const Eigen::Vector3d a = point_position(to_, p_[t[0]]), b = point_position(to_, p_[t[1]]),
+                            c = point_position(to_, p_[t[2]]);
+      const double sides = (b - a).squaredNorm() + (c - b).squaredNorm() + (a - c).squaredNorm();
+      q = std::min(q, sides > 0 ? (b - a).cross(c - a).norm() / sides : 0.0);
+    }
+    return q;
+  }
+  // Moves v to the best of `points` if it lowers the cost, or (when `by_shape`) keeps the cost and
+  // makes the worst triangle clearly better. Returns whether v moved.
+  bool try_points(int v, const std::vector<SurfacePoint>& points, bool by_shape) {
+    const SurfacePoint current = p_[v];
+    SurfacePoint best = current;
+    int64_t best_cost = cost(v);
+    double best_quality = by_shape ? quality(v) : 0.0;
+    bool moved = false;
+    for (const SurfacePoint& p : points) {
+      p_[v] = p;
+      const int64_t c = cost(v);
+      if (c > best_cost) continue;
+      const double q = by_shape ? quality(v) : 0.0;
+      if (c < best_cost || (by_shape && q > 1.5 * best_quality)) best = p, best_cost = c, best_quality = q, moved = true;
+    }
+    p_[v] = best;
+    return moved;
+  }
+  SurfacePoint on_edge(int u, int w, double t) const {
+    for (int f : to_faces_[u]) {
+      const auto& tri = to_.faces[f];
+      int iu = -1, iw = -1;
+      for (int i = 0; i < 3; ++i) {
+        if (tri[i] == u) iu = i;
+        if (tri[i] == w) iw = i;
+      }
+      if (iw < 0) continue;
+      SurfacePoint p{f, {}};
+      p.bary[iu] = 1 - t;
+      p.bary[iw] = t;
+      return p;
+    }
+    return vertex_point(to_, to_faces_, u);  // not an edge of `to`: Γ never says so
+  }
+  void add_face_samples(int f, std::vector<SurfacePoint>& out) const {
+    for (const auto& b : grid_) out.push_back({f, b});
+  }
+  std::vector<SurfacePoint> fibre_points(const Fibres& fb, int v) const {
+    std::vector<SurfacePoint> out;
+    for (int w : fb.vertices[v]) out.push_back(vertex_point(to_, to_faces_, w));
+    for (const auto& e : fb.edges[v])
+      for (double t : {0.25, 0.5, 0.75}) out.push_back(on_edge(e[0], e[1], t));
+    for (int f : fb.faces[v]) add_face_samples(f, out);
+    return out;
+  }
+  // Sample points of the faces within `ring` rings of v's fibre and of its current point.
+  std::vector<SurfacePoint> ring_points(const Fibres& fb, int v, int ring) const {
+    std::vector<int> verts = fb.vertices[v];
+    std::array<int, 3> s{};
+    for (int i = 0, k = support(to_, p_[v], s); i < k; ++i) verts.push_back(s[i]);
+    sort_unique(verts);
+    std::vector<int> faces;
+    for (int r = 0; r < ring; ++r) {
+      faces.clear();
+      for (int w : verts) faces.insert(faces.end(), to_faces_[w].begin(), to_faces_[w].end());
+      sort_unique(faces);
+      if (r + 1 < ring) {
+        for (int f : faces) verts.insert(verts.end(), to_.faces[f].begin(), to_.faces[f].end());
+        sort_unique(verts);
+      }
+    }
+    std::vector<SurfacePoint> out;
+    for (int f : faces) add_face_samples(f, out);
+    return out;
+  }
+
+  const Mesh& from_;
+  const Mesh& to_;
+  const Geometry g_;
+  const PointMapOptions options_;
+  std::vector<std::vector<int>> from_faces_, to_faces_;
+  std::vector<std::array<double, 3>> grid_;
+  std::vector<SurfacePoint> p_;
+};
+
+}  // namespace
+
+PointMaps point_maps(const ProductSpace& space, const std::vector<int64_t>& gamma, const VertexMaps& start,
+                     const PointMapOptions& options) {
+  if (static_cast<int>(start.x_to_y.size()) != space.x().num_vertices() ||
+      static_cast<int>(start.y_to_x.size()) != space.y().num_vertices())
+    throw InvalidInputError("point maps: the vertex maps do not match the meshes");
+  for (const auto* m : {&start.x_to_y, &start.y_to_x})
+    if (std::find(m->begin(), m->end(), -1) != m->end())
+      throw InvalidInputError("point maps: a vertex has no partner (Γ does not cover both shapes)");
+  PointMaps maps;
+  maps.x_to_y = SideMap(space.x(), space.y(), options).run(fibres(space, gamma, true), start.x_to_y);
+  maps.y_to_x = SideMap(space.y(), space.x(), options).run(fibres(space, gamma, false), start.y_to_x);
+  return maps;
+}
+
+std::string point_map_text(const std::vector<SurfacePoint>& map) {
+  std::ostringstream s;
+  s.precision(17);
+  for (const SurfacePoint& p : map) s << p.face << ' ' << p.bary[0] << ' ' << p.bary[1] << ' ' << p.bary[2] << '\n';
+  return s.str();
+}
+
+std::vector<SurfacePoint> read_point_map(const std::string& path, const Mesh& target) {
+  std::ifstream in(path);
+  if (!in) throw IoError(path + ": cannot open");
+  std::vector<std::string> lines;
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  if (in.bad()) throw IoError(path + ": read error");
+  while (!lines.empty() && lines.back().find_first_not_of(" \t\r") == std::string::npos) lines.pop_back();
+  if (lines.empty()) throw InvalidInputError(path + ": no points (empty file)");
+  std::vector<SurfacePoint> map;
+  for (size_t k = 0; k < lines.size(); ++k) {
+    // A blank line inside would shift "line k is vertex k", so it is an error like any other.
+    const std::string where = path + ": line " + std::to_string(k + 1) + ": ";
+    std::istringstream s(lines[k]);
+    std::string tokens[5];
+    int n = 0;
+    while (n < 5 && s >> tokens[n]) ++n;
+    if (n != 4) throw InvalidInputError(where + "expected `face b0 b1 b2`");
+    char* end = nullptr;
+    const long face = std::strtol(tokens[0].c_str(), &end, 10);
+    if (*end != '\0' || face < 0 || face >= target.num_faces())
+      throw InvalidInputError(where + "'" + tokens[0] + "' is not a face (the mesh has " +
+                              std::to_string(target.num_faces()) + ")");
+    SurfacePoint p{static_cast<int>(face), {}};
+    double sum = 0;
+    for (int i = 0; i < 3; ++i) {
+      p.bary[i] = std::strtod(tokens[i + 1].c_str(), &end);
+      if (*end != '\0' || !std::isfinite(p.bary[i]) || p.bary[i] < -1e-9)
+        throw InvalidInputError(where + "'" + tokens[i + 1] + "' is not a barycentric coordinate");
+      sum += p.bary[i];
+    }
+    if (std::abs(sum - 1) > 1e-6) throw InvalidInputError(where + "the coordinates do not sum to 1");
+    map.push_back(p);
+  }
+  return map;
+}
+
+}  // namespace shapematch

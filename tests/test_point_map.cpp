@@ -1,0 +1,170 @@
+#include "test_helpers.hpp"
+
+#include "shapematch/constraints.hpp"
+#include "shapematch/evaluation.hpp"
+#include "shapematch/point_map.hpp"
+#include "shapematch/rounding.hpp"
+
+#include <doctest/doctest.h>
+
+using namespace shapematch;
+
+namespace {
+
+std::vector<int64_t> all_of(const ProductSpace& space) {
+  std::vector<int64_t> g(space.size());
+  for (int64_t j = 0; j < space.size(); ++j) g[j] = j;
+  return g;
+}
+
+std::vector<std::vector<int>> faces_of_vertices(const Mesh& m) {
+  std::vector<std::vector<int>> vf(m.num_vertices());
+  for (int f = 0; f < m.num_faces(); ++f)
+    for (int v : m.faces[f]) vf[v].push_back(f);
+  return vf;
+}
+
+// A x = b of the space that holds exactly Γ's triangles, checked in integers.
+bool closed_and_covering(const ProductSpace& space) {
+  const ConstraintSystem cs = build_constraints(space);
+  LpProblem lp;
+  lp.a = cs.a;
+  lp.at = cs.at;
+  lp.b = cs.b;
+  lp.c.assign(space.size(), 0.0);
+  return satisfies_exactly(lp, all_of(space));
+}
+
+}  // namespace
+
+TEST_CASE("point map: the orientation of three points on a mesh") {
+  const Mesh m = shapes::octahedron();
+  const Geometry g = compute_geometry(m);
+  const auto& f = m.faces[0];
+  const SurfacePoint p{0, {0.6, 0.2, 0.2}}, q{0, {0.2, 0.6, 0.2}}, r{0, {0.2, 0.2, 0.6}};
+  CHECK(image_orientation(m, g, p, q, r) == 1);  // the face's own cyclic order, inside it
+  CHECK(image_orientation(m, g, p, r, q) == -1);
+  CHECK(image_orientation(m, g, p, p, q) == 0);
+  const auto vf = faces_of_vertices(m);
+  const SurfacePoint a = vertex_point(m, vf, f[0]), b = vertex_point(m, vf, f[1]), c = vertex_point(m, vf, f[2]);
+  CHECK(point_vertex(m, a) == f[0]);
+  CHECK(point_vertex(m, p) == -1);
+  CHECK(image_orientation(m, g, a, b, c) == 1);
+  CHECK(image_orientation(m, g, a, c, b) == -1);
+  // Across faces (judged by the normals): reversing the order reverses the verdict.
+  const SurfacePoint s{1, {1.0 / 3, 1.0 / 3, 1.0 / 3}}, t{2, {1.0 / 3, 1.0 / 3, 1.0 / 3}};
+  const int o = image_orientation(m, g, p, s, t);
+  CHECK(o != 0);
+  CHECK(image_orientation(m, g, p, t, s) == -o);
+}
+
+TEST_CASE("point map: the identity matching maps every vertex onto itself, and repairs a wrong start") {
+  const Mesh m = shapes::icosphere(1);
+  const ProductSpace space = ProductSpace::from_list(m, m, identity_matching(m));
+  const std::vector<int64_t> gamma = all_of(space);
+  VertexMaps start = vertex_maps(space, gamma);
+  PointMaps maps = point_maps(space, gamma, start);
+  for (int v = 0; v < m.num_vertices(); ++v) {
+    CHECK(point_vertex(m, maps.x_to_y[v]) == v);
+    CHECK(point_vertex(m, maps.y_to_x[v]) == v);
+  }
+  CHECK(count_orientation_flips(m, m, maps.x_to_y).flips == 0);
+  CHECK(count_orientation_flips(m, m, maps.x_to_y).degenerate == 0);
+
+  // Vertex 0 sent to the antipode inverts its faces; its fibre is vertex 0 alone, so the point
+  // map brings it back.
+  int far = 0;
+  for (int v = 0; v < m.num_vertices(); ++v)
+    if ((m.vertices[v] - m.vertices[0]).norm() > (m.vertices[far] - m.vertices[0]).norm()) far = v;
+  start.x_to_y[0] = far;
+  REQUIRE(count_orientation_flips(m, m, start.x_to_y).flips > 0);
+  maps = point_maps(space, gamma, start);
+  CHECK(point_vertex(m, maps.x_to_y[0]) == 0);
+  CHECK(count_orientation_flips(m, m, maps.x_to_y).flips == 0);
+}
+
+// Y is X with one face split at its centroid c; Γ sends c onto X's corner a, so two faces of Y map
+// onto edges of X (degenerate for any vertex map). The point map moves c (or a) off the corner,
+// after which all faces keep their orientation and none is degenerate.
+TEST_CASE("point map: a vertex collapsed onto a corner moves off it") {
+  const Mesh x = shapes::octahedron();
+  const auto split = x.faces[0];
+  const int a = split[0], b = split[1], d = split[2];
+  std::vector<Eigen::Vector3d> yv = x.vertices;
+  const int c = static_cast<int>(yv.size());
+  yv.push_back((x.vertices[a] + x.vertices[b] + x.vertices[d]) / 3 + 0.05 * x.vertices[a].normalized());
+  std::vector<std::array<int, 3>> yf(x.faces.begin() + 1, x.faces.end());  // Y face i-1 = X face i
+  yf.push_back({a, b, c});
+  yf.push_back({b, d, c});
+  yf.push_back({d, a, c});
+  const Mesh y = make_mesh(yv, yf, "split octahedron");
+  std::vector<ProductTriangle> gamma;
+  for (int i = 1; i < x.num_faces(); ++i) gamma.push_back({x.faces[i], x.faces[i], i, i - 1});
+  const int fy = x.num_faces() - 1;
+  gamma.push_back({{b, d, a}, {b, d, c}, 0, fy + 1});     // X's face onto the middle part
+  gamma.push_back({{b, a, a}, {b, c, a}, -1, fy});        // edge b→a stretched over (a, b, c)
+  gamma.push_back({{d, a, a}, {d, a, c}, -1, fy + 2});    // edge d→a stretched over (d, a, c)
+  const ProductSpace space = ProductSpace::from_list(x, y, gamma);
+  REQUIRE(closed_and_covering(space));
+  REQUIRE(check_graph_surface(space, all_of(space)).ok());
+
+  const VertexMaps vm = vertex_maps(space, all_of(space));
+  CHECK(vm.y_to_x[c] == a);
+  const OrientationFlips by_vertex = count_orientation_flips(y, x, vm.y_to_x);
+  CHECK(by_vertex.degenerate == 2);
+  const PointMaps pm = point_maps(space, all_of(space), vm);
+  const OrientationFlips by_point = count_orientation_flips(y, x, pm.y_to_x);
+  CHECK(by_point.flips == 0);
+  CHECK(by_point.degenerate == 0);
+  // c (or a, whichever moves first) leaves the corner; c stays on a face at a.
+  CHECK((point_vertex(x, pm.y_to_x[c]) == -1 || point_vertex(x, pm.y_to_x[a]) == -1));
+  const auto& at = x.faces[pm.y_to_x[c].face];
+  CHECK(std::count(at.begin(), at.end(), a) == 1);
+  CHECK(count_orientation_flips(x, y, pm.x_to_y).flips == 0);
+}
+
+TEST_CASE("point map: text round trip, and one clear line for a bad file") {
+  const Mesh m = shapes::octahedron();
+  const std::vector<SurfacePoint> map{{0, {1, 0, 0}}, {3, {0.25, 0.5, 0.25}}, {7, {0.1, 0.2, 0.7}}};
+  shapematch::test::TempDir tmp;
+  const std::string path = (tmp.path / "points.txt").string();
+  auto write = [&](const std::string& text) { std::ofstream(path) << text; };
+  write(point_map_text(map));
+  const std::vector<SurfacePoint> back = read_point_map(path, m);
+  REQUIRE(back.size() == map.size());
+  for (size_t i = 0; i < map.size(); ++i) {
+    CHECK(back[i].face == map[i].face);
+    for (int k = 0; k < 3; ++k) CHECK(back[i].bary[k] == map[i].bary[k]);
+  }
+  auto error_of = [&](const std::string& text) {
+    write(text);
+    try {
+      read_point_map(path, m);
+    } catch (const InvalidInputError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  CHECK(error_of("8 1 0 0\n").find("line 1: '8' is not a face") != std::string::npos);
+  CHECK(error_of("0 1 0 0\n1 0.5 0.6 0\n").find("line 2: the coordinates do not sum to 1") != std::string::npos);
+  CHECK(error_of("0 1 0\n").find("line 1: expected") != std::string::npos);
+  CHECK(error_of("0 1 0 0\n\n1 1 0 0\n").find("line 2: expected") != std::string::npos);
+  CHECK(error_of("0 nan 0 1\n").find("not a barycentric coordinate") != std::string::npos);
+  CHECK(error_of("").find("empty file") != std::string::npos);
+}
+
+TEST_CASE("evaluation: a point's geodesic error interpolates its corners' distances") {
+  const Mesh m = shapes::octahedron();
+  const auto& f = m.faces[0];
+  const GroundTruth truth{{0, f[0]}};
+  const double edge = (m.vertices[f[1]] - m.vertices[f[0]]).norm(), scale = std::sqrt(surface_area(m));
+  // At the true vertex: zero; at another vertex: the same as the vertex version.
+  std::vector<MappedPoint> phi{{{f[0], f[1], f[2]}, {1, 0, 0}}};
+  CHECK(geodesic_errors(m, phi, truth).mean == 0.0);
+  phi[0] = {{f[0], f[1], f[2]}, {0, 1, 0}};
+  CHECK(geodesic_errors(m, phi, truth).mean == doctest::Approx(edge / scale));
+  CHECK(geodesic_errors(m, std::vector<int>{f[1]}, truth).mean == doctest::Approx(edge / scale));
+  // Half-way along an edge from the truth: half the edge (exact on a straight edge).
+  phi[0] = {{f[0], f[1], f[2]}, {0.5, 0.5, 0}};
+  CHECK(geodesic_errors(m, phi, truth).mean == doctest::Approx(0.5 * edge / scale));
+}
