@@ -150,7 +150,7 @@ int run_eval(const EvalArgs& args) {
   // The point map (written by match since it has one): the same scores for points, whose
   // corners are vertices of the matched Y, i.e. input vertices of Y.
   const fs::path points_path = dir / "map_x_to_y_points.txt";
-  std::optional<GeodesicErrors> point_errors;
+  std::optional<GeodesicErrors> point_errors, point_symmetric;
   std::optional<OrientationFlips> point_flips;
   if (fs::exists(points_path)) {
     const std::vector<SurfacePoint> points = read_point_map(points_path.string(), ym);
@@ -163,6 +163,9 @@ int run_eval(const EvalArgs& args) {
       phi_points[x_ids[v]] = {{y_ids[f[0]], y_ids[f[1]], y_ids[f[2]]}, points[v].bary};
     }
     point_errors = geodesic_errors(y_full, phi_points, truth, options);
+    if (!args.gt_y_sym.empty())
+      point_symmetric = geodesic_errors(y_full, phi_points,
+                                        read_vts_ground_truth(args.gt_x, args.gt_y_sym, x_input, y_input), options);
     point_flips = count_orientation_flips(xm, ym, points);
   }
 
@@ -199,13 +202,18 @@ int run_eval(const EvalArgs& args) {
       .set("degenerate_faces", flips.degenerate)
       .set("geodesic_solves", errors.geodesic_solves)
       .set("seconds", total.seconds());
-  if (point_errors)
-    out.set("point_map", Json::object()
-                             .set("mean_geodesic_error", point_errors->mean)
-                             .set("median_geodesic_error", point_errors->median)
-                             .set("auc", point_errors->auc)
-                             .set("orientation_flips", point_flips->flips)
-                             .set("degenerate_faces", point_flips->degenerate));
+  if (point_errors) {
+    Json pm = Json::object()
+                  .set("mean_geodesic_error", point_errors->mean)
+                  .set("median_geodesic_error", point_errors->median)
+                  .set("auc", point_errors->auc)
+                  .set("orientation_flips", point_flips->flips)
+                  .set("degenerate_faces", point_flips->degenerate);
+    if (point_symmetric)
+      pm.set("symmetric_mean_geodesic_error", point_symmetric->mean)
+          .set("best_mean_geodesic_error", std::min(point_errors->mean, point_symmetric->mean));
+    out.set("point_map", pm);
+  }
   if (symmetric) {
     const bool sym_better = symmetric->mean < errors.mean;
     out.set("symmetric_ground_truth", args.gt_x + " <-> " + args.gt_y_sym)
