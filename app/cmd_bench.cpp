@@ -513,6 +513,7 @@ struct MatchRow {
   double faces_x = kNaN, faces_y = kNaN, levels = kNaN, variables = kNaN, rounds = kNaN;
   double energy = kNaN, lower_bound = kNaN, gap = kNaN;
   double mean_error = kNaN, median_error = kNaN, symmetric_mean_error = kNaN, flips = kNaN;
+  double point_mean_error = kNaN, point_flips = kNaN;  // the point map's (eval's `point_map`)
   ChildRun run;
 };
 
@@ -723,7 +724,8 @@ double median_ok(const std::vector<MatchRow>& rows, double (*value)(const MatchR
 const std::vector<std::string> kPairsHeader{"pair",        "faces_x", "faces_y", "seconds",
                                             "peak_rss_mb", "energy",  "lower_bound", "gap",
                                             "rounds",      "mean_geodesic_error", "median_geodesic_error",
-                                            "symmetric_mean_geodesic_error", "orientation_flips", "status"};
+                                            "symmetric_mean_geodesic_error", "orientation_flips",
+                                            "point_mean_geodesic_error", "point_orientation_flips", "status"};
 
 // The rows plus a last one of medians; `csv` chooses full precision over readable widths.
 std::vector<std::vector<std::string>> pairs_cells(const std::vector<MatchRow>& rows, bool csv) {
@@ -734,7 +736,8 @@ std::vector<std::vector<std::string>> pairs_cells(const std::vector<MatchRow>& r
     cells.push_back({r.name, csv_int(r.faces_x), csv_int(r.faces_y), num(r.run.seconds, 6, 2),
                      num(r.run.peak_rss_mb, 5, 0), general(r.energy, 12), general(r.lower_bound, 12),
                      general(r.gap, 4), csv_int(r.rounds), num(r.mean_error, 6, 4), num(r.median_error, 6, 4),
-                     num(r.symmetric_mean_error, 6, 4), csv_int(r.flips), r.run.status});
+                     num(r.symmetric_mean_error, 6, 4), csv_int(r.flips), num(r.point_mean_error, 6, 4),
+                     csv_int(r.point_flips), r.run.status});
   const auto ok = std::count_if(rows.begin(), rows.end(), [](const MatchRow& r) { return r.run.status == "ok"; });
   cells.push_back({csv ? "median" : "**median**", "", "",
                    num(median_ok(rows, [](const MatchRow& r) { return r.run.seconds; }), 6, 2),
@@ -743,6 +746,7 @@ std::vector<std::vector<std::string>> pairs_cells(const std::vector<MatchRow>& r
                    num(median_ok(rows, [](const MatchRow& r) { return r.mean_error; }), 6, 4),
                    num(median_ok(rows, [](const MatchRow& r) { return r.median_error; }), 6, 4),
                    num(median_ok(rows, [](const MatchRow& r) { return r.symmetric_mean_error; }), 6, 4), "",
+                   num(median_ok(rows, [](const MatchRow& r) { return r.point_mean_error; }), 6, 4), "",
                    fmt::format("{} of {} ok", ok, rows.size())});
   return cells;
 }
@@ -769,6 +773,10 @@ void evaluate(const BenchMatchArgs& args, const PairSpec& pair, const fs::path& 
     row.median_error = result.number_or_nan("median_geodesic_error");
     row.symmetric_mean_error = result.number_or_nan("symmetric_mean_geodesic_error");
     row.flips = result.number_or_nan("orientation_flips");
+    if (const JsonNode* points = result.get("point_map")) {
+      row.point_mean_error = points->number_or_nan("mean_geodesic_error");
+      row.point_flips = points->number_or_nan("orientation_flips");
+    }
   } catch (const Error& error) {
     row.run.status = std::string("eval failed: ") + error.what();
   }

@@ -220,7 +220,8 @@ TEST_CASE("cli: bench match --pairs matches and evaluates each pair and adds a r
   const std::vector<std::string> expected = {"pair", "faces_x", "faces_y", "seconds", "peak_rss_mb", "energy",
                                              "lower_bound", "gap", "rounds", "mean_geodesic_error",
                                              "median_geodesic_error", "symmetric_mean_geodesic_error",
-                                             "orientation_flips", "status"};
+                                             "orientation_flips", "point_mean_geodesic_error",
+                                             "point_orientation_flips", "status"};
   REQUIRE(header == expected);
   REQUIRE(rows.size() == 3);
   std::vector<double> seconds;
@@ -239,6 +240,9 @@ TEST_CASE("cli: bench match --pairs matches and evaluates each pair and adds a r
     CHECK(mean < 3);
     CHECK(median >= 0);
     CHECK(std::stoi(row.at("orientation_flips")) >= 0);
+    // The point map never inverts more faces than the vertex map it starts from.
+    CHECK(std::stoi(row.at("point_orientation_flips")) <= std::stoi(row.at("orientation_flips")));
+    CHECK(std::stod(row.at("point_mean_geodesic_error")) < 3);
     // Only the second line names a symmetric truth, a different one, so its error differs.
     CHECK(row.at("symmetric_mean_geodesic_error").empty() == (i == 0));
     if (i == 1) CHECK(std::stod(row.at("symmetric_mean_geodesic_error")) != doctest::Approx(mean));
