@@ -227,12 +227,15 @@ LpResult PdhgSolver::solve(const LpProblem& problem, const SolverParams& params)
     // An infeasible LP's primal residual stalls while its dual bound climbs without limit. Where
     // that held over a whole window (measured on a 10 k-face reduced matching LP: residual flat
     // at 2e-2 while the bound rose from 35 to 48 in 1024 iterations; feasible LPs of that size
-    // cut their residual 20x in such a window), stop and return the dual's growth over it.
+    // cut their residual 20x in such a window), stop and return the dual's growth over it. The
+    // residual need only be above the tolerance: at tolerance 1e-3, a 10 k-face LP's residual
+    // went from 8.5e-3 to 7.8e-3 in a window while its bound rose from 36 to 54 against an
+    // objective of 28, and on to 92 (asking for 100 × the tolerance, as before, let it run on).
     if (params.stop_on_divergence && total >= window_end) {
       std::vector<double> xh, yh;
       backend->read(xh, yh);
       const double scale = 1.0 + std::abs(s.cx);
-      if (!window_y.empty() && primal > 100.0 * params.tolerance && primal >= 0.8 * window_primal &&
+      if (!window_y.empty() && primal > params.tolerance && primal >= 0.8 * window_primal &&
           dual_obj - s.cx > 0.1 * scale && dual_obj - window_dual > 0.05 * scale) {
         result.status = LpStatus::Diverging;
         result.y.resize(m);
