@@ -2,6 +2,7 @@
 
 #include "shapematch/constraints.hpp"
 #include "shapematch/evaluation.hpp"
+#include "shapematch/hierarchy.hpp"
 #include "shapematch/point_map.hpp"
 #include "shapematch/rounding.hpp"
 
@@ -15,13 +16,6 @@ std::vector<int64_t> all_of(const ProductSpace& space) {
   std::vector<int64_t> g(space.size());
   for (int64_t j = 0; j < space.size(); ++j) g[j] = j;
   return g;
-}
-
-std::vector<std::vector<int>> faces_of_vertices(const Mesh& m) {
-  std::vector<std::vector<int>> vf(m.num_vertices());
-  for (int f = 0; f < m.num_faces(); ++f)
-    for (int v : m.faces[f]) vf[v].push_back(f);
-  return vf;
 }
 
 // A x = b of the space that holds exactly Γ's triangles, checked in integers.
@@ -45,7 +39,7 @@ TEST_CASE("point map: the orientation of three points on a mesh") {
   CHECK(image_orientation(m, g, p, q, r) == 1);  // the face's own cyclic order, inside it
   CHECK(image_orientation(m, g, p, r, q) == -1);
   CHECK(image_orientation(m, g, p, p, q) == 0);
-  const auto vf = faces_of_vertices(m);
+  const auto vf = vertex_face_table(m);
   const SurfacePoint a = vertex_point(m, vf, f[0]), b = vertex_point(m, vf, f[1]), c = vertex_point(m, vf, f[2]);
   CHECK(point_vertex(m, a) == f[0]);
   CHECK(point_vertex(m, p) == -1);

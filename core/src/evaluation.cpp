@@ -248,6 +248,25 @@ GeodesicErrors geodesic_errors(const Mesh& y, const std::vector<MappedPoint>& ph
   return r;
 }
 
+namespace {
+
+// Each face of X carried through `map` (vertex indices or points of Y); collinear images count
+// with the collapsed ones: they have no orientation to compare.
+template <class Map>
+OrientationFlips count_images(const Mesh& x, const Mesh& y, const Map& map) {
+  const Geometry gy = compute_geometry(y);
+  OrientationFlips r;
+  r.faces = x.num_faces();
+  for (const auto& f : x.faces) {
+    const int o = image_orientation(y, gy, map[f[0]], map[f[1]], map[f[2]]);
+    r.degenerate += o == 0;
+    r.flips += o < 0;
+  }
+  return r;
+}
+
+}  // namespace
+
 OrientationFlips count_orientation_flips(const Mesh& x, const Mesh& y, const std::vector<SurfacePoint>& map_x_to_y) {
   if (static_cast<int>(map_x_to_y.size()) != x.num_vertices())
     throw InvalidInputError("orientation flips: the point map has " + std::to_string(map_x_to_y.size()) +
@@ -256,15 +275,7 @@ OrientationFlips count_orientation_flips(const Mesh& x, const Mesh& y, const std
     if (p.face < 0 || p.face >= y.num_faces())
       throw InvalidInputError("orientation flips: the point map names face " + std::to_string(p.face) +
                               ", but Y has " + std::to_string(y.num_faces()) + " faces");
-  const Geometry gy = compute_geometry(y);
-  OrientationFlips r;
-  r.faces = x.num_faces();
-  for (const auto& f : x.faces) {
-    const int o = image_orientation(y, gy, map_x_to_y[f[0]], map_x_to_y[f[1]], map_x_to_y[f[2]]);
-    r.degenerate += o == 0;
-    r.flips += o < 0;
-  }
-  return r;
+  return count_images(x, y, map_x_to_y);
 }
 
 OrientationFlips count_orientation_flips(const Mesh& x, const Mesh& y, const std::vector<int>& map_x_to_y) {
@@ -275,16 +286,7 @@ OrientationFlips count_orientation_flips(const Mesh& x, const Mesh& y, const std
     if (v < 0 || v >= y.num_vertices())
       throw InvalidInputError("orientation flips: the map sends a vertex to " + std::to_string(v) + ", but Y has " +
                               std::to_string(y.num_vertices()) + " vertices");
-  const Geometry gy = compute_geometry(y);
-  OrientationFlips r;
-  r.faces = x.num_faces();
-  for (const auto& f : x.faces) {
-    // Collinear images count with the collapsed ones: they have no orientation to compare.
-    const int o = image_orientation(y, gy, map_x_to_y[f[0]], map_x_to_y[f[1]], map_x_to_y[f[2]]);
-    r.degenerate += o == 0;
-    r.flips += o < 0;
-  }
-  return r;
+  return count_images(x, y, map_x_to_y);
 }
 
 }  // namespace shapematch

@@ -1,6 +1,7 @@
 #include "shapematch/point_map.hpp"
 
 #include "shapematch/errors.hpp"
+#include "shapematch/hierarchy.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -134,12 +135,8 @@ Fibres fibres(const ProductSpace& space, const std::vector<int64_t>& gamma, bool
 class SideMap {
 public:
   SideMap(const Mesh& from, const Mesh& to, const PointMapOptions& options)
-      : from_(from), to_(to), g_(compute_geometry(to)), options_(options), from_faces_(from.num_vertices()),
-        to_faces_(to.num_vertices()) {
-    for (int f = 0; f < from.num_faces(); ++f)
-      for (int v : from.faces[f]) from_faces_[v].push_back(f);
-    for (int f = 0; f < to.num_faces(); ++f)
-      for (int v : to.faces[f]) to_faces_[v].push_back(f);
+      : from_(from), to_(to), g_(compute_geometry(to)), options_(options), from_faces_(vertex_face_table(from)),
+        to_faces_(vertex_face_table(to)) {
     const int s = std::max(options.samples, 3);
     for (int i = 1; i < s; ++i)
       for (int j = 1; i + j < s; ++j) grid_.push_back({double(i) / s, double(j) / s, double(s - i - j) / s});
