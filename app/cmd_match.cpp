@@ -30,6 +30,7 @@ struct MatchArgs {
   std::string backend = "auto";
   double threshold = 0.5;
   int max_rounds = 50;
+  double later_round_iterations = RoundingOptions{}.later_round_iterations;
   double fractional_batch = RoundingOptions{}.fractional_batch;
   bool close_pockets = RoundingOptions{}.close_pockets;
   double tolerance = 1e-4;
@@ -107,6 +108,7 @@ int run_match(const MatchArgs& args) {
   ro.solver = solver_for(args);
   ro.threshold = args.threshold;
   ro.max_rounds = args.max_rounds;
+  ro.later_round_iterations = args.later_round_iterations;
   ro.fractional_batch = args.fractional_batch;
   ro.close_pockets = args.close_pockets;
   ro.lp.tolerance = args.tolerance;
@@ -240,6 +242,7 @@ int run_match(const MatchArgs& args) {
                               .set("lame_mu", args.pair.lame.at(1))
                               .set("threshold", args.threshold)
                               .set("fractional_batch", args.fractional_batch)
+                              .set("later_round_iterations", args.later_round_iterations)
                               .set("close_pockets", args.close_pockets)
                               .set("tolerance", args.tolerance)
                               .set("coarse_tolerance", co.coarse_tolerance)
@@ -315,6 +318,11 @@ Action add_match_command(CLI::App& app) {
       ->check(CLI::Range(0.0, 1.0))
       ->capture_default_str();
   app.add_option("--max-rounds", a->max_rounds, "rounding rounds before giving up")->capture_default_str();
+  app.add_option("--later-round-iterations", a->later_round_iterations,
+                 "LP iterations of a rounding round after the first, at most this many times the first LP's (at "
+                 "least 2000; then it fixes from its iterate); 0: no limit")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
   app.add_option("--tol", a->tolerance, "LP tolerance")->capture_default_str();
   app.add_option("--coarse-tol", a->coarse_tolerance, "LP tolerance of the levels below the finest, where looser than --tol")
       ->check(CLI::Range(0.0, 0.5))

@@ -74,6 +74,32 @@ TEST_CASE("rounding: a deformed pair rounds to a verified graph surface within t
   CHECK_FALSE(check_graph_surface(m.space, broken).ok());
 }
 
+TEST_CASE("rounding: later rounds stop at their iteration cap and still end exact") {
+  // Threshold 0 on the dolphins at 60 faces: several rounds (see the clashing-candidates test).
+  const Mesh x = decimate(shapes::dolphin(0, 5), 60), y = decimate(shapes::dolphin(-40, 45), 60);
+  const MatchingLp m = build_matching_lp(x, compute_geometry(x), y, compute_geometry(y));
+  RoundingOptions o;
+  o.solver = "pdhg-cpu";
+  o.exact_below = 0;  // every round on PDHG, so that the cap applies to each
+  o.threshold = 0.0;
+  o.later_round_iterations = 1e-9;
+  o.later_round_min_iterations = 16;  // a floor far below what these rounds take
+  const RoundingResult r = round_to_graph_surface(m.space, m.lp, m.energy, o);
+  REQUIRE(r.rounds.size() >= 2);
+  for (size_t i = 1; i < r.rounds.size(); ++i) {
+    CAPTURE(i);
+    CHECK(r.rounds[i].iterations <= 16);
+  }
+  CHECK(satisfies_exactly(m.lp, r.gamma));
+  CHECK(check_graph_surface(m.space, r.gamma).covers_x);
+  // Without the cap, some later round runs longer (so the check above can fail).
+  o.later_round_iterations = 0;
+  const RoundingResult u = round_to_graph_surface(m.space, m.lp, m.energy, o);
+  int64_t longest = 0;
+  for (size_t i = 1; i < u.rounds.size(); ++i) longest = std::max(longest, u.rounds[i].iterations);
+  CHECK(longest > 16);
+}
+
 TEST_CASE("rounding: limits end in an error, never a wrong answer") {
   const Mesh x = shapes::tetrahedron();
   const Mesh y = test::deformed(x, [](const Eigen::Vector3d& p) { return Eigen::Vector3d(p.x(), 2 * p.y(), p.z()); });

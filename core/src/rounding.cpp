@@ -482,6 +482,12 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
     // (Not the first round: its relaxation and bound are the chosen solver's.)
     const bool exact = round > 1 && red.lp.cols() < options.exact_below && options.solver != "clp-dual";
     if (exact && !exact_solver) exact_solver = make_solver("clp-dual");
+    // A cap for the first-order solver only: simplex iterations are another unit.
+    if (round > 1 && !exact && options.later_round_iterations > 0 && options.solver.rfind("pdhg", 0) == 0)
+      params.max_iterations = std::min<int64_t>(
+          params.max_iterations,
+          std::max<int64_t>(options.later_round_min_iterations,
+                            static_cast<int64_t>(options.later_round_iterations * double(result.first_lp.iterations))));
     const LpResult r = (exact ? exact_solver : solver)->solve(red.lp, params);
     RoundingRound info;
     info.round = round;
