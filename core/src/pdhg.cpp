@@ -230,7 +230,7 @@ LpResult PdhgSolver::solve(const LpProblem& problem, const SolverParams& params)
     // cut their residual 20x in such a window), stop and return the dual's growth over it. The
     // residual need only be above the tolerance: at tolerance 1e-3, a 10 k-face LP's residual
     // went from 8.5e-3 to 7.8e-3 in a window while its bound rose from 36 to 54 against an
-    // objective of 28, and on to 92 (asking for 100 × the tolerance, as before, let it run on).
+    // objective of 28, and on to 108 (asking for 100 × the tolerance, as before, let it run on).
     if (params.stop_on_divergence && total >= window_end) {
       std::vector<double> xh, yh;
       backend->read(xh, yh);
