@@ -33,6 +33,7 @@ struct MatchArgs {
   double later_round_iterations = RoundingOptions{}.later_round_iterations;
   double fractional_batch = RoundingOptions{}.fractional_batch;
   bool close_pockets = RoundingOptions{}.close_pockets;
+  int64_t greedy_above = RoundingOptions{}.greedy_above;
   double tolerance = 1e-4;
   double coarse_tolerance = CoarseToFineOptions{}.coarse_tolerance;
   double time_limit = std::numeric_limits<double>::infinity();
@@ -111,6 +112,7 @@ int run_match(const MatchArgs& args) {
   ro.later_round_iterations = args.later_round_iterations;
   ro.fractional_batch = args.fractional_batch;
   ro.close_pockets = args.close_pockets;
+  ro.greedy_above = args.greedy_above;
   ro.lp.tolerance = args.tolerance;
   ro.lp.time_limit = args.time_limit;
   ro.lp.device = args.device;
@@ -244,6 +246,7 @@ int run_match(const MatchArgs& args) {
                               .set("fractional_batch", args.fractional_batch)
                               .set("later_round_iterations", args.later_round_iterations)
                               .set("close_pockets", args.close_pockets)
+                              .set("greedy_above", args.greedy_above)
                               .set("tolerance", args.tolerance)
                               .set("coarse_tolerance", co.coarse_tolerance)
                               .set("faces", args.pair.faces)
@@ -321,6 +324,11 @@ Action add_match_command(CLI::App& app) {
   app.add_option("--later-round-iterations", a->later_round_iterations,
                  "LP iterations of a rounding round after the first, at most this many times the first LP's (at "
                  "least 2000; then it fixes from its iterate); 0: no limit")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  app.add_option("--greedy-above", a->greedy_above,
+                 "where a round's candidates clash and its LP has more free variables than this, fix each candidate "
+                 "that does not clash with larger ones (below: fix the larger half and solve again); 0: always")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   app.add_option("--tol", a->tolerance, "LP tolerance")->capture_default_str();

@@ -202,6 +202,28 @@ TEST_CASE("rounding: a batch full of clashing candidates still ends in an exact 
   MESSAGE("threshold 0: ", r.rounds.size(), " rounds, gap ", r.gap);
 }
 
+TEST_CASE("rounding: greedy fixing takes every candidate that does not clash, in fewer rounds") {
+  const Mesh x = decimate(shapes::dolphin(0, 5), 60), y = decimate(shapes::dolphin(-40, 45), 60);
+  const Geometry gx = compute_geometry(x), gy = compute_geometry(y);
+  const MatchingLp m = build_matching_lp(x, gx, y, gy);
+  RoundingOptions o;
+  o.solver = "pdhg-cpu";
+  o.threshold = 0.0;  // clashes for sure (above)
+  const RoundingResult halved = round_to_graph_surface(m.space, m.lp, m.energy, o);
+  o.greedy_above = 0;
+  const RoundingResult r = round_to_graph_surface(m.space, m.lp, m.energy, o);
+  CHECK(satisfies_exactly(m.lp, r.gamma));
+  CHECK(check_graph_surface(m.space, r.gamma).ok());
+  CHECK(r.energy >= r.lower_bound - 1e-9);
+  REQUIRE(!r.rounds.empty());
+  CHECK(r.rounds[0].undone);  // the first batch clashed and was not applied whole
+  // Halving applies at most half of a clashing batch per round; greedy all that fit.
+  CHECK(r.rounds[0].fixed_to_one > halved.rounds[0].fixed_to_one);
+  CHECK(r.rounds.size() < halved.rounds.size());
+  MESSAGE("threshold 0: greedy ", r.rounds.size(), " rounds, gap ", r.gap, "; halving ", halved.rounds.size(),
+          " rounds, gap ", halved.gap);
+}
+
 TEST_CASE("rounding: an LP with no binary solution ends in InfeasibleError naming the open rows") {
   // x0 + x1 = x1 + x2 = x2 + x0 = 1: the LP has x = 1/2, but no 0/1 point exists; fixing any
   // variable to 1 or to 0 is refuted by propagation, with nothing earlier to undo.

@@ -193,12 +193,32 @@ Reduced reduce(const LpProblem& full, const FixState& s) {
 }
 
 // Fixes the batch (largest first); a fixing that propagation proves infeasible is undone and
-// replaced by fixing fewer (halving down to the single largest), and a single variable that
-// cannot be 1 is fixed to 0 instead: each retry strictly shrinks the search space. Returns the
-// batch actually applied (`batch` itself when nothing had to be undone). `mark` is the fixer's
-// mark before the batch.
+// replaced by fixing fewer: with `greedy`, every candidate that does not clash with the larger
+// ones fixed before it (one propagation each); otherwise halving the batch down to the single
+// largest. A single variable that cannot be 1 is fixed to 0 instead: each retry strictly shrinks
+// the search space. Returns the batch actually applied (`batch` itself when nothing had to be
+// undone). `mark` is the fixer's mark before the batch.
 std::vector<std::pair<int64_t, int>> shrink_and_fix(Fixer& fixer, std::vector<std::pair<int64_t, int>> batch,
-                                                    size_t mark) {
+                                                    size_t mark, bool greedy) {
+  if (fixer.fix(batch)) return batch;
+  fixer.undo_to(mark);
+  if (greedy && batch.size() > 1) {
+    std::vector<std::pair<int64_t, int>> kept;
+    for (const auto& a : batch) {
+      const size_t m = fixer.mark();
+      if (fixer.fix({a})) kept.push_back(a);
+      else fixer.undo_to(m);
+    }
+    if (!kept.empty()) return kept;
+    batch.resize(1);  // not even the largest alone: it must be 0
+    batch.front().second = 0;
+  } else if (batch.size() > 1) {
+    batch.resize(batch.size() / 2);
+  } else if (batch.front().second == 1) {
+    batch.front().second = 0;
+  } else {
+    throw InfeasibleError("rounding: no consistent fixing exists (no binary solution)");
+  }
   while (!fixer.fix(batch)) {
     fixer.undo_to(mark);
     if (batch.size() > 1) {
@@ -451,7 +471,7 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
       else shrinkable = false;
       if (shrinkable) {
         try {
-          step.batch = shrink_and_fix(fixer, smaller, step.mark);  // if still infeasible, shrink further
+          step.batch = shrink_and_fix(fixer, smaller, step.mark, false);  // if still infeasible, shrink further
           return;
         } catch (const InfeasibleError&) {
           fixer.undo_to(step.mark);
@@ -540,7 +560,7 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
     Step step{fixer.mark(), fixer.state().ones, fixer.state().zeros, {}};
     const int64_t ones = step.ones, zeros = step.zeros;
     try {
-      step.batch = shrink_and_fix(fixer, batch, step.mark);
+      step.batch = shrink_and_fix(fixer, batch, step.mark, red.lp.cols() > options.greedy_above);
       info.undone = step.batch != batch;
       history.push_back(std::move(step));
     } catch (const InfeasibleError&) {  // not even the largest can be 1 or 0: an earlier fixing is wrong
