@@ -332,7 +332,7 @@ Action add_match_command(CLI::App& app) {
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   app.add_option("--tol", a->tolerance, "LP tolerance")->capture_default_str();
-  app.add_option("--coarse-tol", a->coarse_tolerance, "LP tolerance of the levels below the finest, where looser than --tol")
+  app.add_option("--coarse-tol", a->coarse_tolerance, "LP tolerance of the levels below the finest (0: --tol)")
       ->check(CLI::Range(0.0, 0.5))
       ->capture_default_str();
   app.add_option("--time-limit", a->time_limit, "time limit of each LP solve, seconds");

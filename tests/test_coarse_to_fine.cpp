@@ -297,7 +297,7 @@ TEST_CASE("coarse to fine: an infeasible reduced LP is widened near the proof, n
   CHECK(variables[0] < variables[1]);
 }
 
-TEST_CASE("coarse to fine: a looser tolerance below the finest level costs fewer iterations there only") {
+TEST_CASE("coarse to fine: the tolerance below the finest level is its own, looser or tighter") {
   CoarseToFineOptions o = two_levels(40);
   o.coarse_tolerance = 0.0;
   const CoarseToFineMatcher tight = finger_matcher(o);  // the results refer to their meshes
@@ -308,6 +308,15 @@ TEST_CASE("coarse to fine: a looser tolerance below the finest level costs fewer
   CHECK(b.levels[0].iterations < a.levels[0].iterations);
   CHECK(check_graph_surface(b.finest.space, b.rounding.gamma).ok());
   CHECK(b.levels[1].lower_bound <= b.levels[1].energy + 1e-9);
+  // Also tighter than a loose finest level (at full resolution 3e-3 below it made rounding thrash).
+  o.rounding.lp.tolerance = 1e-2;
+  o.coarse_tolerance = 0.0;  // 1e-2 everywhere
+  const CoarseToFineMatcher all_loose = finger_matcher(o);
+  o.coarse_tolerance = 1e-4;
+  const CoarseToFineMatcher tight_below = finger_matcher(o);
+  const CoarseToFineResult c = all_loose.run(), d = tight_below.run();
+  CHECK(d.levels[0].iterations > c.levels[0].iterations);
+  CHECK(d.levels[0].iterations == a.levels[0].iterations);  // 1e-4 below the finest, as in `tight`
 }
 
 TEST_CASE("coarse to fine: the second start solves the second level twice and keeps the lower energy") {

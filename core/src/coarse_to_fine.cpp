@@ -343,7 +343,7 @@ CoarseToFineResult CoarseToFineMatcher::run(const Progress& progress) const {
 
 RoundingOptions CoarseToFineMatcher::rounding_for(int l) const {
   RoundingOptions ro = options_.rounding;
-  if (l + 1 < hx_.size()) ro.lp.tolerance = std::max(ro.lp.tolerance, options_.coarse_tolerance);
+  if (l + 1 < hx_.size() && options_.coarse_tolerance > 0.0) ro.lp.tolerance = options_.coarse_tolerance;
   return ro;
 }
 
