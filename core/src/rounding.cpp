@@ -275,6 +275,34 @@ std::vector<std::pair<int64_t, int>> fractional_batch(const LpProblem& lp, const
   return batch;
 }
 
+// The fixings of `batch` that share no row with any variable of a `proof` row (a Farkas
+// certificate's rows after the batch was fixed): what an infeasible LP after the batch does not
+// blame. Any variable, not only free ones: a fixing often acts through the variables its
+// propagation set to 0. Empty where the proof blames all of them or none (then it says nothing
+// local).
+std::vector<std::pair<int64_t, int>> fixings_away_from(const LpProblem& lp, const std::vector<int64_t>& proof,
+                                                       const std::vector<std::pair<int64_t, int>>& batch) {
+  std::vector<char> near(lp.rows(), 0);  // rows of the variables in proof rows
+  for (int64_t i : proof) {
+    near[i] = 1;
+    for (uint32_t k = lp.a.row_ptr[i]; k < lp.a.row_ptr[i + 1]; ++k) {
+      const int64_t j = col_of(lp.a.entry[k]);
+      for (uint32_t q = lp.at.row_ptr[j]; q < lp.at.row_ptr[j + 1]; ++q) near[col_of(lp.at.entry[q])] = 1;
+    }
+  }
+  std::vector<std::pair<int64_t, int>> kept;
+  for (const auto& a : batch) {
+    bool blamed = false;
+    for (uint32_t q = lp.at.row_ptr[a.first]; q < lp.at.row_ptr[a.first + 1] && !blamed; ++q)
+      blamed = near[col_of(lp.at.entry[q])];
+    if (!blamed) kept.push_back(a);
+  }
+  if (kept.size() == batch.size()) kept.clear();
+  spdlog::debug("rounding: the infeasibility proof ({} rows) blames {} of {} fixings", proof.size(),
+                batch.size() - kept.size(), batch.size());
+  return kept;
+}
+
 }  // namespace
 
 int64_t propagation_conflict(const LpProblem& lp, const std::vector<char>& skip) {
@@ -454,9 +482,15 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
   // FAUST 020-024 at 4000 faces got stuck this way in round 15 and lost its whole level. Gives up
   // with the rows still open (so coarse to fine can widen there) when nothing is left to undo or
   // after max_backtracks.
-  auto backtrack = [&]() {
+  // With `proof` (rows of a Farkas certificate of the LP after the last fixing), the last fixing
+  // first loses only its variables near the proof (fixings_away_from): an infeasible LP costs a
+  // full solve, and halving needs about log2(batch) of them where the fault is local.
+  auto backtrack = [&](const std::vector<int64_t>& proof) {
     std::vector<int64_t> open = fixer.unsatisfied_rows();  // where it got stuck
-    for (;;) {
+    std::vector<std::pair<int64_t, int>> away_from_proof;
+    if (!proof.empty() && !history.empty() && history.back().batch.size() > 1)
+      away_from_proof = fixings_away_from(lp, proof, history.back().batch);
+    for (bool first = true;; first = false) {
       if (history.empty() || ++backtracks > options.max_backtracks)
         throw InfeasibleError(history.empty() ? "rounding: no consistent fixing exists (no binary solution)"
                                               : "rounding: no binary solution found within " +
@@ -466,7 +500,8 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
       fixer.undo_to(step.mark);
       auto smaller = step.batch;
       bool shrinkable = true;
-      if (smaller.size() > 1) smaller.resize(smaller.size() / 2);
+      if (first && !away_from_proof.empty()) smaller = std::move(away_from_proof);
+      else if (smaller.size() > 1) smaller.resize(smaller.size() / 2);
       else if (smaller.front().second == 1) smaller.front().second = 0;  // the single variable cannot be 1
       else shrinkable = false;
       if (shrinkable) {
@@ -530,7 +565,7 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
       if (history.empty())
         throw InfeasibleError("rounding: the matching LP is infeasible", certificate_rows(r.y, red.rows));
       info.undone = true;
-      backtrack();
+      backtrack(certificate_rows(r.y, red.rows));
       info.fixed_to_one = fixer.state().ones - history.back().ones;
       info.fixed_to_zero = fixer.state().zeros - history.back().zeros;
       info.seconds = clock.seconds();
@@ -566,7 +601,7 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
     } catch (const InfeasibleError&) {  // not even the largest can be 1 or 0: an earlier fixing is wrong
       fixer.undo_to(step.mark);
       info.undone = true;
-      backtrack();
+      backtrack({});
     }
     info.fixed_to_one = fixer.state().ones - ones;
     info.fixed_to_zero = fixer.state().zeros - zeros;
