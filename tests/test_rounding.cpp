@@ -224,31 +224,35 @@ TEST_CASE("rounding: greedy fixing takes every candidate that does not clash, in
           " rounds, gap ", halved.gap);
 }
 
-TEST_CASE("rounding: an infeasible LP after a fixing undoes only the fixings near its proof") {
-  // Variables a, a', y1..y5, w1, w2, b1, b1', b2, b2'. a + a' = 1; y_i + y_{i+1} + a' = 1 around
-  // a 5-cycle; y1 + ... + y5 + w1 + w2 = 2; b_k + b_k' = 1. a' and b_k' cost 10. The LP has
-  // a' = 1/5 (y = 2/5, the sum at its cap 2) and b = 1, so round 1 fixes b1, b2 and a = 0.8. With
-  // a = 1 the cycle needs y = 1/2, a sum of 5/2: infeasible, but no row alone says so, so only
-  // the next LP can. Its proof lies on the cycle, away from b1 and b2: they stay fixed, where
-  // halving the batch would have kept b1 alone.
-  std::vector<std::vector<int>> rows(9, std::vector<int>(13, 0));
+TEST_CASE("rounding: an infeasible LP after a fixing undoes only the fixings its proof blames") {
+  // Variables a, a', c, y1..y5, w1, w2, b1, b1', b2, b2'. a + a' = 1; a' = c; y_i + y_{i+1} + c = 1
+  // around a 5-cycle; y1 + ... + y5 + w1 + w2 = 2; b_k + b_k' = 1. a' and b_k' cost 10. The LP
+  // has a' = c = 1/5 (y = 2/5, the sum at its cap 2) and b = 1, so round 1 fixes b1, b2 and
+  // a = 0.8. With a = 1 the cycle needs y = 1/2, a sum of 5/2: infeasible, but no row alone says
+  // so, so only the next LP can. Its proof lies on the cycle, two rows away from a (a -> a' -> c,
+  // by propagation) and away from b1 and b2: they stay fixed, where halving the batch would
+  // have kept b1 alone.
+  const int n = 14;
+  std::vector<std::vector<int>> rows(10, std::vector<int>(n, 0));
   rows[0][0] = rows[0][1] = 1;
-  for (int i = 0; i < 5; ++i) rows[1 + i][2 + i] = rows[1 + i][2 + (i + 1) % 5] = rows[1 + i][1] = 1;
-  for (int j = 2; j <= 8; ++j) rows[6][j] = 1;
-  rows[7][9] = rows[7][10] = 1;
-  rows[8][11] = rows[8][12] = 1;
-  std::vector<double> cost(13, 0.0);
-  cost[1] = cost[10] = cost[12] = 10.0;
-  const LpProblem lp = test::dense_lp(rows, {1, 1, 1, 1, 1, 1, 2, 1, 1}, cost);
-  const Mesh sphere = shapes::icosphere(1);  // a space of 13 variables, only for the sizes
+  rows[1][1] = 1;
+  rows[1][2] = -1;
+  for (int i = 0; i < 5; ++i) rows[2 + i][3 + i] = rows[2 + i][3 + (i + 1) % 5] = rows[2 + i][2] = 1;
+  for (int j = 3; j <= 9; ++j) rows[7][j] = 1;
+  rows[8][10] = rows[8][11] = 1;
+  rows[9][12] = rows[9][13] = 1;
+  std::vector<double> cost(n, 0.0);
+  cost[1] = cost[11] = cost[13] = 10.0;
+  const LpProblem lp = test::dense_lp(rows, {1, 0, 1, 1, 1, 1, 1, 2, 1, 1}, cost);
+  const Mesh sphere = shapes::icosphere(1);  // a space of 14 variables, only for the sizes
   const auto id = identity_matching(sphere);
-  const ProductSpace space = ProductSpace::from_list(sphere, sphere, {id.begin(), id.begin() + 13});
+  const ProductSpace space = ProductSpace::from_list(sphere, sphere, {id.begin(), id.begin() + n});
   RoundingOptions options;
   options.solver = "pdhg-cpu";  // its infeasibility proof is a dual point (Clp's names no rows)
   options.exact_below = 0;
   const RoundingResult r = round_to_graph_surface(space, lp, cost, options);
   CHECK(satisfies_exactly(lp, r.gamma));
-  CHECK(r.energy == 10.0);  // a' = 1, b1 = b2 = 1
+  CHECK(r.energy == 10.0);  // a' = c = 1, b1 = b2 = 1
   REQUIRE(r.rounds.size() >= 2);
   CHECK(r.rounds[0].fixed_to_one == 3);
   CHECK(r.rounds[1].status == LpStatus::Infeasible);

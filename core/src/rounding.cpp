@@ -46,6 +46,8 @@ public:
   // Every assignment since `mark()` can be taken back, propagation included, at the cost of what
   // it changed: rounding backtracks over several rounds without keeping copies of the state.
   size_t mark() const { return trail_.size(); }
+  // The variables assigned since `mark`, in order (each fixing followed by what it propagated).
+  std::vector<int64_t> assigned_since(size_t mark) const { return {trail_.begin() + mark, trail_.end()}; }
   void undo_to(size_t mark) {
     while (trail_.size() > mark) {
       const int64_t j = trail_.back();
@@ -200,7 +202,15 @@ Reduced reduce(const LpProblem& full, const FixState& s) {
 // undone). `mark` is the fixer's mark before the batch.
 std::vector<std::pair<int64_t, int>> shrink_and_fix(Fixer& fixer, std::vector<std::pair<int64_t, int>> batch,
                                                     size_t mark, bool greedy) {
-  if (fixer.fix(batch)) return batch;
+  // One at a time, each followed by its propagation: the same state as all at once where it goes
+  // through (propagation's fixed point does not depend on the order), and the trail then says
+  // which fixing propagated what (fixings_away_from).
+  const auto fix_each = [&](const std::vector<std::pair<int64_t, int>>& b) {
+    for (const auto& a : b)
+      if (!fixer.fix({a})) return false;
+    return true;
+  };
+  if (fix_each(batch)) return batch;
   fixer.undo_to(mark);
   if (greedy && batch.size() > 1) {
     std::vector<std::pair<int64_t, int>> kept;
@@ -219,7 +229,7 @@ std::vector<std::pair<int64_t, int>> shrink_and_fix(Fixer& fixer, std::vector<st
   } else {
     throw InfeasibleError("rounding: no consistent fixing exists (no binary solution)");
   }
-  while (!fixer.fix(batch)) {
+  while (!fix_each(batch)) {
     fixer.undo_to(mark);
     if (batch.size() > 1) {
       batch.resize(batch.size() / 2);
@@ -275,13 +285,16 @@ std::vector<std::pair<int64_t, int>> fractional_batch(const LpProblem& lp, const
   return batch;
 }
 
-// The fixings of `batch` that share no row with any variable of a `proof` row (a Farkas
-// certificate's rows after the batch was fixed): what an infeasible LP after the batch does not
-// blame. Any variable, not only free ones: a fixing often acts through the variables its
-// propagation set to 0. Empty where the proof blames all of them or none (then it says nothing
+// The fixings of `batch` that an infeasibility proof after it (a Farkas certificate's rows,
+// `proof`) does not blame. A fixing is blamed where it, or a variable its own propagation set
+// (`assigned`: the trail since the batch, each fixing followed by what it propagated; where the
+// batch went in whole, its propagation is nobody's), shares a row with a variable of a proof
+// row. Any variable, not only free ones: a fixing acts through the zeros it propagates, often
+// several rows away. Empty where the proof blames all of them or none (then it says nothing
 // local).
 std::vector<std::pair<int64_t, int>> fixings_away_from(const LpProblem& lp, const std::vector<int64_t>& proof,
-                                                       const std::vector<std::pair<int64_t, int>>& batch) {
+                                                       const std::vector<std::pair<int64_t, int>>& batch,
+                                                       const std::vector<int64_t>& assigned) {
   std::vector<char> near(lp.rows(), 0);  // rows of the variables in proof rows
   for (int64_t i : proof) {
     near[i] = 1;
@@ -290,13 +303,31 @@ std::vector<std::pair<int64_t, int>> fixings_away_from(const LpProblem& lp, cons
       for (uint32_t q = lp.at.row_ptr[j]; q < lp.at.row_ptr[j + 1]; ++q) near[col_of(lp.at.entry[q])] = 1;
     }
   }
-  std::vector<std::pair<int64_t, int>> kept;
-  for (const auto& a : batch) {
-    bool blamed = false;
-    for (uint32_t q = lp.at.row_ptr[a.first]; q < lp.at.row_ptr[a.first + 1] && !blamed; ++q)
-      blamed = near[col_of(lp.at.entry[q])];
-    if (!blamed) kept.push_back(a);
+  auto touches = [&](int64_t j) {
+    for (uint32_t q = lp.at.row_ptr[j]; q < lp.at.row_ptr[j + 1]; ++q)
+      if (near[col_of(lp.at.entry[q])]) return true;
+    return false;
+  };
+  std::unordered_map<int64_t, size_t> position;  // batch variable -> its index in `batch`
+  for (size_t n = 0; n < batch.size(); ++n) position[batch[n].first] = n;
+  std::vector<char> blamed(batch.size(), 0);
+  // Walk the trail: a batch variable opens its own segment; what follows it is its propagation,
+  // unless it stands next to another batch variable (the batch went in whole: no owner).
+  int64_t owner = -1;
+  for (size_t t = 0; t < assigned.size(); ++t) {
+    const auto it = position.find(assigned[t]);
+    if (it != position.end()) {
+      const bool in_run = (t + 1 < assigned.size() && position.count(assigned[t + 1])) ||
+                          (t > 0 && position.count(assigned[t - 1]));
+      owner = in_run ? -1 : static_cast<int64_t>(it->second);
+      if (touches(assigned[t])) blamed[it->second] = 1;
+    } else if (owner >= 0 && !blamed[owner] && touches(assigned[t])) {
+      blamed[owner] = 1;
+    }
   }
+  std::vector<std::pair<int64_t, int>> kept;
+  for (size_t n = 0; n < batch.size(); ++n)
+    if (!blamed[n]) kept.push_back(batch[n]);
   if (kept.size() == batch.size()) kept.clear();
   spdlog::debug("rounding: the infeasibility proof ({} rows) blames {} of {} fixings", proof.size(),
                 batch.size() - kept.size(), batch.size());
@@ -489,7 +520,8 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
     std::vector<int64_t> open = fixer.unsatisfied_rows();  // where it got stuck
     std::vector<std::pair<int64_t, int>> away_from_proof;
     if (!proof.empty() && !history.empty() && history.back().batch.size() > 1)
-      away_from_proof = fixings_away_from(lp, proof, history.back().batch);
+      away_from_proof =
+          fixings_away_from(lp, proof, history.back().batch, fixer.assigned_since(history.back().mark));
     for (bool first = true;; first = false) {
       if (history.empty() || ++backtracks > options.max_backtracks)
         throw InfeasibleError(history.empty() ? "rounding: no consistent fixing exists (no binary solution)"
