@@ -34,6 +34,7 @@ struct MatchArgs {
   double fractional_batch = RoundingOptions{}.fractional_batch;
   bool close_pockets = RoundingOptions{}.close_pockets;
   int64_t greedy_above = RoundingOptions{}.greedy_above;
+  int greedy_margin = RoundingOptions{}.greedy_margin;
   double tolerance = 1e-4;
   double coarse_tolerance = CoarseToFineOptions{}.coarse_tolerance;
   double time_limit = std::numeric_limits<double>::infinity();
@@ -113,6 +114,7 @@ int run_match(const MatchArgs& args) {
   ro.fractional_batch = args.fractional_batch;
   ro.close_pockets = args.close_pockets;
   ro.greedy_above = args.greedy_above;
+  ro.greedy_margin = args.greedy_margin;
   ro.lp.tolerance = args.tolerance;
   ro.lp.time_limit = args.time_limit;
   ro.lp.device = args.device;
@@ -247,6 +249,7 @@ int run_match(const MatchArgs& args) {
                               .set("later_round_iterations", args.later_round_iterations)
                               .set("close_pockets", args.close_pockets)
                               .set("greedy_above", args.greedy_above)
+                              .set("greedy_margin", args.greedy_margin)
                               .set("tolerance", args.tolerance)
                               .set("coarse_tolerance", co.coarse_tolerance)
                               .set("faces", args.pair.faces)
@@ -329,6 +332,11 @@ Action add_match_command(CLI::App& app) {
   app.add_option("--greedy-above", a->greedy_above,
                  "where a round's candidates clash and its LP has more free variables than this, fix each candidate "
                  "that does not clash with larger ones (below: fix the larger half and solve again); 0: always")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  app.add_option("--greedy-margin", a->greedy_margin,
+                 "those rounds fix only candidates with no undecided variable (valued in (0.1, 0.9)) in their rows "
+                 "or within this many - 1 closedness steps of them; 0: every candidate")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   app.add_option("--tol", a->tolerance, "LP tolerance")->capture_default_str();

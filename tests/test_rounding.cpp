@@ -245,6 +245,47 @@ TEST_CASE("rounding: an infeasible LP after a fixing undoes only the fixings its
   CHECK(r.rounds[1].fixed_to_one == 2);  // b1 and b2 again; halving: b1 alone
 }
 
+TEST_CASE("rounding: a big round fixes only candidates away from the LP's undecided part") {
+  // The LP of the test above: a = 0.8 with a' = c = 0.2 next to it, b1 = b2 = 1 with b1' = b2' =
+  // 0. Where every round counts as big (greedy_above 0), round 1 fixes b1 and b2 but not a (its
+  // row holds a', undecided), so the LP after it is feasible; with the margin off it fixes all
+  // three and the next LP is not.
+  const int n = 14;
+  std::vector<std::vector<int>> rows(10, std::vector<int>(n, 0));
+  rows[0][0] = rows[0][1] = 1;
+  rows[1][1] = 1;
+  rows[1][2] = -1;
+  for (int i = 0; i < 5; ++i) rows[2 + i][3 + i] = rows[2 + i][3 + (i + 1) % 5] = rows[2 + i][2] = 1;
+  for (int j = 3; j <= 9; ++j) rows[7][j] = 1;
+  rows[8][10] = rows[8][11] = 1;
+  rows[9][12] = rows[9][13] = 1;
+  std::vector<double> cost(n, 0.0);
+  cost[1] = cost[11] = cost[13] = 10.0;
+  const LpProblem lp = test::dense_lp(rows, {1, 0, 1, 1, 1, 1, 1, 2, 1, 1}, cost);
+  const Mesh sphere = shapes::icosphere(1);
+  const auto id = identity_matching(sphere);
+  const ProductSpace space = ProductSpace::from_list(sphere, sphere, {id.begin(), id.begin() + n});
+  RoundingOptions options;
+  options.solver = "pdhg-cpu";
+  options.exact_below = 0;
+  options.greedy_above = 0;
+  const RoundingResult away = round_to_graph_surface(space, lp, cost, options);
+  CHECK(satisfies_exactly(lp, away.gamma));
+  CHECK(away.energy == 10.0);
+  REQUIRE(away.rounds.size() >= 2);
+  CHECK(away.rounds[0].fixed_to_one == 2);
+  CHECK(!away.rounds[0].undone);
+  // Round 2's LP keeps b and is feasible. (Then nothing stands away from a' and the whole batch,
+  // a, goes in: the fallback that keeps rounding moving; round 3 undoes it.)
+  CHECK(away.rounds[1].status == LpStatus::Optimal);
+  options.greedy_margin = 0;
+  const RoundingResult all = round_to_graph_surface(space, lp, cost, options);
+  CHECK(satisfies_exactly(lp, all.gamma));
+  REQUIRE(all.rounds.size() >= 2);
+  CHECK(all.rounds[0].fixed_to_one == 3);
+  CHECK(all.rounds[1].status == LpStatus::Infeasible);
+}
+
 TEST_CASE("rounding: an LP with no binary solution ends in InfeasibleError naming the open rows") {
   // x0 + x1 = x1 + x2 = x2 + x0 = 1: the LP has x = 1/2, but no 0/1 point exists; fixing any
   // variable to 1 or to 0 is refuted by propagation, with nothing earlier to undo.

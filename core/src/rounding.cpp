@@ -337,6 +337,62 @@ std::vector<std::pair<int64_t, int>> fixings_away_from(const LpProblem& lp, cons
   return kept;
 }
 
+// The candidates of a big (greedy) round that stand away from the LP's undecided part: none of
+// a candidate's rows may hold a free variable with a value strictly between `unsure` and
+// 1 − `unsure`, nor lie within `margin` − 1 further steps of such a row through the closedness
+// rows (b = 0; a face's coverage row reaches a thousand candidates and would spread everywhere).
+// Why: a candidate next to a split region fixes that region's boundary to one of the LP's mixed
+// alternatives, which the narrow reduced space often cannot complete; propagation does not see
+// it, the next LP is infeasible, and every infeasibility proof costs a solve. The whole batch
+// where nothing would be left.
+std::vector<std::pair<int64_t, int>> away_from_undecided(const LpProblem& lp, const Reduced& red,
+                                                         const std::vector<int8_t>& value, const std::vector<double>& x,
+                                                         const std::vector<std::pair<int64_t, int>>& batch,
+                                                         double unsure, int margin) {
+  if (margin <= 0 || batch.empty()) return batch;
+  std::vector<char> undecided(lp.rows(), 0);
+  std::vector<int64_t> frontier;
+  for (size_t k = 0; k < red.cols.size(); ++k) {
+    if (!(x[k] > unsure && x[k] < 1.0 - unsure)) continue;
+    const int64_t j = red.cols[k];
+    for (uint32_t q = lp.at.row_ptr[j]; q < lp.at.row_ptr[j + 1]; ++q) {
+      const int64_t i = col_of(lp.at.entry[q]);
+      if (!undecided[i]) {
+        undecided[i] = 1;
+        frontier.push_back(i);
+      }
+    }
+  }
+  for (int step = 1; step < margin; ++step) {
+    std::vector<int64_t> next;
+    for (int64_t i : frontier) {
+      if (lp.b[i] != 0.0) continue;
+      for (uint32_t k = lp.a.row_ptr[i]; k < lp.a.row_ptr[i + 1]; ++k) {
+        const int64_t j = col_of(lp.a.entry[k]);
+        if (value[j] >= 0) continue;
+        for (uint32_t q = lp.at.row_ptr[j]; q < lp.at.row_ptr[j + 1]; ++q) {
+          const int64_t r = col_of(lp.at.entry[q]);
+          if (lp.b[r] == 0.0 && !undecided[r]) {
+            undecided[r] = 1;
+            next.push_back(r);
+          }
+        }
+      }
+    }
+    frontier = std::move(next);
+  }
+  std::vector<std::pair<int64_t, int>> kept;
+  for (const auto& a : batch) {
+    bool near = false;
+    for (uint32_t q = lp.at.row_ptr[a.first]; q < lp.at.row_ptr[a.first + 1] && !near; ++q)
+      near = undecided[col_of(lp.at.entry[q])];
+    if (!near) kept.push_back(a);
+  }
+  spdlog::debug("rounding: {} of {} candidates stand away from the undecided part (margin {})", kept.size(),
+                batch.size(), margin);
+  return kept.empty() ? batch : kept;
+}
+
 }  // namespace
 
 int64_t propagation_conflict(const LpProblem& lp, const std::vector<char>& skip) {
@@ -631,7 +687,11 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
     Step step{fixer.mark(), fixer.state().ones, fixer.state().zeros, {}};
     const int64_t ones = step.ones, zeros = step.zeros;
     try {
-      step.batch = shrink_and_fix(fixer, batch, step.mark, red.lp.cols() > options.greedy_above);
+      const bool greedy = red.lp.cols() > options.greedy_above;
+      if (greedy)
+        batch = away_from_undecided(lp, red, fixer.state().value, r.x, batch, options.greedy_unsure,
+                                    options.greedy_margin);
+      step.batch = shrink_and_fix(fixer, batch, step.mark, greedy);
       info.undone = step.batch != batch;
       history.push_back(std::move(step));
     } catch (const InfeasibleError&) {  // not even the largest can be 1 or 0: an earlier fixing is wrong

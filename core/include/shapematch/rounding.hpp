@@ -44,6 +44,11 @@ struct RoundingOptions {
   // At full resolution (round 1: 7.5 M variables) halving left 2.3 M variables to round 2, whose
   // LP alone ran 12-20 minutes. 0: always greedy.
   int64_t greedy_above = 2'000'000;
+  // A greedy round fixes only candidates away from the LP's undecided part: none of their rows
+  // holds a free variable valued in (greedy_unsure, 1 − greedy_unsure), nor lies within
+  // greedy_margin − 1 closedness steps of one (0: fix every candidate).
+  double greedy_unsure = 0.1;
+  int greedy_margin = 1;
   int max_backtracks = 200;    // fixings undone after an infeasible LP (each one more, smaller LP
                                // solve), then fail with InfeasibleError naming the open rows
   std::string solver = "pdhg-cpu";
