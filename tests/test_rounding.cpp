@@ -209,14 +209,11 @@ TEST_CASE("rounding: a batch full of clashing candidates still ends in an exact 
           greedy.rounds.size(), " rounds, gap ", greedy.gap);
 }
 
-TEST_CASE("rounding: an infeasible LP after a fixing undoes only the fixings its proof blames") {
-  // Variables a, a', c, y1..y5, w1, w2, b1, b1', b2, b2'. a + a' = 1; a' = c; y_i + y_{i+1} + c = 1
-  // around a 5-cycle; y1 + ... + y5 + w1 + w2 = 2; b_k + b_k' = 1. a' and b_k' cost 10. The LP
-  // has a' = c = 1/5 (y = 2/5, the sum at its cap 2) and b = 1, so round 1 fixes b1, b2 and
-  // a = 0.8. With a = 1 the cycle needs y = 1/2, a sum of 5/2: infeasible, but no row alone says
-  // so, so only the next LP can. Its proof lies on the cycle, two rows away from a (a -> a' -> c,
-  // by propagation) and away from b1 and b2: they stay fixed, where halving the batch would
-  // have kept b1 alone.
+namespace {
+
+// Variables a, a', c, y1..y5, w1, w2, b1, b1', b2, b2'. a + a' = 1; a' = c; y_i + y_{i+1} + c = 1
+// around a 5-cycle; y1 + ... + y5 + w1 + w2 = 2; b_k + b_k' = 1. a' and b_k' cost 10 (`cost`).
+LpProblem cycle_behind_a_fixing(std::vector<double>& cost) {
   const int n = 14;
   std::vector<std::vector<int>> rows(10, std::vector<int>(n, 0));
   rows[0][0] = rows[0][1] = 1;
@@ -226,9 +223,22 @@ TEST_CASE("rounding: an infeasible LP after a fixing undoes only the fixings its
   for (int j = 3; j <= 9; ++j) rows[7][j] = 1;
   rows[8][10] = rows[8][11] = 1;
   rows[9][12] = rows[9][13] = 1;
-  std::vector<double> cost(n, 0.0);
+  cost.assign(n, 0.0);
   cost[1] = cost[11] = cost[13] = 10.0;
-  const LpProblem lp = test::dense_lp(rows, {1, 0, 1, 1, 1, 1, 1, 2, 1, 1}, cost);
+  return test::dense_lp(rows, {1, 0, 1, 1, 1, 1, 1, 2, 1, 1}, cost);
+}
+
+}  // namespace
+
+TEST_CASE("rounding: an infeasible LP after a fixing undoes only the fixings its proof blames") {
+  // The LP cycle_behind_a_fixing has a' = c = 1/5 (y = 2/5, the sum at its cap 2) and b = 1, so
+  // round 1 fixes b1, b2 and a = 0.8. With a = 1 the cycle needs y = 1/2, a sum of 5/2: infeasible, but no row alone says
+  // so, so only the next LP can. Its proof lies on the cycle, two rows away from a (a -> a' -> c,
+  // by propagation) and away from b1 and b2: they stay fixed, where halving the batch would
+  // have kept b1 alone.
+  const int n = 14;
+  std::vector<double> cost;
+  const LpProblem lp = cycle_behind_a_fixing(cost);
   const Mesh sphere = shapes::icosphere(1);  // a space of 14 variables, only for the sizes
   const auto id = identity_matching(sphere);
   const ProductSpace space = ProductSpace::from_list(sphere, sphere, {id.begin(), id.begin() + n});
@@ -246,22 +256,13 @@ TEST_CASE("rounding: an infeasible LP after a fixing undoes only the fixings its
 }
 
 TEST_CASE("rounding: a big round fixes only candidates away from the LP's undecided part") {
-  // The LP of the test above: a = 0.8 with a' = c = 0.2 next to it, b1 = b2 = 1 with b1' = b2' =
+  // cycle_behind_a_fixing: a = 0.8 with a' = c = 0.2 next to it, b1 = b2 = 1 with b1' = b2' =
   // 0. Where every round counts as big (greedy_above 0), round 1 fixes b1 and b2 but not a (its
   // row holds a', undecided), so the LP after it is feasible; with the margin off it fixes all
   // three and the next LP is not.
   const int n = 14;
-  std::vector<std::vector<int>> rows(10, std::vector<int>(n, 0));
-  rows[0][0] = rows[0][1] = 1;
-  rows[1][1] = 1;
-  rows[1][2] = -1;
-  for (int i = 0; i < 5; ++i) rows[2 + i][3 + i] = rows[2 + i][3 + (i + 1) % 5] = rows[2 + i][2] = 1;
-  for (int j = 3; j <= 9; ++j) rows[7][j] = 1;
-  rows[8][10] = rows[8][11] = 1;
-  rows[9][12] = rows[9][13] = 1;
-  std::vector<double> cost(n, 0.0);
-  cost[1] = cost[11] = cost[13] = 10.0;
-  const LpProblem lp = test::dense_lp(rows, {1, 0, 1, 1, 1, 1, 1, 2, 1, 1}, cost);
+  std::vector<double> cost;
+  const LpProblem lp = cycle_behind_a_fixing(cost);
   const Mesh sphere = shapes::icosphere(1);
   const auto id = identity_matching(sphere);
   const ProductSpace space = ProductSpace::from_list(sphere, sphere, {id.begin(), id.begin() + n});
