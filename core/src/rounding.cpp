@@ -661,8 +661,8 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
     if (r.status == LpStatus::Diverging)  // only asked for in round 1 (above)
       throw InfeasibleError("rounding: the matching LP is probably infeasible (PDHG diverging)",
                             certificate_rows(r.y, red.rows), false);
-    // A later round at its cap whose certified bound lies well above its own objective behaves like an
-    // infeasible LP (its dual grows along a Farkas ray; the proof takes longer than the cap).
+    // A later round at its cap whose certified bound lies well above its own objective behaves
+    // like an infeasible LP (its dual grows along a Farkas ray; the proof takes longer than the cap).
     // Fixing from such an iterate made every LP after it infeasible (full resolution: 60 rounds
     // of undoing), so it is undone like one, its growing dual naming the rows to blame. Far above:
     // those LPs' bounds were 3-60x their objectives; at 5 % above, feasible LPs that had not
