@@ -33,7 +33,8 @@ struct RoundingOptions {
   // bound is the first LP's, and every fixing is checked by propagation and, at the end, A x = b
   // exactly. Measured on FAUST_r 020-024 at full resolution: the first LP converged in 12 160
   // iterations, round 2's (a few million variables) sat at residual 2e-4 with its bound rising
-  // past its objective for 39 000 iterations (20 minutes) without an answer. 0: no limit.
+  // past its objective for 39 000 iterations (20 minutes) without an answer. 0: no limit. A
+  // capped LP whose certified bound is over 50 % above its objective is undone as infeasible.
   double later_round_iterations = 2.0;
   int64_t later_round_min_iterations = 2000;
   // Where the candidates of a round clash (propagation refutes fixing them all), a round whose LP
@@ -46,7 +47,10 @@ struct RoundingOptions {
   int64_t greedy_above = 2'000'000;
   // A greedy round fixes only candidates away from the LP's undecided part: none of their rows
   // holds a free variable valued in (greedy_unsure, 1 − greedy_unsure), nor lies within
-  // greedy_margin − 1 closedness steps of one (0: fix every candidate).
+  // greedy_margin − 1 closedness steps of one (0: fix every candidate). Where under a quarter of
+  // the batch qualifies, only values in (0.3, 0.7) count; where none does then, the whole batch.
+  // Measured at full resolution: without it the LPs after greedy rounds were infeasible round
+  // after round; with it, none of rounds 2-5 (docs/results.md, seventh session).
   double greedy_unsure = 0.1;
   int greedy_margin = 1;
   int max_backtracks = 200;    // fixings undone after an infeasible LP (each one more, smaller LP
