@@ -232,8 +232,8 @@ LpProblem cycle_behind_a_fixing(std::vector<double>& cost) {
 
 TEST_CASE("rounding: an infeasible LP after a fixing undoes only the fixings its proof blames") {
   // The LP cycle_behind_a_fixing has a' = c = 1/5 (y = 2/5, the sum at its cap 2) and b = 1, so
-  // round 1 fixes b1, b2 and a = 0.8. With a = 1 the cycle needs y = 1/2, a sum of 5/2: infeasible, but no row alone says
-  // so, so only the next LP can. Its proof lies on the cycle, two rows away from a (a -> a' -> c,
+  // round 1 fixes b1, b2 and a = 0.8. With a = 1 the cycle needs y = 1/2, a sum of 5/2:
+  // infeasible, but no row alone says so, so only the next LP can. Its proof lies on the cycle, two rows away from a (a -> a' -> c,
   // by propagation) and away from b1 and b2: they stay fixed, where halving the batch would
   // have kept b1 alone.
   const int n = 14;

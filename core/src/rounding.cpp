@@ -662,8 +662,8 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
       throw InfeasibleError("rounding: the matching LP is probably infeasible (PDHG diverging)",
                             certificate_rows(r.y, red.rows), false);
     // A later round at its cap whose certified bound lies well above its own objective behaves
-    // like an infeasible LP (its dual grows along a Farkas ray; the proof takes longer than the cap).
-    // Fixing from such an iterate made every LP after it infeasible (full resolution: 60 rounds
+    // like an infeasible LP (its dual grows along a Farkas ray; the proof takes longer than the
+    // cap). Fixing from such an iterate made every LP after it infeasible (full resolution: 60 rounds
     // of undoing), so it is undone like one, its growing dual naming the rows to blame. Far above:
     // those LPs' bounds were 3-60x their objectives; at 5 % above, feasible LPs that had not
     // converged by the cap (bound 5.34, objective 5.01) were undone round after round.
@@ -671,7 +671,8 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
                          r.lower_bound > r.objective + 0.5 * (1.0 + std::abs(r.objective));
     if (r.status == LpStatus::Infeasible || suspect) {
       // The last fixing left an infeasible LP that propagation could not see: undo it, fix less.
-      if (suspect) spdlog::debug("round {}: LP at its cap with its bound above its objective: undone as infeasible", round);
+      if (suspect)
+        spdlog::debug("round {}: LP at its cap with its bound far above its objective: undone as infeasible", round);
       if (history.empty())
         throw InfeasibleError("rounding: the matching LP is infeasible", certificate_rows(r.y, red.rows));
       info.undone = true;
