@@ -33,6 +33,7 @@ struct MatchArgs {
   double later_round_iterations = RoundingOptions{}.later_round_iterations;
   double fractional_batch = RoundingOptions{}.fractional_batch;
   bool close_pockets = RoundingOptions{}.close_pockets;
+  bool whole_lp = !RoundingOptions{}.split_parts;
   int64_t greedy_above = RoundingOptions{}.greedy_above;
   int greedy_margin = RoundingOptions{}.greedy_margin;
   double tolerance = 1e-4;
@@ -113,6 +114,7 @@ int run_match(const MatchArgs& args) {
   ro.later_round_iterations = args.later_round_iterations;
   ro.fractional_batch = args.fractional_batch;
   ro.close_pockets = args.close_pockets;
+  ro.split_parts = !args.whole_lp;
   ro.greedy_above = args.greedy_above;
   ro.greedy_margin = args.greedy_margin;
   ro.lp.tolerance = args.tolerance;
@@ -126,10 +128,11 @@ int run_match(const MatchArgs& args) {
 
   stage.reset();
   const CoarseToFineResult c2f = matcher.run([&](const LevelReport& level, const RoundingRound& r) {
-    spdlog::info("{}round {:>2}: {:>9} variables, LP {} in {} it, objective {:.6g}, fixed {} to 1 and {} to 0{} ({:.2f} s)",
+    spdlog::info("{}round {:>2}: {:>9} variables{}, LP {} in {} it, objective {:.6g}, fixed {} to 1 and {} to 0{} ({:.2f} s)",
                  matcher.x_levels().size() > 1 ? fmt::format("level {} ", level.level + 1) : std::string(), r.round,
-                 r.variables, to_string(r.status), r.iterations, r.objective, r.fixed_to_one, r.fixed_to_zero,
-                 r.undone ? " (undone: fixed fewer)" : "", r.seconds);
+                 r.variables, r.parts > 1 ? fmt::format(" in {} parts", r.parts) : std::string(), to_string(r.status),
+                 r.iterations, r.objective, r.fixed_to_one, r.fixed_to_zero, r.undone ? " (undone: fixed fewer)" : "",
+                 r.seconds);
   });
   const MatchingLp& m = c2f.finest;
   const RoundingResult& rr = c2f.rounding;
@@ -203,6 +206,8 @@ int run_match(const MatchArgs& args) {
                       .set("fixed_to_one", r.fixed_to_one)
                       .set("fixed_to_zero", r.fixed_to_zero)
                       .set("undone", r.undone)
+                      .set("parts", r.parts)
+                      .set("exact_parts", r.exact_parts)
                       .set("seconds", r.seconds));
     Json report = Json::object();
     auto shape = [](const std::string& file, int input_vertices, const Mesh& mesh) {
@@ -250,6 +255,7 @@ int run_match(const MatchArgs& args) {
                               .set("close_pockets", args.close_pockets)
                               .set("greedy_above", args.greedy_above)
                               .set("greedy_margin", args.greedy_margin)
+                              .set("split_parts", !args.whole_lp)
                               .set("tolerance", args.tolerance)
                               .set("coarse_tolerance", co.coarse_tolerance)
                               .set("faces", args.pair.faces)
@@ -339,6 +345,8 @@ Action add_match_command(CLI::App& app) {
                  "or within this many - 1 closedness steps of them; 0: every candidate")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
+  app.add_flag("--whole-lp", a->whole_lp,
+               "solve each rounding LP after the first as one, not as its independent parts (small parts exactly)");
   app.add_option("--tol", a->tolerance, "LP tolerance")->capture_default_str();
   app.add_option("--coarse-tol", a->coarse_tolerance, "LP tolerance of the levels below the finest (0: --tol)")
       ->check(CLI::Range(0.0, 0.5))

@@ -34,6 +34,18 @@ TEST_CASE("clp: tiny LPs with known optima and an infeasible one") {
   }
 }
 
+TEST_CASE("clp: the dual simplex names the rows of an infeasible LP that clash") {
+  // Row 0 (x0 + x1 = 3) is impossible in the box; rows 1 and 2 are fine on their own.
+  const LpResult r = solve_lp(dense_lp({{1, 1, 0, 0}, {0, 0, 1, 1}, {0, 0, 1, -1}}, {3, 1, 0}, {1, 1, 1, 2}),
+                              "clp-dual");
+  REQUIRE(r.status == LpStatus::Infeasible);
+  REQUIRE(r.y.size() == 3);
+  MESSAGE("ray " << r.y[0] << " " << r.y[1] << " " << r.y[2]);
+  CHECK(std::abs(r.y[0]) > 0.0);
+  CHECK(std::abs(r.y[1]) < 1e-12 * std::abs(r.y[0]));
+  CHECK(std::abs(r.y[2]) < 1e-12 * std::abs(r.y[0]));
+}
+
 TEST_CASE("clp: a mesh against itself has LP optimum 0; a deformed copy a positive one") {
   const Mesh x = shapes::octahedron();
   const Mesh y = test::deformed(x, [](const Eigen::Vector3d& p) {

@@ -100,6 +100,33 @@ TEST_CASE("rounding: later rounds stop at their iteration cap and still end exac
   CHECK(longest > 16);
 }
 
+TEST_CASE("rounding: a later LP solved in its independent parts has the optimum of the whole") {
+  // Threshold 0 on the dolphins at 60 faces: many rounds, and late ones leave separate patches.
+  // Every round after the first on Clp, so both runs agree exactly up to the first round solved
+  // in parts, whose joined optimum must then be the whole LP's.
+  const Mesh x = decimate(shapes::dolphin(0, 5), 60), y = decimate(shapes::dolphin(-40, 45), 60);
+  const MatchingLp m = build_matching_lp(x, compute_geometry(x), y, compute_geometry(y));
+  RoundingOptions o;
+  o.solver = "pdhg-cpu";
+  o.exact_below = m.lp.cols() + 1;
+  o.threshold = 0.0;
+  const RoundingResult split = round_to_graph_surface(m.space, m.lp, m.energy, o);
+  o.split_parts = false;
+  const RoundingResult whole = round_to_graph_surface(m.space, m.lp, m.energy, o);
+  size_t k = 0;
+  while (k < split.rounds.size() && split.rounds[k].parts == 1) ++k;
+  REQUIRE(k < split.rounds.size());
+  REQUIRE(k < whole.rounds.size());
+  MESSAGE("round ", k + 1, ": ", split.rounds[k].variables, " variables in ", split.rounds[k].parts, " parts");
+  CHECK(whole.rounds[k].parts == 1);
+  CHECK(whole.rounds[k].variables == split.rounds[k].variables);
+  CHECK(split.rounds[k].objective == doctest::Approx(whole.rounds[k].objective).epsilon(1e-9));
+  for (const RoundingResult* r : {&split, &whole}) {
+    CHECK(satisfies_exactly(m.lp, r->gamma));
+    CHECK(check_graph_surface(m.space, r->gamma).ok());
+  }
+}
+
 TEST_CASE("rounding: limits end in an error, never a wrong answer") {
   const Mesh x = shapes::tetrahedron();
   const Mesh y = test::deformed(x, [](const Eigen::Vector3d& p) { return Eigen::Vector3d(p.x(), 2 * p.y(), p.z()); });

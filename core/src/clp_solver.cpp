@@ -63,7 +63,13 @@ LpResult ClpSolver::solve(const LpProblem& problem, const SolverParams& params) 
       break;
     default: r.status = LpStatus::NumericalTrouble; break;
   }
-  if (r.status != LpStatus::Infeasible) {
+  if (r.status == LpStatus::Infeasible) {
+    // Clp's Farkas ray where it kept one (callers use it to tell which rows clash; sign is Clp's).
+    if (double* ray = model.infeasibilityRay()) {
+      r.y.assign(ray, ray + problem.rows());
+      delete[] ray;
+    }
+  } else {
     const double* x = model.primalColumnSolution();
     const double* y = model.dualRowSolution();
     r.x.assign(x, x + problem.cols());

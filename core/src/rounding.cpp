@@ -194,6 +194,172 @@ Reduced reduce(const LpProblem& full, const FixState& s) {
   return r;
 }
 
+// The independent parts of an LP: its connected components, two rows joined where a column has
+// entries in both, each with its columns and rows (increasing) and its own LP. Late in rounding
+// the open faces form separate patches, and one whole LP makes every patch wait for the slowest:
+// a first-order solve runs to its cap wherever one patch is infeasible or ill-conditioned, and
+// its iterate is then rounded everywhere.
+struct Part {
+  LpProblem lp;
+  std::vector<int64_t> cols, rows;  // in the split LP's numbering
+};
+
+// Empty where the LP is a single part.
+std::vector<Part> split_into_parts(const LpProblem& lp) {
+  const int64_t m = lp.rows(), n = lp.cols();
+  std::vector<int64_t> parent(m);
+  std::iota(parent.begin(), parent.end(), 0);
+  const auto find = [&](int64_t i) {
+    while (parent[i] != i) i = parent[i] = parent[parent[i]];
+    return i;
+  };
+  for (int64_t j = 0; j < n; ++j) {
+    const uint32_t begin = lp.at.row_ptr[j], end = lp.at.row_ptr[j + 1];
+    for (uint32_t k = begin + 1; k < end; ++k) {
+      const int64_t p = find(col_of(lp.at.entry[begin])), q = find(col_of(lp.at.entry[k]));
+      if (p != q) parent[std::max(p, q)] = std::min(p, q);
+    }
+  }
+  std::vector<int64_t> part_of(m, -1), local(m);
+  std::vector<Part> parts;
+  int64_t roots = 0;
+  for (int64_t i = 0; i < m; ++i) roots += find(i) == i;
+  if (roots <= 1) return parts;  // one part: the LP itself
+  for (int64_t i = 0; i < m; ++i) {
+    const int64_t root = find(i);
+    if (part_of[root] < 0) {
+      part_of[root] = static_cast<int64_t>(parts.size());
+      parts.emplace_back();
+    }
+    Part& part = parts[part_of[root]];
+    local[i] = static_cast<int64_t>(part.rows.size());
+    part.rows.push_back(i);
+  }
+  for (int64_t j = 0; j < n; ++j)  // a column without rows would be free of every constraint
+    if (lp.at.row_ptr[j + 1] > lp.at.row_ptr[j])
+      parts[part_of[find(col_of(lp.at.entry[lp.at.row_ptr[j]]))]].cols.push_back(j);
+  for (Part& part : parts) {
+    SignedCsr& at = part.lp.at;
+    at.rows = static_cast<int64_t>(part.cols.size());
+    at.cols = static_cast<int64_t>(part.rows.size());
+    at.row_ptr.assign(1, 0);
+    for (int64_t j : part.cols) {
+      for (uint32_t k = lp.at.row_ptr[j]; k < lp.at.row_ptr[j + 1]; ++k) {
+        const uint32_t e = lp.at.entry[k];
+        at.entry.push_back(static_cast<uint32_t>(local[col_of(e)]) | (e & SignedCsr::kNegative));
+      }
+      at.row_ptr.push_back(static_cast<uint32_t>(at.entry.size()));
+    }
+    part.lp.a = transpose(at);
+    part.lp.b.resize(part.rows.size());
+    for (size_t i = 0; i < part.rows.size(); ++i) part.lp.b[i] = lp.b[part.rows[i]];
+    part.lp.c.resize(part.cols.size());
+    for (size_t j = 0; j < part.cols.size(); ++j) part.lp.c[j] = lp.c[part.cols[j]];
+    part.lp.objective_scale = lp.objective_scale;
+  }
+  return parts;
+}
+
+// A later round's LP solved part by part: parts with fewer than `exact_below` columns by the exact
+// solver, the others by `solver` from the warm start in `params` (given for the whole LP), and the
+// results joined. The joined status is Infeasible where a part is, the iteration limit where a
+// part stopped there; `proof` holds the duals of the parts that are infeasible, or (where none
+// is) that behave like it at their cap (`suspect`: certified bound far above the objective),
+// zero elsewhere, so that the blame stays with them.
+struct JoinedSolve {
+  LpResult r;
+  std::vector<double> proof;
+  bool suspect = false;
+  int64_t parts = 1, exact_parts = 0;
+};
+
+bool looks_infeasible(const LpResult& r) {
+  // Far above: those LPs' bounds were 3-60x their objectives; at 5 % above, feasible LPs that had
+  // not converged by the cap (bound 5.34, objective 5.01) were undone round after round.
+  return r.status == LpStatus::IterationLimit && r.lower_bound > r.objective + 0.5 * (1.0 + std::abs(r.objective));
+}
+
+JoinedSolve solve_in_parts(const LpProblem& lp, const SolverParams& params, LpSolver& solver, LpSolver* exact,
+                           int64_t exact_below, const SolverParams& exact_params, bool split) {
+  JoinedSolve out;
+  std::vector<Part> parts;
+  if (split) parts = split_into_parts(lp);
+  const bool whole = parts.empty();
+  if (whole) {  // the LP itself, numbered as it is
+    parts.resize(1);
+    parts[0].cols.resize(lp.cols());
+    parts[0].rows.resize(lp.rows());
+    std::iota(parts[0].cols.begin(), parts[0].cols.end(), 0);
+    std::iota(parts[0].rows.begin(), parts[0].rows.end(), 0);
+  }
+  out.parts = static_cast<int64_t>(parts.size());
+  LpResult& r = out.r;
+  r.status = LpStatus::Optimal;
+  r.objective = 0.0;
+  r.lower_bound = 0.0;
+  r.x.assign(lp.cols(), 0.0);
+  r.y.assign(lp.rows(), 0.0);
+  out.proof.assign(lp.rows(), 0.0);
+  std::vector<double> suspect_proof(lp.rows(), 0.0);
+  bool infeasible = false;
+  int64_t exactly = 0, largest = 0;
+  for (const Part& part : parts) {
+    const LpProblem& plp = whole ? lp : part.lp;
+    largest = std::max<int64_t>(largest, plp.cols());
+    const bool use_exact = exact && plp.cols() < exact_below;
+    SolverParams p = use_exact ? exact_params : params;
+    if (!whole) {
+      p.initial_x.clear();
+      p.initial_y.clear();
+      if (!use_exact && !params.initial_x.empty()) {
+        for (int64_t j : part.cols) p.initial_x.push_back(params.initial_x[j]);
+        for (int64_t i : part.rows) p.initial_y.push_back(params.initial_y[i]);
+      }
+    }
+    exactly += use_exact;
+    const LpResult s = (use_exact ? *exact : solver).solve(plp, p);
+    r.iterations = std::max(r.iterations, s.iterations);
+    if (s.status == LpStatus::NumericalTrouble) {
+      r.status = s.status;
+      return out;
+    }
+    if (s.status == LpStatus::Infeasible) {
+      infeasible = true;
+      for (size_t i = 0; i < part.rows.size() && i < s.y.size(); ++i) out.proof[part.rows[i]] = s.y[i];
+      if (s.y.empty())  // no ray (Clp): the whole part is the proof
+        for (int64_t i : part.rows) out.proof[i] = 1.0;
+      continue;
+    }
+    if (s.x.size() != part.cols.size()) {
+      r.status = LpStatus::NumericalTrouble;
+      return out;
+    }
+    if (s.status != LpStatus::Optimal && r.status == LpStatus::Optimal) r.status = s.status;
+    if (looks_infeasible(s)) {
+      out.suspect = true;
+      for (size_t i = 0; i < part.rows.size(); ++i) suspect_proof[part.rows[i]] = s.y[i];
+    }
+    for (size_t j = 0; j < part.cols.size(); ++j) r.x[part.cols[j]] = s.x[j];
+    for (size_t i = 0; i < part.rows.size() && i < s.y.size(); ++i) r.y[part.rows[i]] = s.y[i];
+    r.objective += s.objective;
+    r.lower_bound += s.lower_bound;
+  }
+  out.exact_parts = exactly;
+  if (parts.size() > 1)
+    spdlog::debug("LP in {} independent parts, largest {} variables, {} solved exactly", parts.size(), largest,
+                  exactly);
+  if (infeasible) {
+    r.status = LpStatus::Infeasible;
+    r.objective = std::numeric_limits<double>::quiet_NaN();
+    out.suspect = false;
+  } else if (out.suspect) {
+    out.proof = std::move(suspect_proof);
+  } else {
+    out.proof.clear();
+  }
+  return out;
+}
+
 // Fixes the batch (largest first); a fixing that propagation proves infeasible is undone and
 // replaced by fixing fewer: with `greedy`, every candidate that does not clash with the larger
 // ones fixed before it (one propagation each); otherwise halving the batch down to the single
@@ -636,21 +802,33 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
       for (size_t i = 0; i < red.rows.size(); ++i) params.initial_y[i] = y_full[red.rows[i]];
     }
     // (Not the first round: its relaxation and bound are the chosen solver's.)
-    const bool exact = round > 1 && red.lp.cols() < options.exact_below && options.solver != "clp-dual";
+    const bool exact = round > 1 && options.exact_below > 0 && options.solver != "clp-dual";
     if (exact && !exact_solver) exact_solver = make_solver("clp-dual");
-    // A cap for the first-order solver only: simplex iterations are another unit.
-    if (round > 1 && !exact && options.later_round_iterations > 0 && options.solver.rfind("pdhg", 0) == 0)
+    const SolverParams exact_params = options.lp;
+    // A cap for the first-order solver only (simplex iterations are another unit); the exact
+    // solver gets the parts below exact_below without it.
+    if (round > 1 && options.later_round_iterations > 0 && options.solver.rfind("pdhg", 0) == 0)
       params.max_iterations = std::min<int64_t>(
           params.max_iterations,
           std::max<int64_t>(options.later_round_min_iterations,
                             static_cast<int64_t>(options.later_round_iterations * double(result.first_lp.iterations))));
-    const LpResult r = (exact ? exact_solver : solver)->solve(red.lp, params);
+    JoinedSolve joined;
+    if (round == 1) {
+      joined.r = solver->solve(red.lp, params);
+      if (joined.r.status == LpStatus::Infeasible) joined.proof = joined.r.y;
+    } else {
+      joined = solve_in_parts(red.lp, params, *solver, exact ? exact_solver.get() : nullptr, options.exact_below,
+                              exact_params, options.split_parts);
+    }
+    const LpResult& r = joined.r;
     RoundingRound info;
     info.round = round;
     info.variables = red.lp.cols();
     info.constraints = red.lp.rows();
     info.status = r.status;
     info.iterations = r.iterations;
+    info.parts = joined.parts;
+    info.exact_parts = joined.exact_parts;
     info.objective = r.objective + lp.objective_scale * red.fixed_cost;
     if (round == 1) {  // in the units of the full LP: add what propagation fixed to 1 before it
       result.first_lp = r;
@@ -661,22 +839,20 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
     if (r.status == LpStatus::Diverging)  // only asked for in round 1 (above)
       throw InfeasibleError("rounding: the matching LP is probably infeasible (PDHG diverging)",
                             certificate_rows(r.y, red.rows), false);
-    // A later round at its cap whose certified bound lies well above its own objective behaves
-    // like an infeasible LP (its dual grows along a Farkas ray; the proof takes longer than the
-    // cap). Fixing from such an iterate made every LP after it infeasible (full resolution: 60 rounds
-    // of undoing), so it is undone like one, its growing dual naming the rows to blame. Far above:
-    // those LPs' bounds were 3-60x their objectives; at 5 % above, feasible LPs that had not
-    // converged by the cap (bound 5.34, objective 5.01) were undone round after round.
-    const bool suspect = round > 1 && r.status == LpStatus::IterationLimit && !history.empty() &&
-                         r.lower_bound > r.objective + 0.5 * (1.0 + std::abs(r.objective));
+    // A later round (or part of one) at its cap whose certified bound lies well above its own
+    // objective behaves like an infeasible LP (its dual grows along a Farkas ray; the proof takes
+    // longer than the cap). Fixing from such an iterate made every LP after it infeasible (full
+    // resolution: 60 rounds of undoing), so it is undone like one, its growing dual naming the
+    // rows to blame.
+    const bool suspect = joined.suspect && !history.empty();
     if (r.status == LpStatus::Infeasible || suspect) {
       // The last fixing left an infeasible LP that propagation could not see: undo it, fix less.
       if (suspect)
         spdlog::debug("round {}: LP at its cap with its bound far above its objective: undone as infeasible", round);
       if (history.empty())
-        throw InfeasibleError("rounding: the matching LP is infeasible", certificate_rows(r.y, red.rows));
+        throw InfeasibleError("rounding: the matching LP is infeasible", certificate_rows(joined.proof, red.rows));
       info.undone = true;
-      backtrack(certificate_rows(r.y, red.rows));
+      backtrack(certificate_rows(joined.proof, red.rows));
       info.fixed_to_one = fixer.state().ones - history.back().ones;
       info.fixed_to_zero = fixer.state().zeros - history.back().zeros;
       info.seconds = clock.seconds();

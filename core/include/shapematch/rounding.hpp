@@ -53,6 +53,12 @@ struct RoundingOptions {
   // after round; with it, none of rounds 2-5 (docs/results.md, seventh session).
   double greedy_unsure = 0.1;
   int greedy_margin = 1;
+  // Rounds after the first solve each connected component of their LP (rows joined through a
+  // shared column) on its own: the parts below exact_below exactly, the others with the
+  // first-order solver and their own cap, and an infeasible part's proof blames only the
+  // fixings around it. Late in rounding the open faces form separate patches; as one LP, every
+  // patch waited for the slowest and was rounded from its unconverged iterate.
+  bool split_parts = true;
   int max_backtracks = 200;    // fixings undone after an infeasible LP (each one more, smaller LP
                                // solve), then fail with InfeasibleError naming the open rows
   std::string solver = "pdhg-cpu";
@@ -67,6 +73,8 @@ struct RoundingRound {
   int64_t fixed_to_zero = 0;   // forced to 0 by propagation
   LpStatus status = LpStatus::Optimal;
   int64_t iterations = 0;
+  int64_t parts = 1;           // independent parts its LP was solved in (split_parts)
+  int64_t exact_parts = 0;     // of those, solved by the exact solver
   double objective = 0.0;      // of this round's LP, including the fixed part
   double seconds = 0.0;
   bool undone = false;         // the fixing made the LP infeasible and was replaced by a smaller one
