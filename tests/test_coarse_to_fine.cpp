@@ -8,6 +8,7 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <map>
 #include <set>
 
 using namespace shapematch;
@@ -295,6 +296,72 @@ TEST_CASE("coarse to fine: an infeasible reduced LP is widened near the proof, n
     variables[local ? 0 : 1] = l.variables;
   }
   CHECK(variables[0] < variables[1]);
+}
+
+TEST_CASE("coarse to fine: an iterate carried to a wider space keeps its values by identity and starts near the optimum") {
+  // The finger pair's two levels; the fine LP over ring 1 solved, its iterate carried to the LP
+  // of a space widened on some faces.
+  const Mesh xf = decimate(shapes::bent_finger(10, 8, 8), 320), yf = decimate(shapes::bent_finger(60, 8, 8), 320);
+  const MeshHierarchy hx = build_hierarchy(xf, {40, 320}), hy = build_hierarchy(yf, {40, 320});
+  const Mesh& xc = hx.levels[0].mesh;
+  const Mesh& yc = hy.levels[0].mesh;
+  const Mesh& x = hx.levels[1].mesh;
+  const Mesh& y = hy.levels[1].mesh;
+  const MatchingLp coarse = build_matching_lp(xc, compute_geometry(xc), yc, compute_geometry(yc));
+  const RoundingResult cr = round_to_graph_surface(coarse.space, coarse.lp, coarse.energy);
+  std::vector<ProductTriangle> gamma;
+  for (int64_t j : cr.gamma) gamma.push_back(coarse.space[j]);
+  const Geometry gx = compute_geometry(x), gy = compute_geometry(y);  // the model refers to them
+  const EnergyModel model(x, gx, y, gy);
+  auto lp_at = [&](const std::vector<int>& extra) {
+    return build_matching_lp(ProductSpace::from_list(x, y, reduced_product_space(hx.levels[1], hy.levels[1], xc, yc,
+                                                                                 gamma, 1, Neighbourhood::Fine, extra)),
+                             model);
+  };
+  // As a local widening does: one more ring on a few faces (every tenth).
+  std::vector<int> extra(x.num_faces(), 0);
+  for (int f = 0; f < x.num_faces(); f += 10) extra[f] = 1;
+  const MatchingLp narrow = lp_at({}), wide = lp_at(extra);
+  REQUIRE(narrow.lp.cols() < wide.lp.cols());
+  SolverParams params;
+  params.tolerance = 1e-4;
+  const LpResult a = solve_lp(narrow.lp, "pdhg-cpu", params);
+  REQUIRE(a.status == LpStatus::Optimal);
+  CarriedIterate carried;
+  CHECK(carried.empty());
+  carried.keep(narrow, a.x, a.y);
+  CHECK(!carried.empty());
+  SolverParams warm = params;
+  carried.apply(wide, warm);
+  REQUIRE(warm.initial_x.size() == size_t(wide.lp.cols()));
+  REQUIRE(warm.initial_y.size() == size_t(wide.lp.rows()));
+  // Every variable by identity: the narrow space's values where it has them, 0 elsewhere.
+  std::map<std::array<int, 6>, double> value;
+  for (int64_t j = 0; j < narrow.lp.cols(); ++j) {
+    const ProductTriangle t = narrow.space[j];
+    value[{t.a[0], t.a[1], t.a[2], t.b[0], t.b[1], t.b[2]}] = a.x[j];
+  }
+  int64_t found = 0;
+  for (int64_t j = 0; j < wide.lp.cols(); ++j) {
+    const ProductTriangle t = wide.space[j];
+    const auto it = value.find({t.a[0], t.a[1], t.a[2], t.b[0], t.b[1], t.b[2]});
+    const double expected = it == value.end() || it->second <= 1e-9 ? 0.0 : it->second;
+    found += it != value.end();
+    CHECK(warm.initial_x[j] == expected);
+  }
+  CHECK(found == narrow.lp.cols());
+  // A face's row keeps its dual, in the wide LP's cost scale.
+  const double ratio = narrow.lp.objective_scale / wide.lp.objective_scale;
+  for (int64_t f = 0; f < x.num_faces() + y.num_faces(); ++f)
+    CHECK(warm.initial_y[wide.closedness_rows + f] == doctest::Approx(ratio * a.y[narrow.closedness_rows + f]));
+  // From there the wide LP converges in fewer iterations than from zero, to the same optimum.
+  const LpResult cold = solve_lp(wide.lp, "pdhg-cpu", params);
+  const LpResult hot = solve_lp(wide.lp, "pdhg-cpu", warm);
+  REQUIRE(cold.status == LpStatus::Optimal);
+  REQUIRE(hot.status == LpStatus::Optimal);
+  MESSAGE("wide LP ", wide.lp.cols(), " variables: ", cold.iterations, " iterations cold, ", hot.iterations, " warm");
+  CHECK(hot.iterations < cold.iterations);
+  CHECK(hot.objective == doctest::Approx(cold.objective).epsilon(1e-2));
 }
 
 TEST_CASE("coarse to fine: the tolerance below the finest level is its own, looser or tighter") {

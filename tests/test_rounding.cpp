@@ -127,6 +127,40 @@ TEST_CASE("rounding: a later LP solved in its independent parts has the optimum 
   }
 }
 
+TEST_CASE("rounding: round 1 starts from a warm start over the whole LP and hands its iterate out") {
+  const Mesh x = shapes::bent_finger(10, 5, 6), y = shapes::bent_finger(60, 5, 6);
+  const MatchingLp m = build_matching_lp(x, compute_geometry(x), y, compute_geometry(y));
+  RoundingOptions o;
+  o.solver = "pdhg-cpu";
+  std::vector<double> x0, y0;
+  int calls = 0;
+  o.first_iterate = [&](const std::vector<double>& xs, const std::vector<double>& ys) {
+    x0 = xs;
+    y0 = ys;
+    ++calls;
+  };
+  const RoundingResult cold = round_to_graph_surface(m.space, m.lp, m.energy, o);
+  CHECK(calls == 1);
+  REQUIRE(x0.size() == size_t(m.lp.cols()));
+  REQUIRE(y0.size() == size_t(m.lp.rows()));
+  // Over the whole LP: A x ≈ b (the fixed part included).
+  std::vector<double> ax(m.lp.rows(), 0.0);
+  for (int64_t j = 0; j < m.lp.cols(); ++j)
+    for (uint32_t k = m.lp.at.row_ptr[j]; k < m.lp.at.row_ptr[j + 1]; ++k)
+      ax[col_of(m.lp.at.entry[k])] += (is_negative(m.lp.at.entry[k]) ? -1.0 : 1.0) * x0[j];
+  double residual = 0.0;
+  for (int64_t i = 0; i < m.lp.rows(); ++i) residual = std::max(residual, std::abs(ax[i] - m.lp.b[i]));
+  CHECK(residual < 0.05);
+  o.first_iterate = {};
+  o.lp.initial_x = x0;
+  o.lp.initial_y = y0;
+  const RoundingResult warm = round_to_graph_surface(m.space, m.lp, m.energy, o);
+  MESSAGE("round 1: ", cold.first_lp.iterations, " iterations cold, ", warm.first_lp.iterations, " warm");
+  CHECK(warm.first_lp.iterations * 4 < cold.first_lp.iterations);
+  CHECK(satisfies_exactly(m.lp, warm.gamma));
+  CHECK(warm.first_lp.lower_bound == doctest::Approx(cold.first_lp.lower_bound).epsilon(1e-2));
+}
+
 TEST_CASE("rounding: limits end in an error, never a wrong answer") {
   const Mesh x = shapes::tetrahedron();
   const Mesh y = test::deformed(x, [](const Eigen::Vector3d& p) { return Eigen::Vector3d(p.x(), 2 * p.y(), p.z()); });

@@ -19,7 +19,6 @@ void sort_unique(std::vector<int>& v) {
   v.erase(std::unique(v.begin(), v.end()), v.end());
 }
 
-
 // Where a proof of infeasibility lies: the X and Y vertices of every variable in a proof row and
 // of the face of a π row.
 struct ProofPlace {
@@ -341,6 +340,48 @@ CoarseToFineResult CoarseToFineMatcher::run(const Progress& progress) const {
   return result;
 }
 
+void CarriedIterate::keep(const MatchingLp& m, const std::vector<double>& x, const std::vector<double>& y) {
+  if (x.size() != size_t(m.lp.cols()) || y.size() != size_t(m.lp.rows()))
+    throw InvalidInputError("carried iterate: need one value per column and per row");
+  x_.clear();
+  for (int64_t j = 0; j < m.lp.cols(); ++j)  // mostly 0: keep the rest
+    if (x[j] > 1e-9) x_.emplace_back(key(m.space[j]), x[j]);
+  std::sort(x_.begin(), x_.end());
+  row_edge_ = m.row_edge;
+  y_ = y;
+  closedness_rows_ = m.closedness_rows;
+  scale_ = m.lp.objective_scale;
+}
+
+void CarriedIterate::apply(const MatchingLp& m, SolverParams& params) const {
+  if (empty()) return;
+  params.initial_x.assign(m.lp.cols(), 0.0);
+  params.initial_y.assign(m.lp.rows(), 0.0);
+  for (int64_t j = 0; j < m.lp.cols(); ++j) {
+    const uint64_t k = key(m.space[j]);
+    const auto it = std::lower_bound(x_.begin(), x_.end(), std::pair<uint64_t, double>{k, -1.0});
+    if (it != x_.end() && it->first == k) params.initial_x[j] = it->second;
+  }
+  const double ratio = scale_ / m.lp.objective_scale;  // y scales with the costs
+  for (int64_t i = 0; i < m.closedness_rows; ++i) {
+    const auto it = std::lower_bound(row_edge_.begin(), row_edge_.end(), m.row_edge[i]);
+    if (it != row_edge_.end() && *it == m.row_edge[i]) params.initial_y[i] = ratio * y_[it - row_edge_.begin()];
+  }
+  const int64_t faces = m.lp.rows() - m.closedness_rows;  // one row per face, in face order
+  if (static_cast<int64_t>(y_.size()) - closedness_rows_ == faces)
+    for (int64_t i = 0; i < faces; ++i) params.initial_y[m.closedness_rows + i] = ratio * y_[closedness_rows_ + i];
+}
+
+uint64_t CarriedIterate::key(const ProductTriangle& t) {
+  uint64_t h = 0x9e3779b97f4a7c15ull;
+  for (int i = 0; i < 3; ++i)
+    for (int v : {t.a[i], t.b[i]}) {
+      h ^= static_cast<uint64_t>(static_cast<uint32_t>(v)) + 0x9e3779b97f4a7c15ull + (h << 6) + (h >> 2);
+      h *= 0xbf58476d1ce4e5b9ull;
+    }
+  return h ^ (h >> 31);
+}
+
 RoundingOptions CoarseToFineMatcher::rounding_for(int l) const {
   RoundingOptions ro = options_.rounding;
   if (l + 1 < hx_.size() && options_.coarse_tolerance > 0.0) ro.lp.tolerance = options_.coarse_tolerance;
@@ -357,6 +398,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
   int local = 0;
   int ring = options_.ring;
   bool trust_divergence = true;
+  CarriedIterate warm;  // the last attempt's first LP, for the next
   // One more fine ring on these faces (as far as max_ring allows); false if none could grow.
   auto widen_locally = [&](const std::vector<int>& faces, const char* why = "infeasible") {
     if (!options_.local_widening || local >= options_.max_local_widenings) return false;
@@ -417,6 +459,10 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
       // adds variables); the last attempts wait for a proof.
       ro.lp.stop_on_divergence =
           trust_divergence && l > 0 && options_.local_widening && local < options_.max_local_widenings;
+      if (l > 0 && options_.warm_widening) {
+        if (!warm.empty()) warm.apply(m, ro.lp);
+        ro.first_iterate = [&](const std::vector<double>& x, const std::vector<double>& y) { warm.keep(m, x, y); };
+      }
       RoundingResult rr = round_to_graph_surface(m.space, m.lp, m.energy, ro,
                                                  [&](const RoundingRound& r) {
                                                    if (progress) progress(rep, r);

@@ -14,7 +14,7 @@ MatchingLp build_matching_lp(const Mesh& x, const Geometry& gx, const Mesh& y, c
 }
 
 MatchingLp build_matching_lp(ProductSpace space, const EnergyModel& model, bool scale_costs) {
-  MatchingLp out{std::move(space), {}, {}, 0};
+  MatchingLp out{std::move(space), {}, {}, 0, {}};
   ConstraintSystem cs = build_constraints(out.space);
   out.energy = energy_vector(out.space, model);
 
@@ -30,6 +30,7 @@ MatchingLp build_matching_lp(ProductSpace space, const EnergyModel& model, bool 
   for (size_t j = 0; j < out.energy.size(); ++j) out.lp.c[j] = out.energy[j] / scale;
   out.lp.objective_scale = scale;
   out.closedness_rows = cs.closedness_rows;
+  out.row_edge = std::move(cs.row_edge);
   return out;
 }
 

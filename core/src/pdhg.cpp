@@ -239,7 +239,11 @@ LpResult PdhgSolver::solve(const LpProblem& problem, const SolverParams& params)
           dual_obj - s.cx > 0.1 * scale && dual_obj - window_dual > 0.05 * scale) {
         result.status = LpStatus::Diverging;
         result.y.resize(m);
-        for (int64_t i = 0; i < m; ++i) result.y[i] = r[i] * (yh[i] - window_y[i]);
+        result.last_y.resize(m);
+        for (int64_t i = 0; i < m; ++i) {
+          result.y[i] = r[i] * (yh[i] - window_y[i]);
+          result.last_y[i] = r[i] * yh[i];
+        }
         result.x.resize(n);
         for (int64_t j = 0; j < n; ++j) result.x[j] = d[j] * xh[j];
         break;

@@ -800,6 +800,15 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
       params.initial_y.resize(red.rows.size());
       for (size_t j = 0; j < red.cols.size(); ++j) params.initial_x[j] = x_full[red.cols[j]];
       for (size_t i = 0; i < red.rows.size(); ++i) params.initial_y[i] = y_full[red.rows[i]];
+    } else if (options.lp.initial_x.size() == size_t(lp.cols()) && options.lp.initial_y.size() == size_t(lp.rows())) {
+      // A warm start over the whole LP: what propagation left free of it.
+      params.initial_x.resize(red.cols.size());
+      params.initial_y.resize(red.rows.size());
+      for (size_t j = 0; j < red.cols.size(); ++j) params.initial_x[j] = options.lp.initial_x[red.cols[j]];
+      for (size_t i = 0; i < red.rows.size(); ++i) params.initial_y[i] = options.lp.initial_y[red.rows[i]];
+    } else {
+      params.initial_x.clear();
+      params.initial_y.clear();
     }
     // (Not the first round: its relaxation and bound are the chosen solver's.)
     const bool exact = round > 1 && options.exact_below > 0 && options.solver != "clp-dual";
@@ -821,6 +830,20 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
                               exact_params, options.split_parts);
     }
     const LpResult& r = joined.r;
+    if (round == 1 && options.first_iterate && r.x.size() == red.cols.size()) {
+      std::vector<double> x(lp.cols()), y(lp.rows(), 0.0);
+      for (int64_t j = 0; j < lp.cols(); ++j) x[j] = fixer.state().value[j] == 1 ? 1.0 : 0.0;
+      for (size_t j = 0; j < red.cols.size(); ++j) x[red.cols[j]] = r.x[j];
+      const bool diverged = r.status == LpStatus::Diverging;
+      const std::vector<double>& dual = diverged ? r.last_y : r.y;
+      double growth = 0.0;
+      if (diverged)
+        for (double g : r.y) growth = std::max(growth, std::abs(g));
+      if (dual.size() == red.rows.size())
+        for (size_t i = 0; i < red.rows.size(); ++i)
+          if (!diverged || i >= r.y.size() || std::abs(r.y[i]) <= 0.01 * growth) y[red.rows[i]] = dual[i];
+      options.first_iterate(x, y);
+    }
     RoundingRound info;
     info.round = round;
     info.variables = red.lp.cols();

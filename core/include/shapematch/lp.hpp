@@ -64,6 +64,8 @@ struct LpResult {
   double gap = std::numeric_limits<double>::quiet_NaN();  // |objective − bound| / (1 + |objective| + |bound|)
   std::vector<double> x;
   std::vector<double> y;
+  // Diverging only (y holds the dual's growth there): the dual iterate where it stopped.
+  std::vector<double> last_y;
   int64_t iterations = 0;
   double seconds = 0.0;
   // Of `seconds`, the part before the first iteration: scaling, the ‖A‖ estimate, the device's

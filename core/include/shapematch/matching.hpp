@@ -19,6 +19,7 @@ struct MatchingLp {
   LpProblem lp;
   std::vector<double> energy;  // unscaled energy of each variable (lp.c * lp.objective_scale)
   int64_t closedness_rows = 0;
+  std::vector<int64_t> row_edge;  // product-edge id of each closedness row, increasing
 };
 
 // Over the full product space.

@@ -62,7 +62,15 @@ struct RoundingOptions {
   int max_backtracks = 200;    // fixings undone after an infeasible LP (each one more, smaller LP
                                // solve), then fail with InfeasibleError naming the open rows
   std::string solver = "pdhg-cpu";
-  SolverParams lp;             // parameters of every LP solve (warm starts are filled in)
+  // Parameters of every LP solve. Later rounds' warm starts are filled in; a warm start given
+  // here over the whole LP (as many values as it has columns and rows) starts round 1.
+  SolverParams lp;
+  // Called once with round 1's iterate over the whole LP (fixed variables at their values, rows
+  // that propagation emptied at 0), also when rounding then fails: where a diverging LP makes
+  // coarse to fine widen the space, the widened LP starts from it. After divergence, the rows on
+  // which the dual grew (over 1 % of the largest growth) are 0: there it had left for infinity.
+  // Not called after a proven infeasible LP (no iterate).
+  std::function<void(const std::vector<double>& x, const std::vector<double>& y)> first_iterate;
 };
 
 struct RoundingRound {
