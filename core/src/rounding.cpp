@@ -162,6 +162,30 @@ struct Reduced {
   double fixed_cost = 0.0;  // scaled cost of the variables fixed to 1
 };
 
+// The LP over `cols`, each row i of theirs renumbered to row_new[i], with right-hand side `b`
+// (one per new row) and the same costs.
+LpProblem restrict_lp(const LpProblem& full, const std::vector<int64_t>& cols, const std::vector<int64_t>& row_new,
+                      std::vector<double> b) {
+  LpProblem lp;
+  SignedCsr& at = lp.at;
+  at.rows = static_cast<int64_t>(cols.size());
+  at.cols = static_cast<int64_t>(b.size());
+  at.row_ptr.assign(1, 0);
+  for (int64_t j : cols) {
+    for (uint32_t k = full.at.row_ptr[j]; k < full.at.row_ptr[j + 1]; ++k) {
+      const uint32_t e = full.at.entry[k];
+      at.entry.push_back(static_cast<uint32_t>(row_new[col_of(e)]) | (e & SignedCsr::kNegative));
+    }
+    at.row_ptr.push_back(static_cast<uint32_t>(at.entry.size()));
+  }
+  lp.a = transpose(at);
+  lp.b = std::move(b);
+  lp.c.resize(cols.size());
+  for (size_t j = 0; j < cols.size(); ++j) lp.c[j] = full.c[cols[j]];
+  lp.objective_scale = full.objective_scale;
+  return lp;
+}
+
 Reduced reduce(const LpProblem& full, const FixState& s) {
   Reduced r;
   std::vector<int64_t> row_new(full.rows(), -1);
@@ -174,23 +198,9 @@ Reduced reduce(const LpProblem& full, const FixState& s) {
     if (s.value[j] < 0) r.cols.push_back(j);
     else if (s.value[j] == 1) r.fixed_cost += full.c[j];
   }
-  SignedCsr& at = r.lp.at;
-  at.rows = static_cast<int64_t>(r.cols.size());
-  at.cols = static_cast<int64_t>(r.rows.size());
-  at.row_ptr.assign(1, 0);
-  for (int64_t j : r.cols) {
-    for (uint32_t k = full.at.row_ptr[j]; k < full.at.row_ptr[j + 1]; ++k) {
-      const uint32_t e = full.at.entry[k];
-      at.entry.push_back(static_cast<uint32_t>(row_new[col_of(e)]) | (e & SignedCsr::kNegative));
-    }
-    at.row_ptr.push_back(static_cast<uint32_t>(at.entry.size()));
-  }
-  r.lp.a = transpose(at);
-  r.lp.b.resize(r.rows.size());
-  for (size_t i = 0; i < r.rows.size(); ++i) r.lp.b[i] = static_cast<double>(s.rhs[r.rows[i]]);
-  r.lp.c.resize(r.cols.size());
-  for (size_t j = 0; j < r.cols.size(); ++j) r.lp.c[j] = full.c[r.cols[j]];
-  r.lp.objective_scale = full.objective_scale;
+  std::vector<double> b(r.rows.size());
+  for (size_t i = 0; i < r.rows.size(); ++i) b[i] = static_cast<double>(s.rhs[r.rows[i]]);
+  r.lp = restrict_lp(full, r.cols, row_new, std::move(b));
   return r;
 }
 
@@ -239,23 +249,9 @@ std::vector<Part> split_into_parts(const LpProblem& lp) {
     if (lp.at.row_ptr[j + 1] > lp.at.row_ptr[j])
       parts[part_of[find(col_of(lp.at.entry[lp.at.row_ptr[j]]))]].cols.push_back(j);
   for (Part& part : parts) {
-    SignedCsr& at = part.lp.at;
-    at.rows = static_cast<int64_t>(part.cols.size());
-    at.cols = static_cast<int64_t>(part.rows.size());
-    at.row_ptr.assign(1, 0);
-    for (int64_t j : part.cols) {
-      for (uint32_t k = lp.at.row_ptr[j]; k < lp.at.row_ptr[j + 1]; ++k) {
-        const uint32_t e = lp.at.entry[k];
-        at.entry.push_back(static_cast<uint32_t>(local[col_of(e)]) | (e & SignedCsr::kNegative));
-      }
-      at.row_ptr.push_back(static_cast<uint32_t>(at.entry.size()));
-    }
-    part.lp.a = transpose(at);
-    part.lp.b.resize(part.rows.size());
-    for (size_t i = 0; i < part.rows.size(); ++i) part.lp.b[i] = lp.b[part.rows[i]];
-    part.lp.c.resize(part.cols.size());
-    for (size_t j = 0; j < part.cols.size(); ++j) part.lp.c[j] = lp.c[part.cols[j]];
-    part.lp.objective_scale = lp.objective_scale;
+    std::vector<double> b(part.rows.size());
+    for (size_t i = 0; i < part.rows.size(); ++i) b[i] = lp.b[part.rows[i]];
+    part.lp = restrict_lp(lp, part.cols, local, std::move(b));
   }
   return parts;
 }
