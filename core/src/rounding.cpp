@@ -779,6 +779,11 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
       spdlog::debug("rounding: backtracking over an earlier fixing ({} left)", history.size());
     }
   };
+  // Every solve's parameters without the warm start (copied per round: the whole LP's is
+  // millions of values at full resolution).
+  SolverParams base_params = options.lp;
+  base_params.initial_x.clear();
+  base_params.initial_y.clear();
   for (int round = 1, forward = 0; fixer.state().unsatisfied > 0; ++round) {
     // Out of rounds: no binary solution found in this space. An InfeasibleError with the open
     // rows lets coarse to fine widen there rather than give up the whole run.
@@ -788,7 +793,7 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
                             fixer.unsatisfied_rows());
     Stopwatch clock;
     const Reduced red = reduce(lp, fixer.state());
-    SolverParams params = options.lp;
+    SolverParams params = base_params;
     if (round > 1) {
       // After a fixing, an infeasible LP undoes it: that needs a proof, not a suspicion.
       params.stop_on_divergence = false;
@@ -802,14 +807,11 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
       params.initial_y.resize(red.rows.size());
       for (size_t j = 0; j < red.cols.size(); ++j) params.initial_x[j] = options.lp.initial_x[red.cols[j]];
       for (size_t i = 0; i < red.rows.size(); ++i) params.initial_y[i] = options.lp.initial_y[red.rows[i]];
-    } else {
-      params.initial_x.clear();
-      params.initial_y.clear();
     }
     // (Not the first round: its relaxation and bound are the chosen solver's.)
     const bool exact = round > 1 && options.exact_below > 0 && options.solver != "clp-dual";
     if (exact && !exact_solver) exact_solver = make_solver("clp-dual");
-    const SolverParams exact_params = options.lp;
+    const SolverParams& exact_params = base_params;
     // A cap for the first-order solver only (simplex iterations are another unit); the exact
     // solver gets the parts below exact_below without it.
     if (round > 1 && options.later_round_iterations > 0 && options.solver.rfind("pdhg", 0) == 0)
