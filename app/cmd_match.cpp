@@ -47,7 +47,7 @@ struct MatchArgs {
   int widen_margin = CoarseToFineOptions{}.widen_margin;
   int y_margin = CoarseToFineOptions{}.y_margin;
   int max_local_widenings = CoarseToFineOptions{}.max_local_widenings;
-  bool cold_widening = !CoarseToFineOptions{}.warm_widening;
+  bool warm_widening = CoarseToFineOptions{}.warm_widening;
 };
 
 // auto: a GPU if there is one, else the native solver (lavapipe is for testing, not speed).
@@ -107,7 +107,7 @@ int run_match(const MatchArgs& args) {
   co.widen_margin = args.widen_margin;
   co.y_margin = args.y_margin;
   co.max_local_widenings = args.max_local_widenings;
-  co.warm_widening = !args.cold_widening;
+  co.warm_widening = args.warm_widening;
   co.matching = matching_options(args.pair, p);
   RoundingOptions& ro = co.rounding;
   ro.solver = solver_for(args);
@@ -274,7 +274,7 @@ int run_match(const MatchArgs& args) {
                               .set("widen_margin", args.widen_margin)
                               .set("y_margin", args.y_margin)
                               .set("max_local_widenings", args.max_local_widenings)
-                              .set("warm_widening", !args.cold_widening));
+                              .set("warm_widening", args.warm_widening));
     report.set("seconds", seconds);
     report.set("peak_rss_mb", peak_rss_mb());
     report.set("round_log", rounds);
@@ -380,8 +380,9 @@ Action add_match_command(CLI::App& app) {
                  "after an infeasible reduced LP: local (near the proof first, then everywhere) or global")
       ->check(CLI::IsMember({"local", "global"}))
       ->capture_default_str();
-  app.add_flag("--cold-widening", a->cold_widening,
-               "start the LP of a widened space from zero, not from the previous attempt's iterate");
+  app.add_flag("--warm-widening", a->warm_widening,
+               "start the LP of a widened space from the previous attempt's iterate (measured slower after a "
+               "diverging attempt)");
   app.add_option("--max-local-widenings", a->max_local_widenings,
                  "local widenings per level before the ring widens everywhere")
       ->check(CLI::NonNegativeNumber)

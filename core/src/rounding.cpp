@@ -13,6 +13,7 @@
 #include <numeric>
 #include <set>
 #include <unordered_map>
+#include <unordered_set>
 
 namespace shapematch {
 namespace {
@@ -737,6 +738,7 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
     std::vector<std::pair<int64_t, int>> batch;
   };
   std::vector<Step> history;  // the fixings so far, to undo when a later LP is infeasible
+  std::unordered_set<int64_t> refuted;  // fixings to 1 an infeasibility proof blamed, not tried again
   int backtracks = 0;
   // Undoes the last fixing and applies less of it; where nothing of it can go (a single variable
   // that can be neither 1 nor 0), undoes the fixing before it as well, and so on back. Measured:
@@ -763,7 +765,16 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
       fixer.undo_to(step.mark);
       auto smaller = step.batch;
       bool shrinkable = true;
-      if (first && !away_from_proof.empty()) smaller = std::move(away_from_proof);
+      if (first && !away_from_proof.empty()) {
+        // The blamed fixings are not tried again from this state: the next LP is the one before
+        // them, which would put them first again (full resolution: the same two rounds, fix and
+        // undo, for 100 rounds).
+        for (const auto& a : step.batch)
+          if (a.second == 1 &&
+              std::none_of(away_from_proof.begin(), away_from_proof.end(), [&](const auto& k) { return k.first == a.first; }))
+            refuted.insert(a.first);
+        smaller = std::move(away_from_proof);
+      }
       else if (smaller.size() > 1) smaller.resize(smaller.size() / 2);
       else if (smaller.front().second == 1) smaller.front().second = 0;  // the single variable cannot be 1
       else shrinkable = false;
@@ -776,6 +787,7 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
         }
       }
       history.pop_back();
+      refuted.clear();  // an earlier state: what was refuted after it may hold again
       spdlog::debug("rounding: backtracking over an earlier fixing ({} left)", history.size());
     }
   };
@@ -892,6 +904,14 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
     std::vector<int64_t> order(red.cols.size());
     std::iota(order.begin(), order.end(), 0);
     std::sort(order.begin(), order.end(), [&](int64_t p, int64_t q) { return r.x[p] > r.x[q]; });
+    // Refuted fixings are left out while anything else remains.
+    if (!refuted.empty()) {
+      std::vector<int64_t> open;
+      for (int64_t k : order)
+        if (!refuted.count(red.cols[k])) open.push_back(k);
+      if (open.empty() || r.x[open.front()] <= 0.0) refuted.clear();
+      else order = std::move(open);
+    }
     std::vector<std::pair<int64_t, int>> batch;
     for (int64_t k : order) {
       if (r.x[k] <= options.threshold) break;
