@@ -291,7 +291,7 @@ LpProblem cycle_behind_a_fixing(std::vector<double>& cost) {
 
 }  // namespace
 
-TEST_CASE("rounding: an infeasible LP after a fixing undoes only the fixings its proof blames") {
+TEST_CASE("rounding: an infeasible LP after a fixing undoes only the fixings its proof blames, and not to retry them") {
   // The LP cycle_behind_a_fixing has a' = c = 1/5 (y = 2/5, the sum at its cap 2) and b = 1, so
   // round 1 fixes b1, b2 and a = 0.8. With a = 1 the cycle needs y = 1/2, a sum of 5/2:
   // infeasible, but no row alone says so, so only the next LP can. Its proof lies on the cycle, two rows away from a (a -> a' -> c,
@@ -314,6 +314,13 @@ TEST_CASE("rounding: an infeasible LP after a fixing undoes only the fixings its
   CHECK(r.rounds[1].status == LpStatus::Infeasible);
   CHECK(r.rounds[1].undone);
   CHECK(r.rounds[1].fixed_to_one == 2);  // b1 and b2 again; halving: b1 alone
+  // Round 3's LP is round 1's without b: a = 0.8 again. The proof refuted a from this state, so
+  // it is not fixed again (without that: fixed, and round 4's LP infeasible once more).
+  REQUIRE(r.rounds.size() >= 3);
+  CHECK(r.rounds[2].fixed_to_one == 0);
+  int infeasible = 0;
+  for (const auto& k : r.rounds) infeasible += k.status == LpStatus::Infeasible;
+  CHECK(infeasible == 1);
 }
 
 TEST_CASE("rounding: a big round fixes only candidates away from the LP's undecided part") {
