@@ -35,8 +35,6 @@ struct RoundingOptions {
   // iterations, round 2's (a few million variables) sat at residual 2e-4 with its bound rising
   // past its objective for 39 000 iterations (20 minutes) without an answer. 0: no limit. A
   // capped LP whose certified bound is over 50 % above its objective is undone as infeasible.
-  // Solved in parts (split_parts), a round fixes only from the parts that converged while any
-  // of them has a candidate; the capped ones iterate on next round from where they stopped.
   double later_round_iterations = 2.0;
   int64_t later_round_min_iterations = 2000;
   // Where the candidates of a round clash (propagation refutes fixing them all), a round whose LP
