@@ -266,7 +266,6 @@ std::vector<Part> split_into_parts(const LpProblem& lp) {
 struct JoinedSolve {
   LpResult r;
   std::vector<double> proof;
-  std::vector<char> unsettled;  // per column: its part stopped short of optimal (empty: none did)
   bool suspect = false;
   int64_t parts = 1, exact_parts = 0;
 };
@@ -333,10 +332,6 @@ JoinedSolve solve_in_parts(const LpProblem& lp, const SolverParams& params, LpSo
       return out;
     }
     if (s.status != LpStatus::Optimal && r.status == LpStatus::Optimal) r.status = s.status;
-    if (s.status != LpStatus::Optimal) {
-      out.unsettled.resize(lp.cols(), 0);
-      for (int64_t j : part.cols) out.unsettled[j] = 1;
-    }
     if (looks_infeasible(s)) {
       out.suspect = true;
       for (size_t i = 0; i < part.rows.size(); ++i) suspect_proof[part.rows[i]] = s.y[i];
@@ -909,16 +904,6 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
     std::vector<int64_t> order(red.cols.size());
     std::iota(order.begin(), order.end(), 0);
     std::sort(order.begin(), order.end(), [&](int64_t p, int64_t q) { return r.x[p] > r.x[q]; });
-    // Parts whose LP stopped at its cap keep iterating next round (warm-started) rather than fix
-    // from an unconverged iterate, while a settled part has a candidate. Measured, TOSCA_r
-    // horse0-horse5 at full resolution: 3 858 fixings from a capped round-2 LP left round after
-    // round infeasible, each proof blaming 5-46 of them.
-    if (!joined.unsettled.empty()) {
-      std::vector<int64_t> settled;
-      for (int64_t k : order)
-        if (!joined.unsettled[k]) settled.push_back(k);
-      if (!settled.empty() && r.x[settled.front()] > options.threshold) order = std::move(settled);
-    }
     // Refuted fixings are left out while anything else remains.
     if (!refuted.empty()) {
       std::vector<int64_t> open;
