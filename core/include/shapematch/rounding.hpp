@@ -67,7 +67,8 @@ struct RoundingOptions {
   SolverParams lp;
   // Called once with round 1's iterate over the whole LP (fixed variables at their values, rows
   // that propagation emptied at 0), also when rounding then fails: where a diverging LP makes
-  // coarse to fine widen the space, the widened LP starts from it. After divergence, the rows on
+  // coarse to fine widen the space, the widened LP can start from it (warm_widening, off by
+  // default: measured slower). After divergence, the rows on
   // which the dual grew (over 1 % of the largest growth) are 0: there it had left for infinity.
   // Not called after a proven infeasible LP (no iterate).
   std::function<void(const std::vector<double>& x, const std::vector<double>& y)> first_iterate;
