@@ -276,7 +276,7 @@ bool looks_infeasible(const LpResult& r) {
   return r.status == LpStatus::IterationLimit && r.lower_bound > r.objective + 0.5 * (1.0 + std::abs(r.objective));
 }
 
-JoinedSolve solve_in_parts(const LpProblem& lp, const SolverParams& params, LpSolver& solver, LpSolver* exact,
+JoinedSolve solve_in_parts(const LpProblem& lp, SolverParams params, LpSolver& solver, LpSolver* exact,
                            int64_t exact_below, const SolverParams& exact_params, bool split) {
   JoinedSolve out;
   std::vector<Part> parts;
@@ -300,19 +300,28 @@ JoinedSolve solve_in_parts(const LpProblem& lp, const SolverParams& params, LpSo
   std::vector<double> suspect_proof(lp.rows(), 0.0);
   bool infeasible = false;
   int64_t exactly = 0, largest = 0;
+  // A part's parameters: `params` with its own slice of the whole LP's warm start, which is
+  // moved out first so that copying `params` per part does not copy it.
+  std::vector<double> warm_x, warm_y;
+  if (!whole) {
+    warm_x = std::move(params.initial_x);
+    warm_y = std::move(params.initial_y);
+    params.initial_x.clear();
+    params.initial_y.clear();
+  }
   for (const Part& part : parts) {
     const LpProblem& plp = whole ? lp : part.lp;
     largest = std::max<int64_t>(largest, plp.cols());
     const bool use_exact = exact && plp.cols() < exact_below;
-    SolverParams p = use_exact ? exact_params : params;
-    if (!whole) {
-      p.initial_x.clear();
-      p.initial_y.clear();
-      if (!use_exact && !params.initial_x.empty()) {
-        for (int64_t j : part.cols) p.initial_x.push_back(params.initial_x[j]);
-        for (int64_t i : part.rows) p.initial_y.push_back(params.initial_y[i]);
+    SolverParams own;
+    if (!whole && !use_exact) {
+      own = params;
+      if (!warm_x.empty()) {
+        for (int64_t j : part.cols) own.initial_x.push_back(warm_x[j]);
+        for (int64_t i : part.rows) own.initial_y.push_back(warm_y[i]);
       }
     }
+    const SolverParams& p = use_exact ? exact_params : whole ? params : own;
     exactly += use_exact;
     const LpResult s = (use_exact ? *exact : solver).solve(plp, p);
     r.iterations = std::max(r.iterations, s.iterations);
@@ -836,8 +845,8 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
       joined.r = solver->solve(red.lp, params);
       if (joined.r.status == LpStatus::Infeasible) joined.proof = joined.r.y;
     } else {
-      joined = solve_in_parts(red.lp, params, *solver, exact ? exact_solver.get() : nullptr, options.exact_below,
-                              exact_params, options.split_parts);
+      joined = solve_in_parts(red.lp, std::move(params), *solver, exact ? exact_solver.get() : nullptr,
+                              options.exact_below, exact_params, options.split_parts);
     }
     const LpResult& r = joined.r;
     if (round == 1 && options.first_iterate && r.x.size() == red.cols.size()) {
