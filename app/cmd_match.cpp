@@ -290,6 +290,7 @@ int run_match(const MatchArgs& args) {
                       .set("ring", l.ring)
                       .set("widenings", l.widenings)
                       .set("local_widenings", l.local_widenings)
+                      .set("margin_widenings", l.margin_widenings)
                       .set("widened_faces", l.widened_faces)
                       .set("rounds", l.rounds)
                       .set("iterations", l.iterations)

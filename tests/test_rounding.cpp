@@ -323,6 +323,32 @@ TEST_CASE("rounding: an infeasible LP after a fixing undoes only the fixings its
   CHECK(infeasible == 1);
 }
 
+TEST_CASE("rounding: a fixing from an LP at its iteration cap is undone whole, and the LP solved again longer") {
+  // cycle_behind_a_fixing as above, with round 1 stopped at its cap, its iterate already past
+  // the threshold on a, b1 and b2. The proof after it blames a alone, but an iterate at its cap
+  // is not trusted for the rest either: all three fixings go (the rule above would keep b1, b2).
+  const int n = 14;
+  std::vector<double> cost;
+  const LpProblem lp = cycle_behind_a_fixing(cost);
+  const Mesh sphere = shapes::icosphere(1);
+  const auto id = identity_matching(sphere);
+  const ProductSpace space = ProductSpace::from_list(sphere, sphere, {id.begin(), id.begin() + n});
+  RoundingOptions options;
+  options.solver = "pdhg-cpu";
+  options.exact_below = 0;
+  options.lp.max_iterations = 200;
+  options.lp.threads = 1;  // the same iterates on any machine
+  const RoundingResult r = round_to_graph_surface(space, lp, cost, options);
+  CHECK(satisfies_exactly(lp, r.gamma));
+  CHECK(r.energy == 10.0);
+  REQUIRE(r.rounds.size() >= 3);
+  CHECK(r.rounds[0].status == LpStatus::IterationLimit);
+  CHECK(r.rounds[0].fixed_to_one == 3);
+  CHECK(r.rounds[1].status == LpStatus::Infeasible);
+  CHECK(r.rounds[1].undone);
+  CHECK(r.rounds[1].fixed_to_one == 0);  // nothing of round 1's batch is left
+}
+
 TEST_CASE("rounding: a big round fixes only candidates away from the LP's undecided part") {
   // cycle_behind_a_fixing: a = 0.8 with a' = c = 0.2 next to it, b1 = b2 = 1 with b1' = b2' =
   // 0. Where every round counts as big (greedy_above 0), round 1 fixes b1 and b2 but not a (its

@@ -72,14 +72,14 @@ std::vector<int> faces_to_widen(const MatchingLp& m, const ProofPlace& p, int ma
 // Each place costs a propagation pass and a scan of the space; past this many, widen what was
 // found and look again on the widened space.
 constexpr int kMaxConflictPlaces = 256;
+// Where a place's faces are all at max_ring: X faces up to this many rings around it widen too.
+constexpr int kMaxMarginBoost = 3;
 
 // Every place where unit propagation proves a reduced LP infeasible: after each contradiction
 // the rows of every variable over the X faces near it are set aside, so that the next pass finds
-// the next independent one (at most `max_places`). Returns the faces to widen for all of them
-// (empty: propagation finds no contradiction).
-std::vector<int> faces_near_conflicts(const MatchingLp& m, int max_places, int margin, bool carry_y) {
+// the next independent one (at most `max_places`). Adds them all to `place`; returns how many.
+int conflict_places(const MatchingLp& m, int max_places, int margin, ProofPlace& place) {
   const Mesh& X = m.space.x();
-  ProofPlace all(m);
   std::vector<char> skip(m.lp.rows(), 0), set_aside(X.num_vertices(), 0);
   int places = 0;
   for (; places < max_places; ++places) {
@@ -88,7 +88,7 @@ std::vector<int> faces_near_conflicts(const MatchingLp& m, int max_places, int m
     skip[row] = 1;
     ProofPlace here(m);
     here.add(m, row);
-    all.add(m, row);
+    place.add(m, row);
     for (int f : faces_on(X, here.x, 1 + margin))
       for (int v : X.faces[f]) set_aside[v] = 1;
     for (int64_t j = 0; j < m.space.size(); ++j) {
@@ -97,9 +97,8 @@ std::vector<int> faces_near_conflicts(const MatchingLp& m, int max_places, int m
         for (uint32_t k = m.lp.at.row_ptr[j]; k < m.lp.at.row_ptr[j + 1]; ++k) skip[col_of(m.lp.at.entry[k])] = 1;
     }
   }
-  if (places == 0) return {};
-  spdlog::debug("propagation: {} places of infeasibility", places);
-  return faces_to_widen(m, all, margin, carry_y);
+  if (places > 0) spdlog::debug("propagation: {} places of infeasibility", places);
+  return places;
 }
 
 }  // namespace
@@ -417,17 +416,30 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
                  lx.mesh.num_faces());
     return true;
   };
-  // The faces to widen for a proof, from find(carry_y): the X side first, and where the same
-  // faces come back (the X side alone did not help) the Y side too. Also says which it took.
-  auto faces_for = [&](const auto& find) {
-    std::vector<int> faces = find(false);
-    bool carried = false;
-    if (!faces.empty()) {
-      carried = faces == last_widened;
-      last_widened = faces;
-      if (carried) faces = find(true);
-    }
-    return std::pair{std::move(faces), carried};
+  // Widens around a proof (its place): the X faces on it first; where the same faces come back
+  // (the X side alone did not help) also those that map next to its Y side; where every one of
+  // them is at max_ring, the same with a margin of X faces around the place that grows by one
+  // ring each time, up to kMaxMarginBoost (measured, FAUST_r 021-029 at full resolution: two
+  // places stayed infeasible with their faces at ring 3, and the ring then widened everywhere,
+  // 11.5 M → 22.5 M variables). False: nothing left to widen locally.
+  auto widen_at = [&](const MatchingLp& m, const ProofPlace& place, const char* why) {
+    auto find = [&](bool carry_y, int boost) {
+      return faces_to_widen(m, place, options_.widen_margin + boost, carry_y);
+    };
+    std::vector<int> faces = find(false, 0);
+    if (faces.empty()) return false;
+    const bool carried = faces == last_widened;
+    last_widened = faces;
+    if (carried) faces = find(true, 0);
+    if (widen_locally(faces, why)) return true;
+    if (!carried && widen_locally(find(true, 0), why)) return true;
+    for (int boost = 1; boost <= kMaxMarginBoost; ++boost)
+      if (widen_locally(find(true, boost), why)) {
+        spdlog::info("level {}: widened with a margin of {} rings around the proof", l + 1, boost);
+        ++rep.margin_widenings;
+        return true;
+      }
+    return false;
   };
   for (;;) {
     MatchingLp m;
@@ -448,11 +460,11 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
                  rep.variables, l > 0 ? fmt::format("{:.3g} % of the full space", kept) : "the full space",
                  l > 0 ? fmt::format(", ring {}", ring) : std::string());
     // Propagation alone proves most reduced LPs infeasible, and says where: widen there first.
-    if (l > 0 && options_.local_widening &&
-        widen_locally(faces_for([&](bool carry_y) {
-                        return faces_near_conflicts(m, kMaxConflictPlaces, options_.widen_margin, carry_y);
-                      }).first))
-      continue;
+    if (l > 0 && options_.local_widening) {
+      ProofPlace place(m);
+      if (conflict_places(m, kMaxConflictPlaces, options_.widen_margin, place) > 0 && widen_at(m, place, "infeasible"))
+        continue;
+    }
     try {
       RoundingOptions ro = rounding_for(l);
       // While local widenings remain, a diverging first LP is reason enough to widen (it only
@@ -477,12 +489,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
       if (l == 0) throw;
       ProofPlace proof(m);
       for (int64_t i : e.rows()) proof.add(m, i);
-      auto find = [&](bool carry_y) { return faces_to_widen(m, proof, options_.widen_margin, carry_y); };
-      const char* why = e.certified() ? "infeasible" : "probably infeasible (PDHG diverging)";
-      const auto [faces, carried] = faces_for(find);
-      if (widen_locally(faces, why)) continue;
-      // The X faces there are at their limit: try those that map next to the Y side.
-      if (!carried && widen_locally(find(true), why)) continue;
+      if (widen_at(m, proof, e.certified() ? "infeasible" : "probably infeasible (PDHG diverging)")) continue;
       if (!e.certified()) {  // nothing left to widen locally on a suspicion: solve for a proof
         trust_divergence = false;
         continue;
