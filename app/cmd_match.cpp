@@ -268,6 +268,7 @@ int run_match(const MatchArgs& args) {
                               .set("levels", matcher.x_levels().size())
                               .set("coarsest_faces", args.hierarchy.coarsest_faces)
                               .set("second_faces", args.hierarchy.second_faces)
+                              .set("level_ratio", args.hierarchy.ratio)
                               .set("ring", args.ring)
                               .set("neighbourhood", args.neighbourhood)
                               .set("widen", args.widen)
@@ -358,6 +359,10 @@ Action add_match_command(CLI::App& app) {
   app.add_option("--time-limit", a->time_limit, "time limit of each LP solve, seconds");
   app.add_option("--levels", a->hierarchy.levels, "coarse-to-fine levels including the finest (0: from --coarsest-faces)")
       ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  app.add_option("--level-ratio", a->hierarchy.ratio,
+                 "with --levels 0: faces grow by at most this factor from level to level")
+      ->check(CLI::Range(1.01, 1e6))
       ->capture_default_str();
   app.add_option("--coarsest-faces", a->hierarchy.coarsest_faces, "faces of the coarsest level")
       ->check(CLI::Range(4, 1 << 30))
