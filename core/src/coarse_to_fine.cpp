@@ -72,7 +72,9 @@ std::vector<int> faces_to_widen(const MatchingLp& m, const ProofPlace& p, int ma
 // Each place costs a propagation pass and a scan of the space; past this many, widen what was
 // found and look again on the widened space.
 constexpr int kMaxConflictPlaces = 256;
-// Where a place's faces are all at max_ring: X faces up to this many rings around it widen too.
+// Where a place's faces are all at max_ring: they may grow this many rings beyond it, and then X
+// faces up to kMaxMarginBoost rings around it widen too.
+constexpr int kMaxRingBeyond = 3;
 constexpr int kMaxMarginBoost = 3;
 
 // Every place where unit propagation proves a reduced LP infeasible: after each contradiction
@@ -86,6 +88,14 @@ int conflict_places(const MatchingLp& m, int max_places, int margin, ProofPlace&
     const int64_t row = propagation_conflict(m.lp, skip);
     if (row < 0) break;
     skip[row] = 1;
+    {
+      const int64_t face = row - m.closedness_rows;
+      const int fx = m.space.x().num_faces();
+      spdlog::debug("propagation: conflict in row {} ({}), {} variables", row,
+                    face < 0 ? "closedness" : face < fx ? "X face " + std::to_string(face)
+                                                        : "Y face " + std::to_string(face - fx),
+                    m.lp.a.row_ptr[row + 1] - m.lp.a.row_ptr[row]);
+    }
     ProofPlace here(m);
     here.add(m, row);
     place.add(m, row);
@@ -398,13 +408,13 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
   int ring = options_.ring;
   bool trust_divergence = true;
   CarriedIterate warm;  // the last attempt's first LP, for the next
-  // One more fine ring on these faces (as far as max_ring allows); false if none could grow.
-  auto widen_locally = [&](const std::vector<int>& faces, const char* why = "infeasible") {
+  // One more fine ring on these faces (up to `cap` rings); false if none could grow.
+  auto widen_locally = [&](const std::vector<int>& faces, const char* why, int cap) {
     if (!options_.local_widening || local >= options_.max_local_widenings) return false;
     extra.resize(lx.mesh.num_faces(), 0);
     int64_t widened = 0;
     for (int f : faces)
-      if (ring + extra[f] < options_.max_ring) {
+      if (ring + extra[f] < cap) {
         ++extra[f];
         ++widened;
       }
@@ -418,10 +428,11 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
   };
   // Widens around a proof (its place): the X faces on it first; where the same faces come back
   // (the X side alone did not help) also those that map next to its Y side; where every one of
-  // them is at max_ring, the same with a margin of X faces around the place that grows by one
-  // ring each time, up to kMaxMarginBoost (measured, FAUST_r 021-029 at full resolution: two
-  // places stayed infeasible with their faces at ring 3, and the ring then widened everywhere,
-  // 11.5 M → 22.5 M variables). False: nothing left to widen locally.
+  // them is at max_ring, those faces alone beyond it, up to kMaxRingBeyond more, and then a
+  // margin of X faces around the place that grows by one ring each time, up to kMaxMarginBoost
+  // (measured, FAUST_r 021-029 at full resolution: one place stayed infeasible with its faces at
+  // ring 3, and the ring then widened everywhere, 11.5 M → 22.5 M variables; margins up to 3
+  // did not clear it). False: nothing left to widen locally.
   auto widen_at = [&](const MatchingLp& m, const ProofPlace& place, const char* why) {
     auto find = [&](bool carry_y, int boost) {
       return faces_to_widen(m, place, options_.widen_margin + boost, carry_y);
@@ -431,10 +442,17 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
     const bool carried = faces == last_widened;
     last_widened = faces;
     if (carried) faces = find(true, 0);
-    if (widen_locally(faces, why)) return true;
-    if (!carried && widen_locally(find(true, 0), why)) return true;
+    const int max_ring = options_.max_ring;
+    if (widen_locally(faces, why, max_ring)) return true;
+    if (!carried && widen_locally(find(true, 0), why, max_ring)) return true;
+    for (int cap = max_ring + 1; cap <= max_ring + kMaxRingBeyond; ++cap)
+      if (widen_locally(find(true, 0), why, cap)) {
+        spdlog::info("level {}: widened near the proof beyond ring {}, up to {}", l + 1, max_ring, cap);
+        ++rep.margin_widenings;
+        return true;
+      }
     for (int boost = 1; boost <= kMaxMarginBoost; ++boost)
-      if (widen_locally(find(true, boost), why)) {
+      if (widen_locally(find(true, boost), why, max_ring + kMaxRingBeyond)) {
         spdlog::info("level {}: widened with a margin of {} rings around the proof", l + 1, boost);
         ++rep.margin_widenings;
         return true;

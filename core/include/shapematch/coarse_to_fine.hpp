@@ -116,7 +116,7 @@ struct LevelReport {
   int ring = -1;               // ring of the reduced space (-1: full space)
   int widenings = 0;           // times the ring was widened everywhere after an infeasible reduced LP
   int local_widenings = 0;     // times it was widened only near the proof of infeasibility
-  int margin_widenings = 0;    // of those, with a margin of X faces around the proof
+  int margin_widenings = 0;    // of those, past max_ring near the proof or with a margin around it
   int64_t widened_faces = 0;   // fine X faces widened locally, summed over those times
   int rounds = 0;
   int64_t iterations = 0;      // LP iterations over all rounds of the accepted ring (seconds
