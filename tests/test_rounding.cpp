@@ -546,3 +546,38 @@ TEST_CASE("rounding: a pocket with two tips (an edge over the star of an edge) i
   CHECK(close_pockets(space, indices(pocket), &closed) == indices(collapsed));
   CHECK(closed == 1);
 }
+
+TEST_CASE("rounding: an undone fixing whose blamed part comes back by propagation is halved, not repeated") {
+  // cycle_behind_a_fixing plus a slack s: b1 + a' + s = 1, so b1 = 1 forces a' = 0 and a = 1.
+  // Round 1 fixes a, b1 and b2; the next LP is infeasible and its proof blames a, but a follows
+  // from b1 again: without the rule the state after undoing is the infeasible one (3 ones and
+  // 5 zeros again) and the same LP is solved twice.
+  const int n = 15;
+  std::vector<std::vector<int>> rows(11, std::vector<int>(n, 0));
+  rows[0][0] = rows[0][1] = 1;
+  rows[1][1] = 1;
+  rows[1][2] = -1;
+  for (int i = 0; i < 5; ++i) rows[2 + i][3 + i] = rows[2 + i][3 + (i + 1) % 5] = rows[2 + i][2] = 1;
+  for (int j = 3; j <= 9; ++j) rows[7][j] = 1;
+  rows[8][10] = rows[8][11] = 1;
+  rows[9][12] = rows[9][13] = 1;
+  rows[10][10] = rows[10][1] = rows[10][14] = 1;
+  std::vector<double> cost(n, 0.0);
+  cost[1] = cost[11] = cost[13] = 10.0;
+  const LpProblem lp = test::dense_lp(rows, {1, 0, 1, 1, 1, 1, 1, 2, 1, 1, 1}, cost);
+  const Mesh sphere = shapes::icosphere(1);
+  const auto id = identity_matching(sphere);
+  const ProductSpace space = ProductSpace::from_list(sphere, sphere, {id.begin(), id.begin() + n});
+  RoundingOptions options;
+  options.solver = "pdhg-cpu";
+  options.exact_below = 0;
+  options.lp.threads = 1;
+  const RoundingResult r = round_to_graph_surface(space, lp, cost, options);
+  CHECK(satisfies_exactly(lp, r.gamma));
+  REQUIRE(r.rounds.size() >= 3);
+  CHECK(r.rounds[0].fixed_to_one == 3);
+  CHECK(r.rounds[1].status == LpStatus::Infeasible);
+  CHECK(r.rounds[1].undone);
+  CHECK(r.rounds[1].fixed_to_one + r.rounds[1].fixed_to_zero < r.rounds[0].fixed_to_one + r.rounds[0].fixed_to_zero);
+  CHECK(r.rounds[2].status == LpStatus::Optimal);  // another LP than round 2's
+}
