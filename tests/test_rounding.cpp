@@ -274,9 +274,9 @@ namespace {
 
 // Variables a, a', c, y1..y5, w1, w2, b1, b1', b2, b2'. a + a' = 1; a' = c; y_i + y_{i+1} + c = 1
 // around a 5-cycle; y1 + ... + y5 + w1 + w2 = 2; b_k + b_k' = 1. a' and b_k' cost 10 (`cost`).
-LpProblem cycle_behind_a_fixing(std::vector<double>& cost) {
-  const int n = 14;
-  std::vector<std::vector<int>> rows(10, std::vector<int>(n, 0));
+LpProblem cycle_behind_a_fixing(std::vector<double>& cost, bool linked = false) {
+  const int n = linked ? 15 : 14;
+  std::vector<std::vector<int>> rows(linked ? 11 : 10, std::vector<int>(n, 0));
   rows[0][0] = rows[0][1] = 1;
   rows[1][1] = 1;
   rows[1][2] = -1;
@@ -284,9 +284,29 @@ LpProblem cycle_behind_a_fixing(std::vector<double>& cost) {
   for (int j = 3; j <= 9; ++j) rows[7][j] = 1;
   rows[8][10] = rows[8][11] = 1;
   rows[9][12] = rows[9][13] = 1;
+  std::vector<double> b{1, 0, 1, 1, 1, 1, 1, 2, 1, 1};
+  if (linked) {  // b1 + a' + s = 1 with a slack s: b1 = 1 forces a' = 0, hence a = 1
+    rows[10][10] = rows[10][1] = rows[10][14] = 1;
+    b.push_back(1);
+  }
   cost.assign(n, 0.0);
   cost[1] = cost[11] = cost[13] = 10.0;
-  return test::dense_lp(rows, {1, 0, 1, 1, 1, 1, 1, 2, 1, 1}, cost);
+  return test::dense_lp(rows, b, cost);
+}
+
+// Rounds cycle_behind_a_fixing on a stand-in space of its size (only for the sizes) with
+// PDHG, whose infeasibility proof is a dual point (Clp's names no rows), and checks A x = b.
+RoundingResult round_cycle(RoundingOptions options, bool linked = false) {
+  std::vector<double> cost;
+  const LpProblem lp = cycle_behind_a_fixing(cost, linked);
+  const Mesh sphere = shapes::icosphere(1);
+  const auto id = identity_matching(sphere);
+  const ProductSpace space = ProductSpace::from_list(sphere, sphere, {id.begin(), id.begin() + lp.cols()});
+  options.solver = "pdhg-cpu";
+  options.exact_below = 0;
+  RoundingResult r = round_to_graph_surface(space, lp, cost, options);
+  CHECK(satisfies_exactly(lp, r.gamma));
+  return r;
 }
 
 }  // namespace
@@ -297,17 +317,7 @@ TEST_CASE("rounding: an infeasible LP after a fixing undoes only the fixings its
   // infeasible, but no row alone says so, so only the next LP can. Its proof lies on the cycle, two rows away from a (a -> a' -> c,
   // by propagation) and away from b1 and b2: they stay fixed, where halving the batch would
   // have kept b1 alone.
-  const int n = 14;
-  std::vector<double> cost;
-  const LpProblem lp = cycle_behind_a_fixing(cost);
-  const Mesh sphere = shapes::icosphere(1);  // a space of 14 variables, only for the sizes
-  const auto id = identity_matching(sphere);
-  const ProductSpace space = ProductSpace::from_list(sphere, sphere, {id.begin(), id.begin() + n});
-  RoundingOptions options;
-  options.solver = "pdhg-cpu";  // its infeasibility proof is a dual point (Clp's names no rows)
-  options.exact_below = 0;
-  const RoundingResult r = round_to_graph_surface(space, lp, cost, options);
-  CHECK(satisfies_exactly(lp, r.gamma));
+  const RoundingResult r = round_cycle({});
   CHECK(r.energy == 10.0);  // a' = c = 1, b1 = b2 = 1
   REQUIRE(r.rounds.size() >= 2);
   CHECK(r.rounds[0].fixed_to_one == 3);
@@ -327,19 +337,10 @@ TEST_CASE("rounding: a fixing from an LP at its iteration cap is undone whole, a
   // cycle_behind_a_fixing as above, with round 1 stopped at its cap, its iterate already past
   // the threshold on a, b1 and b2. The proof after it blames a alone, but an iterate at its cap
   // is not trusted for the rest either: all three fixings go (the rule above would keep b1, b2).
-  const int n = 14;
-  std::vector<double> cost;
-  const LpProblem lp = cycle_behind_a_fixing(cost);
-  const Mesh sphere = shapes::icosphere(1);
-  const auto id = identity_matching(sphere);
-  const ProductSpace space = ProductSpace::from_list(sphere, sphere, {id.begin(), id.begin() + n});
   RoundingOptions options;
-  options.solver = "pdhg-cpu";
-  options.exact_below = 0;
   options.lp.max_iterations = 200;
   options.lp.threads = 1;  // the same iterates on any machine
-  const RoundingResult r = round_to_graph_surface(space, lp, cost, options);
-  CHECK(satisfies_exactly(lp, r.gamma));
+  const RoundingResult r = round_cycle(options);
   CHECK(r.energy == 10.0);
   REQUIRE(r.rounds.size() >= 3);
   CHECK(r.rounds[0].status == LpStatus::IterationLimit);
@@ -354,18 +355,9 @@ TEST_CASE("rounding: a big round fixes only candidates away from the LP's undeci
   // 0. Where every round counts as big (greedy_above 0), round 1 fixes b1 and b2 but not a (its
   // row holds a', undecided), so the LP after it is feasible; with the margin off it fixes all
   // three and the next LP is not.
-  const int n = 14;
-  std::vector<double> cost;
-  const LpProblem lp = cycle_behind_a_fixing(cost);
-  const Mesh sphere = shapes::icosphere(1);
-  const auto id = identity_matching(sphere);
-  const ProductSpace space = ProductSpace::from_list(sphere, sphere, {id.begin(), id.begin() + n});
   RoundingOptions options;
-  options.solver = "pdhg-cpu";
-  options.exact_below = 0;
   options.greedy_above = 0;
-  const RoundingResult away = round_to_graph_surface(space, lp, cost, options);
-  CHECK(satisfies_exactly(lp, away.gamma));
+  const RoundingResult away = round_cycle(options);
   CHECK(away.energy == 10.0);
   REQUIRE(away.rounds.size() >= 2);
   CHECK(away.rounds[0].fixed_to_one == 2);
@@ -374,8 +366,7 @@ TEST_CASE("rounding: a big round fixes only candidates away from the LP's undeci
   // a, goes in: the fallback that keeps rounding moving; round 3 undoes it.)
   CHECK(away.rounds[1].status == LpStatus::Optimal);
   options.greedy_margin = 0;
-  const RoundingResult all = round_to_graph_surface(space, lp, cost, options);
-  CHECK(satisfies_exactly(lp, all.gamma));
+  const RoundingResult all = round_cycle(options);
   REQUIRE(all.rounds.size() >= 2);
   CHECK(all.rounds[0].fixed_to_one == 3);
   CHECK(all.rounds[1].status == LpStatus::Infeasible);
@@ -548,32 +539,13 @@ TEST_CASE("rounding: a pocket with two tips (an edge over the star of an edge) i
 }
 
 TEST_CASE("rounding: an undone fixing whose blamed part comes back by propagation is halved, not repeated") {
-  // cycle_behind_a_fixing plus a slack s: b1 + a' + s = 1, so b1 = 1 forces a' = 0 and a = 1.
+  // cycle_behind_a_fixing, linked: b1 = 1 forces a' = 0 and a = 1.
   // Round 1 fixes a, b1 and b2; the next LP is infeasible and its proof blames a, but a follows
   // from b1 again: without the rule the state after undoing is the infeasible one (3 ones and
   // 5 zeros again) and the same LP is solved twice.
-  const int n = 15;
-  std::vector<std::vector<int>> rows(11, std::vector<int>(n, 0));
-  rows[0][0] = rows[0][1] = 1;
-  rows[1][1] = 1;
-  rows[1][2] = -1;
-  for (int i = 0; i < 5; ++i) rows[2 + i][3 + i] = rows[2 + i][3 + (i + 1) % 5] = rows[2 + i][2] = 1;
-  for (int j = 3; j <= 9; ++j) rows[7][j] = 1;
-  rows[8][10] = rows[8][11] = 1;
-  rows[9][12] = rows[9][13] = 1;
-  rows[10][10] = rows[10][1] = rows[10][14] = 1;
-  std::vector<double> cost(n, 0.0);
-  cost[1] = cost[11] = cost[13] = 10.0;
-  const LpProblem lp = test::dense_lp(rows, {1, 0, 1, 1, 1, 1, 1, 2, 1, 1, 1}, cost);
-  const Mesh sphere = shapes::icosphere(1);
-  const auto id = identity_matching(sphere);
-  const ProductSpace space = ProductSpace::from_list(sphere, sphere, {id.begin(), id.begin() + n});
   RoundingOptions options;
-  options.solver = "pdhg-cpu";
-  options.exact_below = 0;
-  options.lp.threads = 1;
-  const RoundingResult r = round_to_graph_surface(space, lp, cost, options);
-  CHECK(satisfies_exactly(lp, r.gamma));
+  options.lp.threads = 1;  // the same iterates on any machine
+  const RoundingResult r = round_cycle(options, true);
   REQUIRE(r.rounds.size() >= 3);
   CHECK(r.rounds[0].fixed_to_one == 3);
   CHECK(r.rounds[1].status == LpStatus::Infeasible);
