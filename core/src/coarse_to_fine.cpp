@@ -90,14 +90,12 @@ int conflict_places(const MatchingLp& m, int max_places, int margin, ProofPlace&
     const int64_t row = propagation_conflict(m.lp, skip);
     if (row < 0) break;
     skip[row] = 1;
-    {
-      const int64_t face = row - m.closedness_rows;
-      const int fx = m.space.x().num_faces();
-      spdlog::debug("propagation: conflict in row {} ({}), {} variables", row,
-                    face < 0 ? "closedness" : face < fx ? "X face " + std::to_string(face)
-                                                        : "Y face " + std::to_string(face - fx),
-                    m.lp.a.row_ptr[row + 1] - m.lp.a.row_ptr[row]);
-    }
+    const int64_t face = row - m.closedness_rows;
+    spdlog::debug("propagation: conflict in row {} ({}), {} variables", row,
+                  face < 0                 ? std::string("closedness")
+                  : face < X.num_faces()   ? "X face " + std::to_string(face)
+                                           : "Y face " + std::to_string(face - X.num_faces()),
+                  m.lp.a.row_ptr[row + 1] - m.lp.a.row_ptr[row]);
     ProofPlace here(m);
     here.add(m, row);
     place.add(m, row);
@@ -411,9 +409,10 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
   bool trust_divergence = true;
   bool regional_done = false;
   CarriedIterate warm;  // the last attempt's first LP, for the next
-  // One more fine ring on these faces (up to `cap` rings); false if none could grow.
-  auto widen_locally = [&](const std::vector<int>& faces, const char* why, int cap) {
-    if (!options_.local_widening || local >= options_.max_local_widenings) return false;
+  // One more fine ring on these faces (up to `cap` rings); false if none could grow. `last`: the
+  // level's regional widening, which comes after max_local_widenings.
+  auto widen_locally = [&](const std::vector<int>& faces, const char* why, int cap, bool last = false) {
+    if (!options_.local_widening || (local >= options_.max_local_widenings && !last)) return false;
     extra.resize(lx.mesh.num_faces(), 0);
     int64_t widened = 0;
     for (int f : faces)
@@ -422,7 +421,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
         ++widened;
       }
     if (widened == 0) return false;
-    ++local;
+    if (!last) ++local;  // the regional one is not counted against the limit
     ++rep.local_widenings;
     rep.widened_faces += widened;
     spdlog::warn("level {}: the reduced LP is {}; widening {} of {} faces by one ring", l + 1, why, widened,
@@ -519,23 +518,16 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
       // face widened so far gets one more ring, before the ring grows everywhere (measured,
       // FAUST_r 021-029 at full resolution: 24 local widenings, each clearing one conflict with
       // the next one next to it; ring 2 everywhere then meant 23.9 M variables against 14.1 M).
-      if (!regional_done && local > 0 && options_.local_widening) {
+      if (!regional_done && local > 0) {
         regional_done = true;
         const Mesh& X = lx.mesh;
         std::vector<char> near(X.num_vertices(), 0);
         for (int f = 0; f < X.num_faces(); ++f)
           if (extra[f] > 0)
             for (int v : X.faces[f]) near[v] = 1;
-        int64_t widened = 0;
-        for (int f : faces_on(X, near, kRegionRings))
-          if (ring + extra[f] < options_.max_ring + kMaxRingBeyond) ++extra[f], ++widened;
-        if (widened > 0) {
-          ++rep.local_widenings;
+        if (widen_locally(faces_on(X, near, kRegionRings), "infeasible", options_.max_ring + kMaxRingBeyond, true)) {
+          spdlog::info("level {}: widened around all earlier local widenings ({} rings)", l + 1, kRegionRings);
           ++rep.margin_widenings;
-          rep.widened_faces += widened;
-          spdlog::warn("level {}: the reduced LP is infeasible; widening {} of {} faces near the earlier widenings by "
-                       "one ring",
-                       l + 1, widened, X.num_faces());
           continue;
         }
       }

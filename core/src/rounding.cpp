@@ -799,10 +799,10 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
         // The blamed fixings are not tried again from this state: the next LP is the one before
         // them, which would put them first again (full resolution: the same two rounds, fix and
         // undo, for 100 rounds).
+        std::unordered_set<int64_t> kept;
+        for (const auto& k : away_from_proof) kept.insert(k.first);
         for (const auto& a : step.batch)
-          if (a.second == 1 &&
-              std::none_of(away_from_proof.begin(), away_from_proof.end(), [&](const auto& k) { return k.first == a.first; }))
-            refuted.insert(a.first);
+          if (a.second == 1 && !kept.count(a.first)) refuted.insert(a.first);
         smaller = std::move(away_from_proof);
       }
       else if (smaller.size() > 1) smaller.resize(smaller.size() / 2);
@@ -847,33 +847,30 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
     Stopwatch clock;
     const Reduced red = reduce(lp, fixer.state());
     SolverParams params = base_params;
-    if (round > 1) {
-      // After a fixing, an infeasible LP undoes it: that needs a proof, not a suspicion.
-      params.stop_on_divergence = false;
+    // The warm start over the whole LP (the last round's iterate, or round 1's given one) cut to
+    // what propagation left free.
+    const bool given = options.lp.initial_x.size() == size_t(lp.cols()) && options.lp.initial_y.size() == size_t(lp.rows());
+    if (round > 1 || given) {
+      const std::vector<double>& wx = round > 1 ? x_full : options.lp.initial_x;
+      const std::vector<double>& wy = round > 1 ? y_full : options.lp.initial_y;
       params.initial_x.resize(red.cols.size());
       params.initial_y.resize(red.rows.size());
-      for (size_t j = 0; j < red.cols.size(); ++j) params.initial_x[j] = x_full[red.cols[j]];
-      for (size_t i = 0; i < red.rows.size(); ++i) params.initial_y[i] = y_full[red.rows[i]];
-    } else if (options.lp.initial_x.size() == size_t(lp.cols()) && options.lp.initial_y.size() == size_t(lp.rows())) {
-      // A warm start over the whole LP: what propagation left free of it.
-      params.initial_x.resize(red.cols.size());
-      params.initial_y.resize(red.rows.size());
-      for (size_t j = 0; j < red.cols.size(); ++j) params.initial_x[j] = options.lp.initial_x[red.cols[j]];
-      for (size_t i = 0; i < red.rows.size(); ++i) params.initial_y[i] = options.lp.initial_y[red.rows[i]];
+      for (size_t j = 0; j < red.cols.size(); ++j) params.initial_x[j] = wx[red.cols[j]];
+      for (size_t i = 0; i < red.rows.size(); ++i) params.initial_y[i] = wy[red.rows[i]];
     }
+    // After a fixing, an infeasible LP undoes it: that needs a proof, not a suspicion.
+    if (round > 1) params.stop_on_divergence = false;
     // (Not the first round: its relaxation and bound are the chosen solver's.)
     const bool exact = round > 1 && options.exact_below > 0 && options.solver != "clp-dual";
     if (exact && !exact_solver) exact_solver = make_solver("clp-dual");
     const SolverParams& exact_params = base_params;
     // A cap for the first-order solver only (simplex iterations are another unit); the exact
     // solver gets the parts below exact_below without it.
-    if (round > 1 && options.later_round_iterations > 0 && options.solver.rfind("pdhg", 0) == 0)
-      params.max_iterations = std::min<int64_t>(
-          params.max_iterations,
-          static_cast<int64_t>(cap_scale * double(std::max<int64_t>(
-                                               options.later_round_min_iterations,
-                                               static_cast<int64_t>(options.later_round_iterations *
-                                                                    double(result.first_lp.iterations))))));
+    if (round > 1 && options.later_round_iterations > 0 && options.solver.rfind("pdhg", 0) == 0) {
+      const double cap = std::max(double(options.later_round_min_iterations),
+                                  std::floor(options.later_round_iterations * double(result.first_lp.iterations)));
+      params.max_iterations = std::min<int64_t>(params.max_iterations, static_cast<int64_t>(cap_scale * cap));
+    }
     JoinedSolve joined;
     if (round == 1) {
       joined.r = solver->solve(red.lp, params);
