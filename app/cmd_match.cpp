@@ -36,6 +36,7 @@ struct MatchArgs {
   bool whole_lp = !RoundingOptions{}.split_parts;
   int64_t greedy_above = RoundingOptions{}.greedy_above;
   int greedy_margin = RoundingOptions{}.greedy_margin;
+  int64_t search_below = RoundingOptions{}.search_below;
   double tolerance = 1e-4;
   double coarse_tolerance = CoarseToFineOptions{}.coarse_tolerance;
   double time_limit = std::numeric_limits<double>::infinity();
@@ -119,6 +120,7 @@ int run_match(const MatchArgs& args) {
   ro.split_parts = !args.whole_lp;
   ro.greedy_above = args.greedy_above;
   ro.greedy_margin = args.greedy_margin;
+  ro.search_below = args.search_below;
   ro.lp.tolerance = args.tolerance;
   ro.lp.time_limit = args.time_limit;
   ro.lp.device = args.device;
@@ -130,11 +132,19 @@ int run_match(const MatchArgs& args) {
 
   stage.reset();
   const CoarseToFineResult c2f = matcher.run([&](const LevelReport& level, const RoundingRound& r) {
+    const std::string at = matcher.x_levels().size() > 1 ? fmt::format("level {} ", level.level + 1) : std::string();
+    const std::string parts = r.parts > 1 ? fmt::format(" in {} parts", r.parts) : std::string();
+    if (r.searched_parts > 0 || r.released > 0) {  // a search round (RoundingOptions::search_below)
+      spdlog::info("{}round {:>2}: {:>9} variables{}, searched: {} parts finished in {} nodes, fixed {} to 1 and {} "
+                   "to 0{} ({:.2f} s)",
+                   at, r.round, r.variables, parts, r.searched_parts, r.iterations, r.fixed_to_one, r.fixed_to_zero,
+                   r.released > 0 ? fmt::format(", released {} fixings around the rest", r.released) : std::string(),
+                   r.seconds);
+      return;
+    }
     spdlog::info("{}round {:>2}: {:>9} variables{}, LP {} in {} it, objective {:.6g}, fixed {} to 1 and {} to 0{} ({:.2f} s)",
-                 matcher.x_levels().size() > 1 ? fmt::format("level {} ", level.level + 1) : std::string(), r.round,
-                 r.variables, r.parts > 1 ? fmt::format(" in {} parts", r.parts) : std::string(), to_string(r.status),
-                 r.iterations, r.objective, r.fixed_to_one, r.fixed_to_zero, r.undone ? " (undone: fixed fewer)" : "",
-                 r.seconds);
+                 at, r.round, r.variables, parts, to_string(r.status), r.iterations, r.objective, r.fixed_to_one,
+                 r.fixed_to_zero, r.undone ? " (undone: fixed fewer)" : "", r.seconds);
   });
   const MatchingLp& m = c2f.finest;
   const RoundingResult& rr = c2f.rounding;
@@ -210,6 +220,8 @@ int run_match(const MatchArgs& args) {
                       .set("undone", r.undone)
                       .set("parts", r.parts)
                       .set("exact_parts", r.exact_parts)
+                      .set("searched_parts", r.searched_parts)
+                      .set("released", r.released)
                       .set("seconds", r.seconds));
     Json report = Json::object();
     auto shape = [](const std::string& file, int input_vertices, const Mesh& mesh) {
@@ -257,6 +269,7 @@ int run_match(const MatchArgs& args) {
                               .set("close_pockets", args.close_pockets)
                               .set("greedy_above", args.greedy_above)
                               .set("greedy_margin", args.greedy_margin)
+                              .set("search_below", args.search_below)
                               .set("split_parts", !args.whole_lp)
                               .set("tolerance", args.tolerance)
                               .set("coarse_tolerance", co.coarse_tolerance)
@@ -335,6 +348,11 @@ Action add_match_command(CLI::App& app) {
       ->check(CLI::Range(0.0, 1.0))
       ->capture_default_str();
   app.add_option("--max-rounds", a->max_rounds, "rounding rounds before giving up")->capture_default_str();
+  app.add_option("--search-below", a->search_below,
+                 "where rounding stalls on at most this many free variables, finish each part by depth-first "
+                 "search over exact LPs, releasing the fixings around a part without a binary solution (0: never)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
   app.add_option("--later-round-iterations", a->later_round_iterations,
                  "LP iterations of a rounding round after the first, at most this many times the first LP's (at "
                  "least 2000; then it fixes from its iterate); 0: no limit")

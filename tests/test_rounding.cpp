@@ -127,6 +127,29 @@ TEST_CASE("rounding: a later LP solved in its independent parts has the optimum 
   }
 }
 
+TEST_CASE("rounding: later rounds finished by search end in a verified graph surface") {
+  // Threshold 0 on the dolphins at 60 faces (many rounds otherwise), every round after the first
+  // searched: each part ends at an integral vertex or by branching, and the joined Γ must still
+  // be exact and a graph surface, with an energy above the bound.
+  const Mesh x = decimate(shapes::dolphin(0, 5), 60), y = decimate(shapes::dolphin(-40, 45), 60);
+  const MatchingLp m = build_matching_lp(x, compute_geometry(x), y, compute_geometry(y));
+  RoundingOptions o;
+  o.solver = "pdhg-cpu";
+  o.threshold = 0.0;
+  o.search_stall = 0;
+  o.search_below = m.lp.cols();
+  const RoundingResult r = round_to_graph_surface(m.space, m.lp, m.energy, o);
+  int64_t searched = 0;
+  for (const RoundingRound& k : r.rounds) searched += k.searched_parts;
+  MESSAGE(r.rounds.size(), " rounds, ", searched, " parts searched, gap ", r.gap);
+  CHECK(searched > 0);
+  CHECK(r.rounds.size() <= 3);  // the search leaves nothing open where every part has a solution
+  CHECK(satisfies_exactly(m.lp, r.gamma));
+  CHECK(check_graph_surface(m.space, r.gamma).covers_x);
+  CHECK(check_graph_surface(m.space, r.gamma).orientation);
+  CHECK(r.energy >= r.lower_bound - 1e-9);
+}
+
 TEST_CASE("rounding: round 1 starts from a warm start over the whole LP and hands its iterate out") {
   const Mesh x = shapes::bent_finger(10, 5, 6), y = shapes::bent_finger(60, 5, 6);
   const MatchingLp m = build_matching_lp(x, compute_geometry(x), y, compute_geometry(y));
@@ -409,6 +432,69 @@ TEST_CASE("rounding: a fixing of an earlier round that leaves no binary solution
   // Without backtracking over rounds the same LP ends in an error.
   options.max_backtracks = 0;
   CHECK_THROWS_AS(round_to_graph_surface(space, lp, {0, 10, 0, 0, 0}, options), InfeasibleError);
+}
+
+TEST_CASE("rounding: a stalled remainder is finished by search, releasing the fixings around a part with no binary solution") {
+  // The LP above (a + a' = 1, x_i + x_j + a' = 1): round 1 fixes a, and the x left in round 2 form
+  // an odd cycle with no binary solution. Searched at once (search_stall 0), that part is proved
+  // to have none; the fixing of a within two steps of it is released (not undone as the last
+  // fixing: backtracking is off), and the search over the whole LP then branches past x = 1/2 to
+  // a' = 1.
+  const LpProblem lp = test::dense_lp({{1, 1, 0, 0, 0}, {0, 1, 1, 1, 0}, {0, 1, 0, 1, 1}, {0, 1, 1, 0, 1}},
+                                      {1, 1, 1, 1}, {0, 10, 0, 0, 0});
+  const Mesh o = shapes::octahedron();  // a space of five variables, only for the sizes
+  const auto id = identity_matching(o);
+  const ProductSpace space = ProductSpace::from_list(o, o, {id[0], id[1], id[2], id[3], id[4]});
+  RoundingOptions options;
+  options.solver = "clp-dual";
+  options.max_backtracks = 0;
+  options.search_stall = 0;
+  const RoundingResult r = round_to_graph_surface(space, lp, {0, 10, 0, 0, 0}, options);
+  CHECK(r.gamma == std::vector<int64_t>{1});
+  CHECK(r.energy == 10.0);
+  REQUIRE(r.rounds.size() == 3);
+  CHECK(r.rounds[0].fixed_to_one == 1);   // a
+  CHECK(r.rounds[1].variables == 3);      // the odd cycle
+  CHECK(r.rounds[1].searched_parts == 0);
+  CHECK(r.rounds[1].released == 1);       // a again free
+  CHECK(r.rounds[1].fixed_to_one == -1);
+  CHECK(r.rounds[2].variables == 5);
+  CHECK(r.rounds[2].searched_parts == 1);
+  CHECK(r.rounds[2].iterations >= 2);     // x1 = 1 refuted, then the node with x1 = 0
+  // Without the search, the same options end in an error.
+  options.search_below = 0;
+  CHECK_THROWS_AS(round_to_graph_surface(space, lp, {0, 10, 0, 0, 0}, options), InfeasibleError);
+  // With the default stall of three rounds, rounding gets there by backtracking first.
+  options.max_backtracks = RoundingOptions{}.max_backtracks;
+  options.search_below = RoundingOptions{}.search_below;
+  options.search_stall = RoundingOptions{}.search_stall;
+  const RoundingResult b = round_to_graph_surface(space, lp, {0, 10, 0, 0, 0}, options);
+  CHECK(b.gamma == std::vector<int64_t>{1});
+  for (const RoundingRound& k : b.rounds) CHECK(k.searched_parts == 0);
+}
+
+TEST_CASE("rounding: a searched part with no binary solution and no fixing near it ends in InfeasibleError") {
+  // a + a' = 1 (a' costs 10) beside an odd cycle x0 + x1 = x1 + x2 = x2 + x0 = 1 that shares no
+  // row with it: round 1 fixes a, the search of round 2 proves the cycle has no binary solution,
+  // and no fixing lies within reach of it to release. That ends in an error naming the cycle's
+  // rows (coarse to fine widens there), not in rounds that release and search again.
+  const LpProblem lp =
+      test::dense_lp({{1, 1, 0, 0, 0}, {0, 0, 1, 1, 0}, {0, 0, 0, 1, 1}, {0, 0, 1, 0, 1}}, {1, 1, 1, 1}, {0, 10, 1, 1, 1});
+  const Mesh o = shapes::octahedron();
+  const auto id = identity_matching(o);
+  const ProductSpace space = ProductSpace::from_list(o, o, {id[0], id[1], id[2], id[3], id[4]});
+  RoundingOptions options;
+  options.solver = "clp-dual";
+  options.search_stall = 0;
+  std::vector<RoundingRound> seen;
+  try {
+    round_to_graph_surface(space, lp, {0, 10, 1, 1, 1}, options, [&](const RoundingRound& r) { seen.push_back(r); });
+    FAIL("no InfeasibleError");
+  } catch (const InfeasibleError& e) {
+    CHECK(e.rows() == std::vector<int64_t>{1, 2, 3});
+  }
+  REQUIRE(seen.size() == 1);  // round 2 threw before reporting
+  CHECK(seen[0].fixed_to_one == 1);
 }
 
 namespace {

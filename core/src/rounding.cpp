@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cmath>
 #include <deque>
+#include <limits>
 #include <map>
 #include <numeric>
 #include <set>
@@ -574,6 +575,104 @@ std::vector<std::pair<int64_t, int>> away_from_undecided(const LpProblem& lp, co
   return kept.empty() ? batch : kept;
 }
 
+
+// How a depth-first search for a binary solution of one part ended.
+enum class SearchEnd { found, none, node_limit };
+
+// A binary solution of A x = b (one part of a late round's LP), by depth-first search: at each
+// node the exact LP over what is still free; an integral optimum ends it, otherwise it branches
+// on the largest fractional variable, 1 before 0, with propagation after every fixing. Complete:
+// `none` is a proof that no binary solution exists (the fixings around the part are wrong).
+// `value` gets one 0/1 per column on `found`.
+SearchEnd search_part(const LpProblem& plp, LpSolver& exact, const SolverParams& params, int64_t max_nodes,
+                      std::vector<int8_t>& value, int64_t& nodes) {
+  Fixer f(plp);
+  if (!f.propagate_all()) return SearchEnd::none;
+  struct Branch {
+    size_t mark;
+    int64_t col;
+    int value;  // the value being tried: 1 first, then 0
+  };
+  std::vector<Branch> stack;
+  // Back to the deepest branch with a value left to try; false where none is.
+  const auto retreat = [&] {
+    while (!stack.empty()) {
+      Branch& b = stack.back();
+      f.undo_to(b.mark);
+      if (b.value == 1) {
+        b.value = 0;
+        if (f.fix({{b.col, 0}})) return true;
+        f.undo_to(b.mark);
+      }
+      stack.pop_back();
+    }
+    return false;
+  };
+  const auto finish = [&] {
+    value.resize(plp.cols());
+    for (int64_t j = 0; j < plp.cols(); ++j) value[j] = f.state().value[j] == 1 ? 1 : 0;
+    return SearchEnd::found;
+  };
+  for (bool alive = true;; alive = true) {
+    if (f.state().unsatisfied == 0) return finish();  // what is still free is 0
+    if (++nodes > max_nodes) return SearchEnd::node_limit;
+    const Reduced red = reduce(plp, f.state());
+    const LpResult s = exact.solve(red.lp, params);
+    if (s.status == LpStatus::Infeasible) {
+      alive = false;
+    } else if (s.status != LpStatus::Optimal || s.x.size() != red.cols.size()) {
+      return SearchEnd::node_limit;  // no answer: as good as running out of nodes
+    } else {
+      constexpr double kIntegral = 1e-6;
+      int64_t branch = -1;
+      for (size_t k = 0; k < red.cols.size(); ++k)
+        if (s.x[k] > kIntegral && s.x[k] < 1.0 - kIntegral && (branch < 0 || s.x[k] > s.x[branch])) branch = k;
+      if (branch < 0) {  // an integral vertex: it satisfies A x = b, so it is a solution
+        std::vector<std::pair<int64_t, int>> all;
+        for (size_t k = 0; k < red.cols.size(); ++k) all.push_back({red.cols[k], s.x[k] > 0.5 ? 1 : 0});
+        const size_t mark = f.mark();
+        if (f.fix(all) && f.state().unsatisfied == 0) return finish();
+        f.undo_to(mark);  // rounding error in the vertex: branch instead
+        branch = 0;
+        for (size_t k = 1; k < red.cols.size(); ++k)
+          if (std::abs(s.x[k] - 0.5) < std::abs(s.x[branch] - 0.5)) branch = k;
+      }
+      stack.push_back({f.mark(), red.cols[branch], 1});
+      alive = f.fix({{red.cols[branch], 1}});
+    }
+    if (!alive && !retreat()) return SearchEnd::none;
+  }
+}
+
+// The columns within `depth` row-column-row steps of `rows` in the LP's graph (fixed or free):
+// the neighbourhood whose fixings are released where a part has no binary solution.
+std::vector<char> columns_near(const LpProblem& lp, const std::vector<int64_t>& rows, int depth) {
+  std::vector<char> row_seen(lp.rows(), 0), col_seen(lp.cols(), 0);
+  std::vector<int64_t> frontier;
+  for (int64_t i : rows)
+    if (!row_seen[i]) {
+      row_seen[i] = 1;
+      frontier.push_back(i);
+    }
+  for (int step = 0; step < depth && !frontier.empty(); ++step) {
+    std::vector<int64_t> next;
+    for (int64_t i : frontier)
+      for (uint32_t k = lp.a.row_ptr[i]; k < lp.a.row_ptr[i + 1]; ++k) {
+        const int64_t j = col_of(lp.a.entry[k]);
+        if (col_seen[j]) continue;
+        col_seen[j] = 1;
+        for (uint32_t q = lp.at.row_ptr[j]; q < lp.at.row_ptr[j + 1]; ++q) {
+          const int64_t r = col_of(lp.at.entry[q]);
+          if (!row_seen[r]) {
+            row_seen[r] = 1;
+            next.push_back(r);
+          }
+        }
+      }
+    frontier = std::move(next);
+  }
+  return col_seen;
+}
 }  // namespace
 
 int64_t propagation_conflict(const LpProblem& lp, const std::vector<char>& skip) {
@@ -837,6 +936,90 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
   SolverParams base_params = options.lp;
   base_params.initial_x.clear();
   base_params.initial_y.clear();
+  // Releases every fixing within reach of `rows` (columns_near, 2, 4, 8 … steps, further until
+  // one is in reach) and propagates the rest again from the state before the first round: where
+  // a part has no binary solution, the fault lies in the fixings around it, not in the last ones
+  // made (parts are independent; the last fixing is as likely in another). Returns how many went.
+  std::unique_ptr<LpSolver> search_solver;
+  int releases = 0;
+  auto release_around = [&](const std::vector<int64_t>& rows) {
+    if (++releases > options.max_releases || history.empty())
+      throw InfeasibleError("rounding: no binary solution around a stalled part after " +
+                                std::to_string(releases - 1) + " releases of the fixings near it",
+                            fixer.unsatisfied_rows());
+    constexpr int kMaxDepth = 1 << 12;
+    for (int depth = 2 << std::min(releases - 1, 5); depth <= kMaxDepth; depth *= 2) {
+      const std::vector<char> near = columns_near(lp, rows, depth);
+      std::vector<std::pair<int64_t, int>> kept;
+      for (const Step& st : history)
+        for (const auto& a : st.batch)
+          if (!near[a.first]) kept.push_back(a);
+      int64_t all = 0;
+      for (const Step& st : history) all += static_cast<int64_t>(st.batch.size());
+      if (static_cast<int64_t>(kept.size()) == all) continue;  // nothing within reach yet
+      fixer.undo_to(history.front().mark);
+      history.clear();
+      refuted.clear();
+      Step rest{fixer.mark(), fixer.state().ones, fixer.state().zeros, {}, false};
+      // Fewer fixings propagate to a subset of a consistent state, so this goes through whole.
+      rest.batch = shrink_and_fix(fixer, kept, rest.mark, true);
+      history.push_back(std::move(rest));
+      spdlog::debug("rounding: released {} fixings within {} steps of a part without a binary solution",
+                    all - static_cast<int64_t>(kept.size()), depth);
+      return all - static_cast<int64_t>(kept.size());
+    }
+    throw InfeasibleError("rounding: no binary solution around a stalled part, and no fixing near it",
+                          fixer.unsatisfied_rows());
+  };
+  // Finishes every part of `red` by search; parts without a binary solution release the fixings
+  // around them. Fills the round's counts.
+  auto search_round = [&](const Reduced& red, RoundingRound& info) {
+    if (!search_solver) search_solver = make_solver("clp-dual");
+    std::vector<Part> parts = split_into_parts(red.lp);
+    if (parts.empty()) {
+      parts.resize(1);
+      parts[0].lp = red.lp;
+      parts[0].cols.resize(red.lp.cols());
+      parts[0].rows.resize(red.lp.rows());
+      std::iota(parts[0].cols.begin(), parts[0].cols.end(), 0);
+      std::iota(parts[0].rows.begin(), parts[0].rows.end(), 0);
+    }
+    std::vector<std::pair<int64_t, int>> found;
+    std::vector<int64_t> stuck;
+    int64_t nodes = 0;
+    for (const Part& part : parts) {
+      std::vector<int8_t> value;
+      if (search_part(part.lp, *search_solver, base_params, options.search_nodes, value, nodes) == SearchEnd::found) {
+        ++info.searched_parts;
+        for (size_t k = 0; k < part.cols.size(); ++k) found.push_back({red.cols[part.cols[k]], value[k]});
+      } else {
+        for (int64_t i : part.rows) stuck.push_back(red.rows[i]);
+      }
+    }
+    info.parts = static_cast<int64_t>(parts.size());
+    info.iterations = nodes;
+    const int64_t ones = fixer.state().ones, zeros = fixer.state().zeros;
+    if (!found.empty()) {
+      Step step{fixer.mark(), ones, zeros, {}, false};
+      // Each part's solution satisfies its rows exactly, and parts share none.
+      if (!fixer.fix(found)) throw SolverError("rounding: a searched part's solution does not fit (a bug)");
+      step.batch = std::move(found);
+      history.push_back(std::move(step));
+    }
+    if (!stuck.empty()) {
+      info.undone = true;
+      info.released = release_around(stuck);
+    }
+    info.fixed_to_one = fixer.state().ones - ones;
+    info.fixed_to_zero = fixer.state().zeros - zeros;
+    double cost = 0.0;
+    for (int64_t j = 0; j < lp.cols(); ++j)
+      if (fixer.state().value[j] == 1) cost += lp.c[j];
+    info.objective = lp.objective_scale * cost;
+    spdlog::debug("rounding: searched {} parts in {} nodes, {} finished", parts.size(), nodes, info.searched_parts);
+  };
+  int64_t fewest_free = std::numeric_limits<int64_t>::max();
+  int stalled = 0;
   for (int round = 1, forward = 0; fixer.state().unsatisfied > 0; ++round) {
     // Out of rounds: no binary solution found in this space. An InfeasibleError with the open
     // rows lets coarse to fine widen there rather than give up the whole run.
@@ -846,6 +1029,25 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
                             fixer.unsatisfied_rows());
     Stopwatch clock;
     const Reduced red = reduce(lp, fixer.state());
+    if (red.lp.cols() < fewest_free) {
+      fewest_free = red.lp.cols();
+      stalled = 0;
+    } else {
+      ++stalled;
+    }
+    if (round > 1 && options.search_below > 0 && red.lp.cols() <= options.search_below &&
+        stalled >= options.search_stall) {
+      ++forward;
+      RoundingRound info;
+      info.round = round;
+      info.variables = red.lp.cols();
+      info.constraints = red.lp.rows();
+      search_round(red, info);
+      info.seconds = clock.seconds();
+      result.rounds.push_back(info);
+      if (progress) progress(info);
+      continue;
+    }
     SolverParams params = base_params;
     // The warm start over the whole LP (the last round's iterate, or round 1's given one) cut to
     // what propagation left free.
