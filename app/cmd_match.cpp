@@ -46,6 +46,7 @@ struct MatchArgs {
   std::string neighbourhood = "fine";
   std::string widen = "local";
   int widen_margin = CoarseToFineOptions{}.widen_margin;
+  int widen_around = CoarseToFineOptions{}.widen_around;
   int y_margin = CoarseToFineOptions{}.y_margin;
   int max_local_widenings = CoarseToFineOptions{}.max_local_widenings;
   bool warm_widening = CoarseToFineOptions{}.warm_widening;
@@ -106,6 +107,7 @@ int run_match(const MatchArgs& args) {
   co.local_widening = args.widen == "local";
   co.coarse_tolerance = args.coarse_tolerance;
   co.widen_margin = args.widen_margin;
+  co.widen_around = args.widen_around;
   co.y_margin = args.y_margin;
   co.max_local_widenings = args.max_local_widenings;
   co.warm_widening = args.warm_widening;
@@ -286,6 +288,7 @@ int run_match(const MatchArgs& args) {
                               .set("neighbourhood", args.neighbourhood)
                               .set("widen", args.widen)
                               .set("widen_margin", args.widen_margin)
+                              .set("widen_around", args.widen_around)
                               .set("y_margin", args.y_margin)
                               .set("max_local_widenings", args.max_local_widenings)
                               .set("warm_widening", args.warm_widening));
@@ -412,6 +415,11 @@ Action add_match_command(CLI::App& app) {
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   app.add_option("--widen-margin", a->widen_margin, "fine rings of faces around the proof that widen with it")
+      ->check(CLI::Range(0, 64))
+      ->capture_default_str();
+  app.add_option("--widen-around", a->widen_around,
+                 "once propagation finds no more contradictions at a level where it found some, one more ring on "
+                 "every X face within this many fine rings of those widened so far, before the first LP (0: off)")
       ->check(CLI::Range(0, 64))
       ->capture_default_str();
   app.add_option("--y-margin", a->y_margin,

@@ -410,16 +410,31 @@ TEST_CASE("rounding: an LP with no binary solution ends in InfeasibleError namin
   }
 }
 
-TEST_CASE("rounding: a fixing of an earlier round that leaves no binary solution is undone") {
-  // Variables a, a', x1, x2, x3. a + a' = 1; x_i + x_j + a' = 1 for the three pairs. With a = 1
-  // the x form an odd cycle whose only solution is x = 1/2; with a' = 1 all x are 0. a is free
-  // and a' costs 10, so the LP picks a = 1 (x = 1/2). Round 1 fixes a; round 2 finds that x1 can
-  // be neither 1 nor 0; only undoing round 1's fixing (a = 0) leads to the binary solution.
-  const LpProblem lp = test::dense_lp({{1, 1, 0, 0, 0}, {0, 1, 1, 1, 0}, {0, 1, 0, 1, 1}, {0, 1, 1, 0, 1}},
-                                      {1, 1, 1, 1}, {0, 10, 0, 0, 0});
-  const Mesh o = shapes::octahedron();  // a space of five variables, only for the sizes
+namespace {
+
+// a + a' = 1 and x_i + x_j + a' = 1 for the three pairs of x1, x2, x3 (variables a, a', x1, x2,
+// x3; a' costs 10): with a = 1 the x form an odd cycle whose only solution is x = 1/2, with
+// a' = 1 they are all 0.
+LpProblem odd_cycle_behind_a() {
+  return test::dense_lp({{1, 1, 0, 0, 0}, {0, 1, 1, 1, 0}, {0, 1, 0, 1, 1}, {0, 1, 1, 0, 1}}, {1, 1, 1, 1},
+                        {0, 10, 0, 0, 0});
+}
+
+// A space of five variables, only for the sizes.
+ProductSpace five_variables() {
+  static const Mesh o = shapes::octahedron();
   const auto id = identity_matching(o);
-  const ProductSpace space = ProductSpace::from_list(o, o, {id[0], id[1], id[2], id[3], id[4]});
+  return ProductSpace::from_list(o, o, {id[0], id[1], id[2], id[3], id[4]});
+}
+
+}  // namespace
+
+TEST_CASE("rounding: a fixing of an earlier round that leaves no binary solution is undone") {
+  // odd_cycle_behind_a: a is free and a' costs 10, so the LP picks a = 1 (x = 1/2). Round 1
+  // fixes a; round 2 finds that x1 can be neither 1 nor 0; only undoing round 1's fixing (a = 0)
+  // leads to the binary solution.
+  const LpProblem lp = odd_cycle_behind_a();
+  const ProductSpace space = five_variables();
   RoundingOptions options;
   options.solver = "clp-dual";  // a vertex: x = 1/2 exactly, so round 2 has no candidate above 0.5
   const RoundingResult r = round_to_graph_surface(space, lp, {0, 10, 0, 0, 0}, options);
@@ -435,16 +450,12 @@ TEST_CASE("rounding: a fixing of an earlier round that leaves no binary solution
 }
 
 TEST_CASE("rounding: a stalled remainder is finished by search, releasing the fixings around a part with no binary solution") {
-  // The LP above (a + a' = 1, x_i + x_j + a' = 1): round 1 fixes a, and the x left in round 2 form
-  // an odd cycle with no binary solution. Searched at once (search_stall 0), that part is proved
-  // to have none; the fixing of a within two steps of it is released (not undone as the last
-  // fixing: backtracking is off), and the search over the whole LP then branches past x = 1/2 to
-  // a' = 1.
-  const LpProblem lp = test::dense_lp({{1, 1, 0, 0, 0}, {0, 1, 1, 1, 0}, {0, 1, 0, 1, 1}, {0, 1, 1, 0, 1}},
-                                      {1, 1, 1, 1}, {0, 10, 0, 0, 0});
-  const Mesh o = shapes::octahedron();  // a space of five variables, only for the sizes
-  const auto id = identity_matching(o);
-  const ProductSpace space = ProductSpace::from_list(o, o, {id[0], id[1], id[2], id[3], id[4]});
+  // odd_cycle_behind_a: round 1 fixes a, and the x left in round 2 form an odd cycle with no
+  // binary solution. Searched at once (search_stall 0), that part is proved to have none; the
+  // fixing of a within two steps of it is released (not undone as the last fixing: backtracking
+  // is off), and the search over the whole LP then branches past x = 1/2 to a' = 1.
+  const LpProblem lp = odd_cycle_behind_a();
+  const ProductSpace space = five_variables();
   RoundingOptions options;
   options.solver = "clp-dual";
   options.max_backtracks = 0;

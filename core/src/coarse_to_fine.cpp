@@ -408,6 +408,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
   int ring = options_.ring;
   bool trust_divergence = true;
   bool regional_done = false;
+  bool around_done = false;
   CarriedIterate warm;  // the last attempt's first LP, for the next
   // One more fine ring on these faces (up to `cap` rings); false if none could grow. `last`: the
   // level's regional widening, which comes after max_local_widenings.
@@ -427,6 +428,15 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
     spdlog::warn("level {}: the reduced LP is {}; widening {} of {} faces by one ring", l + 1, why, widened,
                  lx.mesh.num_faces());
     return true;
+  };
+  // The X faces within `rings` fine rings of every face widened so far at this level.
+  auto around_widened = [&](int rings) {
+    const Mesh& X = lx.mesh;
+    std::vector<char> near(X.num_vertices(), 0);
+    for (int f = 0; f < X.num_faces() && f < int(extra.size()); ++f)
+      if (extra[f] > 0)
+        for (int v : X.faces[f]) near[v] = 1;
+    return faces_on(X, near, rings);
   };
   // Widens around a proof (its place): the X faces on it first; where the same faces come back
   // (the X side alone did not help) also those that map next to its Y side; where every one of
@@ -484,6 +494,14 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
       ProofPlace place(m);
       if (conflict_places(m, kMaxConflictPlaces, options_.widen_margin, place) > 0 && widen_at(m, place, "infeasible"))
         continue;
+      if (options_.widen_around > 0 && !around_done && local > 0) {
+        around_done = true;
+        if (widen_locally(around_widened(options_.widen_around), "infeasible nearby (pre-emptively)",
+                          options_.max_ring + kMaxRingBeyond, true)) {
+          ++rep.margin_widenings;
+          continue;
+        }
+      }
     }
     try {
       RoundingOptions ro = rounding_for(l);
@@ -520,12 +538,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
       // the next one next to it; ring 2 everywhere then meant 23.9 M variables against 14.1 M).
       if (!regional_done && local > 0) {
         regional_done = true;
-        const Mesh& X = lx.mesh;
-        std::vector<char> near(X.num_vertices(), 0);
-        for (int f = 0; f < X.num_faces(); ++f)
-          if (extra[f] > 0)
-            for (int v : X.faces[f]) near[v] = 1;
-        if (widen_locally(faces_on(X, near, kRegionRings), "infeasible", options_.max_ring + kMaxRingBeyond, true)) {
+        if (widen_locally(around_widened(kRegionRings), "infeasible", options_.max_ring + kMaxRingBeyond, true)) {
           spdlog::info("level {}: widened around all earlier local widenings ({} rings)", l + 1, kRegionRings);
           ++rep.margin_widenings;
           continue;

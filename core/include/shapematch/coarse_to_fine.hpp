@@ -68,6 +68,11 @@ struct CoarseToFineOptions {
   // 20 s), but on 020-024 at 2000 faces it widened 1311 of 2000 faces and still left an LP that
   // PDHG needed 111 s to prove infeasible; at 0 one widening of 335 faces gave a feasible LP.
   int widen_margin = 0;
+  // Once propagation has no more contradictions to show at a level where it found some, every X
+  // face within this many fine rings of the faces widened so far gets one more ring before the
+  // first LP: PDHG takes minutes to show an infeasibility that propagation misses (FAUST_r
+  // 020-024 at full resolution: 141 s, after two propagation widenings). 0: off.
+  int widen_around = 0;
   // More fine rings on Y at every ring (fine neighbourhood): a wider space from the start, paid
   // for in variables, against infeasible reduced LPs whose proof PDHG must find (slow at
   // 10 k faces).
