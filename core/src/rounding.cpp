@@ -269,6 +269,9 @@ struct JoinedSolve {
   std::vector<double> proof;
   bool suspect = false;
   int64_t parts = 1, exact_parts = 0;
+  // Every row of the parts that are infeasible (or, where none is, suspect), in the LP's
+  // numbering: wider than the certificate's rows, for blaming a batch from a capped LP.
+  std::vector<int64_t> failed_rows;
 };
 
 bool looks_infeasible(const LpResult& r) {
@@ -331,7 +334,9 @@ JoinedSolve solve_in_parts(const LpProblem& lp, SolverParams params, LpSolver& s
       return out;
     }
     if (s.status == LpStatus::Infeasible) {
+      if (!infeasible) out.failed_rows.clear();  // drop the suspect parts' rows
       infeasible = true;
+      out.failed_rows.insert(out.failed_rows.end(), part.rows.begin(), part.rows.end());
       for (size_t i = 0; i < part.rows.size() && i < s.y.size(); ++i) out.proof[part.rows[i]] = s.y[i];
       if (s.y.empty())  // no ray (Clp): the whole part is the proof
         for (int64_t i : part.rows) out.proof[i] = 1.0;
@@ -344,6 +349,7 @@ JoinedSolve solve_in_parts(const LpProblem& lp, SolverParams params, LpSolver& s
     if (s.status != LpStatus::Optimal && r.status == LpStatus::Optimal) r.status = s.status;
     if (looks_infeasible(s)) {
       out.suspect = true;
+      if (!infeasible) out.failed_rows.insert(out.failed_rows.end(), part.rows.begin(), part.rows.end());
       for (size_t i = 0; i < part.rows.size(); ++i) suspect_proof[part.rows[i]] = s.y[i];
     }
     for (size_t j = 0; j < part.cols.size(); ++j) r.x[part.cols[j]] = s.x[j];
@@ -845,7 +851,6 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
     int64_t ones = 0, zeros = 0;
     std::vector<std::pair<int64_t, int>> batch;
     bool capped = false;  // fixed from an LP stopped at its iteration cap
-    int trims = 0;        // times an infeasibility proof took part of it back
   };
   std::vector<Step> history;  // the fixings so far, to undo when a later LP is infeasible
   std::unordered_set<int64_t> refuted;  // fixings to 1 an infeasibility proof blamed, not tried again
@@ -884,12 +889,12 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
       // batch by what each proof blames costs a solve per few fixings (measured, TOSCA_r horse0-5
       // at full resolution: 3 858 fixings from a capped round, then 9 infeasible rounds blaming
       // 5-46 each, the last ones identical).
-      // Where a proof blames only a few of them, those few go first (measured, FAUST_r 020-024
-      // at full resolution with --widen-around 3: proofs blamed 8 of 3 192 and 7 of 4 130
-      // fixings, and undoing whole batches unwound three capped rounds, each LP then longer);
-      // a second infeasible LP after the same batch undoes it whole.
+      // Where the proof (for such a batch: every row of the infeasible parts) blames at most a
+      // quarter of it, only those go (measured, FAUST_r 020-024 at full resolution with
+      // --widen-around 3: certificates blamed 8 of 3 192 and then 3 of 3 184 fixings, and
+      // undoing whole batches unwound three capped rounds, each LP then longer).
       const size_t blamed = step.batch.size() - away_from_proof.size();
-      const bool few_blamed = !away_from_proof.empty() && 4 * blamed <= step.batch.size() && step.trims == 0;
+      const bool few_blamed = !away_from_proof.empty() && 4 * blamed <= step.batch.size();
       if (first && step.capped && cap_scale < kMaxCapScale && !few_blamed) {
         cap_scale *= 2.0;
         spdlog::debug("rounding: undoing the {} fixings from a capped LP; the cap grows {}x", step.batch.size(),
@@ -910,7 +915,6 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
         for (const auto& a : step.batch)
           if (a.second == 1 && !kept.count(a.first)) refuted.insert(a.first);
         smaller = std::move(away_from_proof);
-        ++step.trims;
       }
       else if (smaller.size() > 1) smaller.resize(smaller.size() / 2);
       else if (smaller.front().second == 1) smaller.front().second = 0;  // the single variable cannot be 1
@@ -1136,7 +1140,14 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
         throw InfeasibleError("rounding: the matching LP is infeasible", certificate_rows(joined.proof, red.rows));
       info.undone = true;
       // What is left of the last fixing (nothing where one from a capped LP was undone whole).
-      const bool whole = backtrack(certificate_rows(joined.proof, red.rows));
+      // A batch from a capped LP is blamed by the whole parts that failed: its iterate was far
+      // from the optimum everywhere near them, not only on the certificate's rows.
+      std::vector<int64_t> blame = certificate_rows(joined.proof, red.rows);
+      if (!history.empty() && history.back().capped && !joined.failed_rows.empty()) {
+        blame.clear();
+        for (int64_t i : joined.failed_rows) blame.push_back(red.rows[i]);
+      }
+      const bool whole = backtrack(blame);
       info.fixed_to_one = whole ? 0 : fixer.state().ones - history.back().ones;
       info.fixed_to_zero = whole ? 0 : fixer.state().zeros - history.back().zeros;
       info.seconds = clock.seconds();
