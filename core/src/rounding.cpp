@@ -581,7 +581,6 @@ std::vector<std::pair<int64_t, int>> away_from_undecided(const LpProblem& lp, co
   return kept.empty() ? batch : kept;
 }
 
-
 // How a depth-first search for a binary solution of one part ended.
 enum class SearchEnd { found, none, node_limit };
 
@@ -679,6 +678,7 @@ std::vector<char> columns_near(const LpProblem& lp, const std::vector<int64_t>& 
   }
   return col_seen;
 }
+
 }  // namespace
 
 int64_t propagation_conflict(const LpProblem& lp, const std::vector<char>& skip) {
@@ -972,10 +972,12 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
       fixer.undo_to(history.front().mark);
       history.clear();
       refuted.clear();
-      Step rest{fixer.mark(), fixer.state().ones, fixer.state().zeros, {}, false};
-      // Fewer fixings propagate to a subset of a consistent state, so this goes through whole.
-      rest.batch = shrink_and_fix(fixer, kept, rest.mark, true);
-      history.push_back(std::move(rest));
+      if (!kept.empty()) {  // (a step with an empty batch would have nothing to halve)
+        Step rest{fixer.mark(), fixer.state().ones, fixer.state().zeros, {}, false};
+        // Fewer fixings propagate to a subset of a consistent state, so this goes through whole.
+        rest.batch = shrink_and_fix(fixer, kept, rest.mark, true);
+        history.push_back(std::move(rest));
+      }
       spdlog::debug("rounding: released {} fixings within {} steps of a part without a binary solution",
                     all - static_cast<int64_t>(kept.size()), depth);
       return all - static_cast<int64_t>(kept.size());
