@@ -137,16 +137,21 @@ int run_match(const MatchArgs& args) {
     const std::string at = matcher.x_levels().size() > 1 ? fmt::format("level {} ", level.level + 1) : std::string();
     const std::string parts = r.parts > 1 ? fmt::format(" in {} parts", r.parts) : std::string();
     if (r.searched_parts > 0 || r.released > 0) {  // a search round (RoundingOptions::search_below)
-      spdlog::info("{}round {:>2}: {:>9} variables{}, searched: {} parts finished in {} nodes, fixed {} to 1 and {} "
-                   "to 0{} ({:.2f} s)",
+      spdlog::info("{}round {:>2}: {:>9} variables{}, searched: {} parts finished in {} nodes, net fixed {} to 1 and "
+                   "{} to 0{} ({:.2f} s)",
                    at, r.round, r.variables, parts, r.searched_parts, r.iterations, r.fixed_to_one, r.fixed_to_zero,
                    r.released > 0 ? fmt::format(", released {} fixings around the rest", r.released) : std::string(),
                    r.seconds);
       return;
     }
-    spdlog::info("{}round {:>2}: {:>9} variables{}, LP {} in {} it, objective {:.6g}, fixed {} to 1 and {} to 0{} ({:.2f} s)",
-                 at, r.round, r.variables, parts, to_string(r.status), r.iterations, r.objective, r.fixed_to_one,
-                 r.fixed_to_zero, r.undone ? " (undone: fixed fewer)" : "", r.seconds);
+    // A backtrack over an earlier round leaves fewer fixed than before: say "undid", not "fixed -n".
+    const std::string fixed = r.fixed_to_one <= 0 && r.fixed_to_zero <= 0 && r.fixed_to_one + r.fixed_to_zero < 0
+                                  ? fmt::format("undid {} to 1 and {} to 0 of earlier rounds", -r.fixed_to_one,
+                                                -r.fixed_to_zero)
+                                  : fmt::format("fixed {} to 1 and {} to 0", r.fixed_to_one, r.fixed_to_zero);
+    spdlog::info("{}round {:>2}: {:>9} variables{}, LP {} in {} it, objective {:.6g}, {}{} ({:.2f} s)", at, r.round,
+                 r.variables, parts, to_string(r.status), r.iterations, r.objective, fixed,
+                 r.undone ? " (undone: fixed fewer)" : "", r.seconds);
   });
   const MatchingLp& m = c2f.finest;
   const RoundingResult& rr = c2f.rounding;
