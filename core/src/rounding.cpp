@@ -877,11 +877,10 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
       away_from_proof =
           fixings_away_from(lp, fixer.state().value, proof, history.back().batch,
                             fixer.assigned_since(history.back().mark));
-    // A batch that a proof has trimmed before: its fixings within 4, 8, 16 … LP steps of this
-    // proof go too (measured, FAUST_r 021-024 at full resolution: proofs blamed 11-82 of about
-    // 1 500 fixings of a capped round, one 15 s round each, for 15 rounds; then 1-14 of 2 700 of
-    // an uncapped one, 25-35 s each, for 8 rounds).
-    if (!away_from_proof.empty() && history.back().trims > 0) {
+    // A batch from a capped LP that a proof has trimmed before: its fixings within 4, 8, 16 … LP
+    // steps of this proof go too (measured, FAUST_r 021-024 at full resolution: proofs over the
+    // failed parts blamed 11-82 of about 1 500 fixings, one 15 s round each, for 15 rounds).
+    if (!away_from_proof.empty() && history.back().capped && history.back().trims > 0) {
       const std::vector<char> near = columns_near(lp, proof, 2 << std::min(history.back().trims, 10));
       std::erase_if(away_from_proof, [&](const std::pair<int64_t, int>& a) { return near[a.first] != 0; });
       spdlog::debug("rounding: trimmed {} times before: {} of {} fixings stay", history.back().trims,
