@@ -851,7 +851,6 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
     int64_t ones = 0, zeros = 0;
     std::vector<std::pair<int64_t, int>> batch;
     bool capped = false;  // fixed from an LP stopped at its iteration cap
-    int trims = 0;        // times an infeasibility proof took part of it back
   };
   std::vector<Step> history;  // the fixings so far, to undo when a later LP is infeasible
   std::unordered_set<int64_t> refuted;  // fixings to 1 an infeasibility proof blamed, not tried again
@@ -877,15 +876,6 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
       away_from_proof =
           fixings_away_from(lp, fixer.state().value, proof, history.back().batch,
                             fixer.assigned_since(history.back().mark));
-    // A batch from a capped LP that a proof has trimmed before: its fixings within 4, 8, 16 … LP
-    // steps of this proof go too (measured, FAUST_r 021-024 at full resolution: proofs over the
-    // failed parts blamed 11-82 of about 1 500 fixings, one 15 s round each, for 15 rounds).
-    if (!away_from_proof.empty() && history.back().capped && history.back().trims > 0) {
-      const std::vector<char> near = columns_near(lp, proof, 2 << std::min(history.back().trims, 10));
-      std::erase_if(away_from_proof, [&](const std::pair<int64_t, int>& a) { return near[a.first] != 0; });
-      spdlog::debug("rounding: trimmed {} times before: {} of {} fixings stay", history.back().trims,
-                    away_from_proof.size(), history.back().batch.size());
-    }
     for (bool first = true;; first = false) {
       if (history.empty() || ++backtracks > options.max_backtracks)
         throw InfeasibleError(history.empty() ? "rounding: no consistent fixing exists (no binary solution)"
@@ -925,7 +915,6 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
         for (const auto& a : step.batch)
           if (a.second == 1 && !kept.count(a.first)) refuted.insert(a.first);
         smaller = std::move(away_from_proof);
-        ++step.trims;
       }
       else if (smaller.size() > 1) smaller.resize(smaller.size() / 2);
       else if (smaller.front().second == 1) smaller.front().second = 0;  // the single variable cannot be 1
