@@ -216,6 +216,17 @@ struct Part {
   std::vector<int64_t> cols, rows;  // in the split LP's numbering
 };
 
+// The LP itself as its one part: columns and rows numbered as they are; `lp` left empty (the
+// caller uses the LP itself, not a copy).
+Part whole_part(const LpProblem& lp) {
+  Part p;
+  p.cols.resize(lp.cols());
+  p.rows.resize(lp.rows());
+  std::iota(p.cols.begin(), p.cols.end(), 0);
+  std::iota(p.rows.begin(), p.rows.end(), 0);
+  return p;
+}
+
 // Empty where the LP is a single part.
 std::vector<Part> split_into_parts(const LpProblem& lp) {
   const int64_t m = lp.rows(), n = lp.cols();
@@ -286,13 +297,7 @@ JoinedSolve solve_in_parts(const LpProblem& lp, SolverParams params, LpSolver& s
   std::vector<Part> parts;
   if (split) parts = split_into_parts(lp);
   const bool whole = parts.empty();
-  if (whole) {  // the LP itself, numbered as it is
-    parts.resize(1);
-    parts[0].cols.resize(lp.cols());
-    parts[0].rows.resize(lp.rows());
-    std::iota(parts[0].cols.begin(), parts[0].cols.end(), 0);
-    std::iota(parts[0].rows.begin(), parts[0].rows.end(), 0);
-  }
+  if (whole) parts.push_back(whole_part(lp));
   out.parts = static_cast<int64_t>(parts.size());
   LpResult& r = out.r;
   r.status = LpStatus::Optimal;
@@ -960,14 +965,14 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
                                 std::to_string(releases - 1) + " releases of the fixings near it",
                             fixer.unsatisfied_rows());
     constexpr int kMaxDepth = 1 << 12;
+    int64_t all = 0;  // fixings made so far
+    for (const Step& st : history) all += static_cast<int64_t>(st.batch.size());
     for (int depth = 2 << std::min(releases - 1, 5); depth <= kMaxDepth; depth *= 2) {
       const std::vector<char> near = columns_near(lp, rows, depth);
       std::vector<std::pair<int64_t, int>> kept;
       for (const Step& st : history)
         for (const auto& a : st.batch)
           if (!near[a.first]) kept.push_back(a);
-      int64_t all = 0;
-      for (const Step& st : history) all += static_cast<int64_t>(st.batch.size());
       if (static_cast<int64_t>(kept.size()) == all) continue;  // nothing within reach yet
       fixer.undo_to(history.front().mark);
       history.clear();
@@ -990,20 +995,15 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
   auto search_round = [&](const Reduced& red, RoundingRound& info) {
     if (!search_solver) search_solver = make_solver("clp-dual");
     std::vector<Part> parts = split_into_parts(red.lp);
-    if (parts.empty()) {
-      parts.resize(1);
-      parts[0].lp = red.lp;
-      parts[0].cols.resize(red.lp.cols());
-      parts[0].rows.resize(red.lp.rows());
-      std::iota(parts[0].cols.begin(), parts[0].cols.end(), 0);
-      std::iota(parts[0].rows.begin(), parts[0].rows.end(), 0);
-    }
+    const bool whole = parts.empty();
+    if (whole) parts.push_back(whole_part(red.lp));
     std::vector<std::pair<int64_t, int>> found;
     std::vector<int64_t> stuck;
     int64_t nodes = 0;
     for (const Part& part : parts) {
       std::vector<int8_t> value;
-      if (search_part(part.lp, *search_solver, base_params, options.search_nodes, value, nodes) == SearchEnd::found) {
+      const LpProblem& plp = whole ? red.lp : part.lp;
+      if (search_part(plp, *search_solver, base_params, options.search_nodes, value, nodes) == SearchEnd::found) {
         ++info.searched_parts;
         for (size_t k = 0; k < part.cols.size(); ++k) found.push_back({red.cols[part.cols[k]], value[k]});
       } else {
