@@ -136,7 +136,7 @@ int run_match(const MatchArgs& args) {
   const CoarseToFineResult c2f = matcher.run([&](const LevelReport& level, const RoundingRound& r) {
     const std::string at = matcher.x_levels().size() > 1 ? fmt::format("level {} ", level.level + 1) : std::string();
     const std::string parts = r.parts > 1 ? fmt::format(" in {} parts", r.parts) : std::string();
-    if (r.searched_parts > 0 || r.released > 0) {  // a search round (RoundingOptions::search_below)
+    if (r.search) {  // a search round (RoundingOptions::search_below)
       spdlog::info("{}round {:>2}: {:>9} variables{}, searched: {} parts finished in {} nodes, net fixed {} to 1 and "
                    "{} to 0{} ({:.2f} s)",
                    at, r.round, r.variables, parts, r.searched_parts, r.iterations, r.fixed_to_one, r.fixed_to_zero,
@@ -149,9 +149,11 @@ int run_match(const MatchArgs& args) {
                                   ? fmt::format("undid {} to 1 and {} to 0 of earlier rounds", -r.fixed_to_one,
                                                 -r.fixed_to_zero)
                                   : fmt::format("fixed {} to 1 and {} to 0", r.fixed_to_one, r.fixed_to_zero);
+    const std::string undone = r.released > 0 ? fmt::format(" (failed again: released {} fixings around it)", r.released)
+                               : r.undone       ? std::string(" (undone: fixed fewer)")
+                                                : std::string();
     spdlog::info("{}round {:>2}: {:>9} variables{}, LP {} in {} it, objective {:.6g}, {}{} ({:.2f} s)", at, r.round,
-                 r.variables, parts, to_string(r.status), r.iterations, r.objective, fixed,
-                 r.undone ? " (undone: fixed fewer)" : "", r.seconds);
+                 r.variables, parts, to_string(r.status), r.iterations, r.objective, fixed, undone, r.seconds);
   });
   const MatchingLp& m = c2f.finest;
   const RoundingResult& rr = c2f.rounding;
@@ -227,6 +229,7 @@ int run_match(const MatchArgs& args) {
                       .set("undone", r.undone)
                       .set("parts", r.parts)
                       .set("exact_parts", r.exact_parts)
+                      .set("search", r.search)
                       .set("searched_parts", r.searched_parts)
                       .set("released", r.released)
                       .set("seconds", r.seconds));
