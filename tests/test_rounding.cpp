@@ -655,38 +655,6 @@ TEST_CASE("rounding: an undone fixing whose blamed part comes back by propagatio
   CHECK(r.rounds[2].status == LpStatus::Optimal);  // another LP than round 2's
 }
 
-TEST_CASE("rounding: a part that fails again after its last fixing was trimmed releases the fixings around it") {
-  // cycle_behind_a_fixing with b1 and b2 both linked to a (b_k = 1 forces a = 1, and a = 1 leaves
-  // the cycle's LP infeasible): round 1 fixes b1, b2 and a; the proof after it blames a, and the
-  // b left after trimming forces a again, so the cycle's part fails a second time. Then the
-  // fixings around that part (the b, any round's) are released and not retried, where trimming
-  // would go on halving the last batch. (Here both end at the optimum, energy 30: b1' = b2' =
-  // a' = 1; the measured case is at full resolution, docs/results.md.) The search is off so
-  // that only the LP rounds act.
-  RoundingOptions options;
-  options.lp.threads = 1;  // the same iterates on any machine
-  options.search_below = 0;
-  options.release_repeated = true;
-  const RoundingResult r = round_cycle(options, 2);
-  CHECK(r.energy == 30.0);
-  int64_t released = 0;
-  bool after_failure = false;
-  for (size_t k = 1; k < r.rounds.size(); ++k)
-    if (r.rounds[k].released > 0) {
-      released += r.rounds[k].released;
-      CHECK(r.rounds[k].undone);
-      CHECK(!r.rounds[k].search);  // an LP round
-      CHECK(r.rounds[k].status != LpStatus::Optimal);
-      after_failure = after_failure || r.rounds[k - 1].status == LpStatus::Infeasible;
-    }
-  CHECK(released > 0);
-  CHECK(after_failure);
-  options.release_repeated = false;
-  const RoundingResult t = round_cycle(options, 2);
-  CHECK(t.energy == 30.0);
-  for (const RoundingRound& k : t.rounds) CHECK(k.released == 0);
-}
-
 TEST_CASE("rounding: a part at its iteration cap goes on from its iterate before it is fixed from it") {
   // The dolphins at 60 faces with every LP capped at 300 PDHG iterations: round 1 fixes from its
   // capped iterate (the first LP is not held back), and round 2's LP over the rest stops at its

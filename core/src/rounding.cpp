@@ -486,7 +486,8 @@ std::vector<std::pair<int64_t, int>> fractional_batch(const LpProblem& lp, const
 std::vector<std::pair<int64_t, int>> fixings_away_from(const LpProblem& lp, const std::vector<int8_t>& value,
                                                        const std::vector<int64_t>& proof,
                                                        const std::vector<std::pair<int64_t, int>>& batch,
-                                                       const std::vector<int64_t>& assigned) {
+                                                       const std::vector<int64_t>& assigned,
+                                                       int64_t* blamed_count = nullptr) {
   std::vector<char> near(lp.rows(), 0);  // proof rows and the rows of their free variables
   for (int64_t i : proof) {
     near[i] = 1;
@@ -521,9 +522,11 @@ std::vector<std::pair<int64_t, int>> fixings_away_from(const LpProblem& lp, cons
   std::vector<std::pair<int64_t, int>> kept;
   for (size_t n = 0; n < batch.size(); ++n)
     if (!blamed[n]) kept.push_back(batch[n]);
+  const int64_t count = static_cast<int64_t>(batch.size() - kept.size());
+  if (blamed_count) *blamed_count = count;
   if (kept.size() == batch.size()) kept.clear();
-  spdlog::debug("rounding: the infeasibility proof ({} rows) blames {} of {} fixings", proof.size(),
-                batch.size() - kept.size(), batch.size());
+  spdlog::debug("rounding: the infeasibility proof ({} rows) blames {} of {} fixings", proof.size(), count,
+                batch.size());
   return kept;
 }
 
@@ -1047,7 +1050,6 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
   };
   int64_t fewest_free = std::numeric_limits<int64_t>::max();
   int stalled = 0;
-  std::vector<char> last_failed;  // rows of the parts the last infeasible LP failed in (release_repeated)
   bool waited = false;            // the last round fixed nothing: only capped parts were left
   for (int round = 1, forward = 0; fixer.state().unsatisfied > 0; ++round) {
     // Out of rounds: no binary solution found in this space. An InfeasibleError with the open
@@ -1159,28 +1161,38 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
       info.undone = true;
       std::vector<int64_t> failed;  // the failed parts' rows, in the full LP's numbering
       for (int64_t i : joined.failed_rows) failed.push_back(red.rows[i]);
-      // The same region failing again: what was trimmed from the last fixing was not the fault
-      // (measured, FAUST_r 021-024 at full resolution: an infeasible part grew from 21 537 to
-      // 170 875 rows over 17 rounds, each trimming 16-82 fixings of the last batch next to it).
-      bool repeated = false;
-      if (options.release_repeated && !last_failed.empty() && failed.size() < red.rows.size())
-        repeated = std::any_of(failed.begin(), failed.end(), [&](int64_t i) { return last_failed[i] != 0; });
-      if (repeated) {
+      // What is left of the last fixing (nothing where one from a capped LP was undone whole).
+      // A batch from a capped LP is blamed by the whole parts that failed: its iterate was far
+      // from the optimum everywhere near them, not only on the certificate's rows.
+      std::vector<int64_t> blame = certificate_rows(joined.proof, red.rows);
+      if (history.back().capped && !failed.empty()) blame = failed;
+      // Parts are independent, so a failed part that no fixing of the last round touches failed
+      // because of earlier fixings (its LP had stopped at its cap before: converged_first), or
+      // has not failed yet: it only looks infeasible at its cap. Measured, FAUST_r 020-021 at full
+      // resolution: a 578 589-variable part looked infeasible after the last round fixed 27 in
+      // other parts, and halving those 27 solved the same LP five times.
+      int64_t touched = -1;
+      if (options.converged_first && !history.back().batch.empty())
+        fixings_away_from(lp, fixer.state().value, blame.empty() ? failed : blame, history.back().batch,
+                          fixer.assigned_since(history.back().mark), &touched);
+      const bool proven = r.status == LpStatus::Infeasible;
+      if (touched == 0 && !proven && cap_scale < kMaxCapScale) {
+        cap_scale *= 2.0;
+        spdlog::debug("round {}: a part at its cap looks infeasible, away from the last fixing: it goes on from its "
+                      "iterate, the cap {}x",
+                      round, cap_scale);
+        for (size_t j = 0; j < red.cols.size(); ++j) x_full[red.cols[j]] = r.x[j];
+        for (size_t i = 0; i < red.rows.size() && i < r.y.size(); ++i) y_full[red.rows[i]] = r.y[i];
+        info.undone = false;
+        ++forward;
+      } else if (touched == 0 && !failed.empty() && failed.size() < red.rows.size()) {
         const int64_t ones = fixer.state().ones, zeros = fixer.state().zeros;
-        spdlog::debug("round {}: the part that failed before failed again ({} rows): releasing around it", round,
-                      failed.size());
+        spdlog::debug("round {}: a part failed away from the last fixing ({} rows): releasing the fixings around it",
+                      round, failed.size());
         info.released = release_around(failed, true);
-        last_failed.clear();
         info.fixed_to_one = fixer.state().ones - ones;
         info.fixed_to_zero = fixer.state().zeros - zeros;
       } else {
-        last_failed.assign(lp.rows(), 0);
-        for (int64_t i : failed) last_failed[i] = 1;
-        // What is left of the last fixing (nothing where one from a capped LP was undone whole).
-        // A batch from a capped LP is blamed by the whole parts that failed: its iterate was far
-        // from the optimum everywhere near them, not only on the certificate's rows.
-        std::vector<int64_t> blame = certificate_rows(joined.proof, red.rows);
-        if (!history.empty() && history.back().capped && !failed.empty()) blame = failed;
         const bool whole = backtrack(blame);
         info.fixed_to_one = whole ? 0 : fixer.state().ones - history.back().ones;
         info.fixed_to_zero = whole ? 0 : fixer.state().zeros - history.back().zeros;

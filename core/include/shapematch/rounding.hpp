@@ -39,7 +39,9 @@ struct RoundingOptions {
   int64_t later_round_min_iterations = 2000;
   // A round whose LP stopped at its cap in some parts fixes only from the parts that converged;
   // the others go on from their iterate next round, and are fixed from an unconverged iterate
-  // only after one round more with nothing else left.
+  // only after one round more with nothing else left. A part that then fails where no fixing of
+  // the last round touches it goes on from its iterate with twice the cap where it only looks
+  // infeasible, and releases the fixings of every round around it where it is proved so.
   bool converged_first = true;
   // Where the candidates of a round clash (propagation refutes fixing them all), a round whose LP
   // has more free variables than this fixes each candidate that does not clash with the larger
@@ -76,12 +78,6 @@ struct RoundingOptions {
   int search_stall = 3;
   int64_t search_nodes = 2000;
   int max_releases = 12;
-  // Where an LP after a fixing is infeasible (or looks it, at its cap) in a part that overlaps
-  // the part that failed the time before, trimming the last fixing has not cured it: the fault
-  // lies in the fixings of earlier rounds around it, which are released as for a searched part
-  // without a binary solution (counted against max_releases). Only where the LP has other parts
-  // (releasing around the whole LP would start over).
-  bool release_repeated = false;
   int max_backtracks = 200;    // fixings undone after an infeasible LP (each one more, smaller LP
                                // solve), then fail with InfeasibleError naming the open rows
   std::string solver = "pdhg-cpu";
@@ -113,7 +109,7 @@ struct RoundingRound {
   int64_t searched_parts = 0;  // parts finished by search (search_below); iterations: its nodes
   bool search = false;         // finished by search (search_below), not by an LP
   int64_t released = 0;        // fixings released around parts without a binary solution (search)
-                               // or around a part whose LP failed twice (release_repeated)
+                               // or around a failed part no fixing of the last round touched
 };
 
 struct RoundingResult {
