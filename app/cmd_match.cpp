@@ -37,6 +37,7 @@ struct MatchArgs {
   int64_t greedy_above = RoundingOptions{}.greedy_above;
   int greedy_margin = RoundingOptions{}.greedy_margin;
   int64_t search_below = RoundingOptions{}.search_below;
+  bool converged_first = RoundingOptions{}.converged_first;
   double tolerance = 1e-4;
   double coarse_tolerance = CoarseToFineOptions{}.coarse_tolerance;
   double time_limit = std::numeric_limits<double>::infinity();
@@ -123,6 +124,7 @@ int run_match(const MatchArgs& args) {
   ro.greedy_above = args.greedy_above;
   ro.greedy_margin = args.greedy_margin;
   ro.search_below = args.search_below;
+  ro.converged_first = args.converged_first;
   ro.lp.tolerance = args.tolerance;
   ro.lp.time_limit = args.time_limit;
   ro.lp.device = args.device;
@@ -280,6 +282,7 @@ int run_match(const MatchArgs& args) {
                               .set("greedy_above", args.greedy_above)
                               .set("greedy_margin", args.greedy_margin)
                               .set("search_below", args.search_below)
+                              .set("converged_first", args.converged_first)
                               .set("split_parts", !args.whole_lp)
                               .set("tolerance", args.tolerance)
                               .set("coarse_tolerance", co.coarse_tolerance)
@@ -359,6 +362,9 @@ Action add_match_command(CLI::App& app) {
       ->check(CLI::Range(0.0, 1.0))
       ->capture_default_str();
   app.add_option("--max-rounds", a->max_rounds, "rounding rounds before giving up")->capture_default_str();
+  app.add_flag("--converged-first", a->converged_first,
+               "in a later round whose LP stopped at its iteration cap in some parts, fix only from the parts that "
+               "converged; the others go on from their iterate one round more");
   app.add_option("--search-below", a->search_below,
                  "where rounding stalls on at most this many free variables, finish each part by depth-first "
                  "search over exact LPs, releasing the fixings around a part without a binary solution (0: never)")

@@ -667,6 +667,7 @@ TEST_CASE("rounding: a part at its iteration cap goes on from its iterate before
   o.exact_below = 0;
   o.lp.max_iterations = 300;
   o.lp.threads = 1;  // the same iterates on any machine
+  o.converged_first = true;
   const auto waits = [](const RoundingRound& k) {
     return k.status == LpStatus::IterationLimit && !k.undone && k.fixed_to_one == 0 && k.fixed_to_zero == 0;
   };

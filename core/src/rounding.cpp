@@ -1167,12 +1167,13 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
       std::vector<int64_t> blame = certificate_rows(joined.proof, red.rows);
       if (history.back().capped && !failed.empty()) blame = failed;
       // Parts are independent, so a failed part that no fixing of the last round touches failed
-      // because of earlier fixings (its LP had stopped at its cap before: converged_first), or
-      // has not failed yet: it only looks infeasible at its cap. Measured, FAUST_r 020-021 at full
-      // resolution: a 578 589-variable part looked infeasible after the last round fixed 27 in
-      // other parts, and halving those 27 solved the same LP five times.
+      // because of earlier fixings (its LP had stopped at its cap before, or the last fixing was
+      // trimmed to what lies elsewhere), or has not failed yet: it only looks infeasible at its
+      // cap. Measured, FAUST_r 020-021 at full resolution (converged_first): a 578 589-variable
+      // part looked infeasible after the last round fixed 27 in other parts, and halving those 27
+      // solved the same LP five times.
       int64_t touched = -1;
-      if (options.converged_first && !history.back().batch.empty())
+      if (!history.back().batch.empty())
         fixings_away_from(lp, fixer.state().value, blame.empty() ? failed : blame, history.back().batch,
                           fixer.assigned_since(history.back().mark), &touched);
       const bool proven = r.status == LpStatus::Infeasible;
