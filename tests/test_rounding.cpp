@@ -12,6 +12,18 @@
 
 using namespace shapematch;
 
+namespace {
+
+// The dolphins at 60 faces, one bent: a pair small enough for many rounds, built once (the space
+// refers to its meshes, which live as long as the test binary).
+const MatchingLp& dolphins_60() {
+  static const Mesh x = decimate(shapes::dolphin(0, 5), 60), y = decimate(shapes::dolphin(-40, 45), 60);
+  static const MatchingLp m = build_matching_lp(x, compute_geometry(x), y, compute_geometry(y));
+  return m;
+}
+
+}  // namespace
+
 TEST_CASE("rounding: a mesh against itself rounds to the identity with zero gap") {
   // A perturbed octahedron: the regular one has symmetries of zero energy, this one only the identity.
   std::mt19937 rng(9);
@@ -76,8 +88,7 @@ TEST_CASE("rounding: a deformed pair rounds to a verified graph surface within t
 
 TEST_CASE("rounding: later rounds stop at their iteration cap and still end exact") {
   // Threshold 0 on the dolphins at 60 faces: several rounds (see the clashing-candidates test).
-  const Mesh x = decimate(shapes::dolphin(0, 5), 60), y = decimate(shapes::dolphin(-40, 45), 60);
-  const MatchingLp m = build_matching_lp(x, compute_geometry(x), y, compute_geometry(y));
+  const MatchingLp& m = dolphins_60();
   RoundingOptions o;
   o.solver = "pdhg-cpu";
   o.exact_below = 0;  // every round on PDHG, so that the cap applies to each
@@ -104,8 +115,7 @@ TEST_CASE("rounding: a later LP solved in its independent parts has the optimum 
   // Threshold 0 on the dolphins at 60 faces: many rounds, and late ones leave separate patches.
   // Every round after the first on Clp, so both runs agree exactly up to the first round solved
   // in parts, whose joined optimum must then be the whole LP's.
-  const Mesh x = decimate(shapes::dolphin(0, 5), 60), y = decimate(shapes::dolphin(-40, 45), 60);
-  const MatchingLp m = build_matching_lp(x, compute_geometry(x), y, compute_geometry(y));
+  const MatchingLp& m = dolphins_60();
   RoundingOptions o;
   o.solver = "pdhg-cpu";
   o.exact_below = m.lp.cols() + 1;
@@ -131,8 +141,7 @@ TEST_CASE("rounding: later rounds finished by search end in a verified graph sur
   // Threshold 0 on the dolphins at 60 faces (many rounds otherwise), every round after the first
   // searched: each part ends at an integral vertex or by branching, and the joined Γ must still
   // be exact and a graph surface, with an energy above the bound.
-  const Mesh x = decimate(shapes::dolphin(0, 5), 60), y = decimate(shapes::dolphin(-40, 45), 60);
-  const MatchingLp m = build_matching_lp(x, compute_geometry(x), y, compute_geometry(y));
+  const MatchingLp& m = dolphins_60();
   RoundingOptions o;
   o.solver = "pdhg-cpu";
   o.threshold = 0.0;
@@ -270,9 +279,7 @@ TEST_CASE("rounding: a batch full of clashing candidates still ends in an exact 
   // and must be taken back exactly (propagation included). Measured: fixing every candidate that
   // does not clash (greedy) ends in fewer rounds but at a 123 % gap on the 30-face bench pair,
   // against < 100 % for halving the batch; greedy only pays in rounds of millions of variables.
-  const Mesh x = decimate(shapes::dolphin(0, 5), 60), y = decimate(shapes::dolphin(-40, 45), 60);
-  const Geometry gx = compute_geometry(x), gy = compute_geometry(y);
-  const MatchingLp m = build_matching_lp(x, gx, y, gy);
+  const MatchingLp& m = dolphins_60();
   RoundingOptions o;
   o.solver = "pdhg-cpu";
   o.threshold = 0.0;
@@ -660,8 +667,7 @@ TEST_CASE("rounding: a part at its iteration cap goes on from its iterate before
   // capped iterate (the first LP is not held back), and round 2's LP over the rest stops at its
   // cap too. It is not rounded then: round 3 goes on from its iterate, converges, and fixes. With
   // converged_first off, round 2 fixes from its capped iterate at once.
-  const Mesh x = decimate(shapes::dolphin(0, 5), 60), y = decimate(shapes::dolphin(-40, 45), 60);
-  const MatchingLp m = build_matching_lp(x, compute_geometry(x), y, compute_geometry(y));
+  const MatchingLp& m = dolphins_60();
   RoundingOptions o;
   o.solver = "pdhg-cpu";
   o.exact_below = 0;

@@ -973,8 +973,8 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
   // and where two alternatives each fail, refuting only the last released swaps them forever).
   auto release_around = [&](const std::vector<int64_t>& rows, bool refute) {
     if (++releases > options.max_releases || history.empty())
-      throw InfeasibleError("rounding: no binary solution around a stalled part after " +
-                                std::to_string(releases - 1) + " releases of the fixings near it",
+      throw InfeasibleError("rounding: no binary solution around a part after " + std::to_string(releases - 1) +
+                                " releases of the fixings near it",
                             fixer.unsatisfied_rows());
     constexpr int kMaxDepth = 1 << 12;
     int64_t all = 0;  // fixings made so far
@@ -1003,7 +1003,7 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
                     all - static_cast<int64_t>(kept.size()), depth);
       return all - static_cast<int64_t>(kept.size());
     }
-    throw InfeasibleError("rounding: no binary solution around a stalled part, and no fixing near it",
+    throw InfeasibleError("rounding: no binary solution around a part, and no fixing near it",
                           fixer.unsatisfied_rows());
   };
   // Finishes every part of `red` by search; parts without a binary solution release the fixings
