@@ -151,9 +151,11 @@ int run_match(const MatchArgs& args) {
                                   ? fmt::format("undid {} to 1 and {} to 0 of earlier rounds", -r.fixed_to_one,
                                                 -r.fixed_to_zero)
                                   : fmt::format("fixed {} to 1 and {} to 0", r.fixed_to_one, r.fixed_to_zero);
-    const std::string undone = r.released > 0 ? fmt::format(" (a part failed away from the last fixing: released {} fixings around it)", r.released)
-                               : r.undone       ? std::string(" (undone: fixed fewer)")
-                                                : std::string();
+    const std::string undone =
+        r.released > 0 ? fmt::format(" (a part failed away from the last fixing: released {} fixings around it)",
+                                     r.released)
+        : r.undone     ? std::string(" (undone: fixed fewer)")
+                       : std::string();
     spdlog::info("{}round {:>2}: {:>9} variables{}, LP {} in {} it, objective {:.6g}, {}{} ({:.2f} s)", at, r.round,
                  r.variables, parts, to_string(r.status), r.iterations, r.objective, fixed, undone, r.seconds);
   });

@@ -42,9 +42,10 @@ struct RoundingOptions {
   // only after one round more with nothing else left. Off: measured on FAUST_r 020-024 at full
   // resolution it cost a round (47 s) and 0.24 % energy (24.626 against 24.568), and FAUST_r
   // 020-021 did not complete with it either (docs/results.md, eleventh session).
-  // (Always on, whatever this says: a part that fails where no fixing of the last round touches
-  // it goes on from its iterate with twice the cap where it only looks infeasible at its cap, and
-  // releases the fixings of every round around it where it is proved infeasible.)
+  // (Always on, with or without this option: a part that fails where no fixing of the last round
+  // touches it goes on from its iterate with twice the cap where it only looks infeasible at its
+  // cap, and releases the fixings of every round around it where it is proved infeasible or
+  // still looks it at 16x the cap.)
   bool converged_first = false;
   // Where the candidates of a round clash (propagation refutes fixing them all), a round whose LP
   // has more free variables than this fixes each candidate that does not clash with the larger
