@@ -304,11 +304,9 @@ namespace {
 
 // Variables a, a', c, y1..y5, w1, w2, b1, b1', b2, b2'. a + a' = 1; a' = c; y_i + y_{i+1} + c = 1
 // around a 5-cycle; y1 + ... + y5 + w1 + w2 = 2; b_k + b_k' = 1. a' and b_k' cost 10 (`cost`).
-// With `links` k, b1 … bk are linked to a: b_k + a' + s_k = 1 with a slack s_k, so that b_k = 1
-// forces a' = 0, hence a = 1.
-LpProblem cycle_behind_a_fixing(std::vector<double>& cost, int links = 0) {
-  const int n = 14 + links;
-  std::vector<std::vector<int>> rows(10 + links, std::vector<int>(n, 0));
+LpProblem cycle_behind_a_fixing(std::vector<double>& cost, bool linked = false) {
+  const int n = linked ? 15 : 14;
+  std::vector<std::vector<int>> rows(linked ? 11 : 10, std::vector<int>(n, 0));
   rows[0][0] = rows[0][1] = 1;
   rows[1][1] = 1;
   rows[1][2] = -1;
@@ -317,8 +315,8 @@ LpProblem cycle_behind_a_fixing(std::vector<double>& cost, int links = 0) {
   rows[8][10] = rows[8][11] = 1;
   rows[9][12] = rows[9][13] = 1;
   std::vector<double> b{1, 0, 1, 1, 1, 1, 1, 2, 1, 1};
-  for (int k = 0; k < links; ++k) {
-    rows[10 + k][10 + 2 * k] = rows[10 + k][1] = rows[10 + k][14 + k] = 1;
+  if (linked) {  // b1 + a' + s = 1 with a slack s: b1 = 1 forces a' = 0, hence a = 1
+    rows[10][10] = rows[10][1] = rows[10][14] = 1;
     b.push_back(1);
   }
   cost.assign(n, 0.0);
@@ -328,9 +326,9 @@ LpProblem cycle_behind_a_fixing(std::vector<double>& cost, int links = 0) {
 
 // Rounds cycle_behind_a_fixing on a stand-in space of its size (only for the sizes) with
 // PDHG, whose infeasibility proof is a dual point (Clp's names no rows), and checks A x = b.
-RoundingResult round_cycle(RoundingOptions options, int links = 0) {
+RoundingResult round_cycle(RoundingOptions options, bool linked = false) {
   std::vector<double> cost;
-  const LpProblem lp = cycle_behind_a_fixing(cost, links);
+  const LpProblem lp = cycle_behind_a_fixing(cost, linked);
   const Mesh sphere = shapes::icosphere(1);
   const auto id = identity_matching(sphere);
   const ProductSpace space = ProductSpace::from_list(sphere, sphere, {id.begin(), id.begin() + lp.cols()});
@@ -653,7 +651,7 @@ TEST_CASE("rounding: an undone fixing whose blamed part comes back by propagatio
   // 5 zeros again) and the same LP is solved twice.
   RoundingOptions options;
   options.lp.threads = 1;  // the same iterates on any machine
-  const RoundingResult r = round_cycle(options, 1);
+  const RoundingResult r = round_cycle(options, true);
   REQUIRE(r.rounds.size() >= 3);
   CHECK(r.rounds[0].fixed_to_one == 3);
   CHECK(r.rounds[1].status == LpStatus::Infeasible);

@@ -878,18 +878,13 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
   // FAUST 020-024 at 4000 faces got stuck this way in round 15 and lost its whole level. Gives up
   // with the rows still open (so coarse to fine can widen there) when nothing is left to undo or
   // after max_backtracks.
-  // With `proof` (rows of a Farkas certificate of the LP after the last fixing), the last fixing
-  // first loses only its variables near the proof (fixings_away_from): an infeasible LP costs a
-  // full solve, and halving needs about log2(batch) of them where the fault is local.
-  // Returns true where the last fixing was undone whole (one from a capped LP; see there).
-  auto backtrack = [&](const std::vector<int64_t>& proof) {
+  // With `away_from_proof` (the last fixing's assignments an infeasibility proof of the LP after
+  // it does not blame: fixings_away_from), the last fixing first loses only those it blames: an
+  // infeasible LP costs a full solve, and halving needs about log2(batch) of them where the fault
+  // is local. Returns true where the last fixing was undone whole (one from a capped LP; see there).
+  auto backtrack = [&](std::vector<std::pair<int64_t, int>> away_from_proof) {
     std::vector<int64_t> open = fixer.unsatisfied_rows();  // where it got stuck
     const int64_t ones_before = fixer.state().ones, zeros_before = fixer.state().zeros;
-    std::vector<std::pair<int64_t, int>> away_from_proof;
-    if (!proof.empty() && !history.empty() && history.back().batch.size() > 1)
-      away_from_proof =
-          fixings_away_from(lp, fixer.state().value, proof, history.back().batch,
-                            fixer.assigned_since(history.back().mark));
     for (bool first = true;; first = false) {
       if (history.empty() || ++backtracks > options.max_backtracks)
         throw InfeasibleError(history.empty() ? "rounding: no consistent fixing exists (no binary solution)"
@@ -1050,7 +1045,17 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
   };
   int64_t fewest_free = std::numeric_limits<int64_t>::max();
   int stalled = 0;
-  bool waited = false;            // the last round fixed nothing: only capped parts were left
+  bool waited = false;  // the last round fixed nothing: only capped parts were left
+  const auto record = [&](RoundingRound& info, const Stopwatch& clock) {
+    info.seconds = clock.seconds();
+    result.rounds.push_back(info);
+    if (progress) progress(info);
+  };
+  // The round's iterate over the whole LP, the next round's warm start.
+  const auto keep_iterate = [&](const Reduced& red, const LpResult& r) {
+    for (size_t j = 0; j < red.cols.size(); ++j) x_full[red.cols[j]] = r.x[j];
+    for (size_t i = 0; i < red.rows.size(); ++i) y_full[red.rows[i]] = i < r.y.size() ? r.y[i] : 0.0;
+  };
   for (int round = 1, forward = 0; fixer.state().unsatisfied > 0; ++round) {
     // Out of rounds: no binary solution found in this space. An InfeasibleError with the open
     // rows lets coarse to fine widen there rather than give up the whole run.
@@ -1075,9 +1080,7 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
       info.constraints = red.lp.rows();
       info.search = true;
       search_round(red, info);
-      info.seconds = clock.seconds();
-      result.rounds.push_back(info);
-      if (progress) progress(info);
+      record(info, clock);
       continue;
     }
     SolverParams params = base_params;
@@ -1173,17 +1176,17 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
       // part looked infeasible after the last round fixed 27 in other parts, and halving those 27
       // solved the same LP five times.
       int64_t touched = -1;
+      std::vector<std::pair<int64_t, int>> away;  // what the proof leaves of the last fixing
       if (!history.back().batch.empty())
-        fixings_away_from(lp, fixer.state().value, blame.empty() ? failed : blame, history.back().batch,
-                          fixer.assigned_since(history.back().mark), &touched);
+        away = fixings_away_from(lp, fixer.state().value, blame.empty() ? failed : blame, history.back().batch,
+                                 fixer.assigned_since(history.back().mark), &touched);
       const bool proven = r.status == LpStatus::Infeasible;
       if (touched == 0 && !proven && cap_scale < kMaxCapScale) {
         cap_scale *= 2.0;
         spdlog::debug("round {}: a part at its cap looks infeasible, away from the last fixing: it goes on from its "
                       "iterate, the cap {}x",
                       round, cap_scale);
-        for (size_t j = 0; j < red.cols.size(); ++j) x_full[red.cols[j]] = r.x[j];
-        for (size_t i = 0; i < red.rows.size() && i < r.y.size(); ++i) y_full[red.rows[i]] = r.y[i];
+        keep_iterate(red, r);
         info.undone = false;
         ++forward;
       } else if (touched == 0 && !failed.empty() && failed.size() < red.rows.size()) {
@@ -1194,19 +1197,18 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
         info.fixed_to_one = fixer.state().ones - ones;
         info.fixed_to_zero = fixer.state().zeros - zeros;
       } else {
-        const bool whole = backtrack(blame);
+        // (Without a proof, or for a single fixing, nothing local: halve.)
+        if (blame.empty() || history.back().batch.size() < 2) away.clear();
+        const bool whole = backtrack(std::move(away));
         info.fixed_to_one = whole ? 0 : fixer.state().ones - history.back().ones;
         info.fixed_to_zero = whole ? 0 : fixer.state().zeros - history.back().zeros;
       }
-      info.seconds = clock.seconds();
-      result.rounds.push_back(info);
-      if (progress) progress(info);
+      record(info, clock);
       continue;
     }
     if (r.status == LpStatus::NumericalTrouble || r.x.size() != size_t(red.lp.cols()))
       throw SolverError(std::string("rounding: LP solve failed (") + to_string(r.status) + ")");
-    for (size_t j = 0; j < red.cols.size(); ++j) x_full[red.cols[j]] = r.x[j];
-    for (size_t i = 0; i < red.rows.size(); ++i) y_full[red.rows[i]] = r.y.empty() ? 0.0 : r.y[i];
+    keep_iterate(red, r);
 
     // Candidates above the threshold, largest first; if none, the single largest.
     std::vector<int64_t> order(red.cols.size());
@@ -1238,9 +1240,7 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
         waited = true;
         ++forward;
         spdlog::debug("round {}: only parts at their cap are left; they go on from their iterate", round);
-        info.seconds = clock.seconds();
-        result.rounds.push_back(info);
-        if (progress) progress(info);
+        record(info, clock);
         continue;
       } else {
         waited = false;
@@ -1273,9 +1273,7 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
     }
     info.fixed_to_one = fixer.state().ones - ones;
     info.fixed_to_zero = fixer.state().zeros - zeros;
-    info.seconds = clock.seconds();
-    result.rounds.push_back(info);
-    if (progress) progress(info);
+    record(info, clock);
   }
 
   // Every row is satisfied: the remaining free variables are 0.
