@@ -51,6 +51,7 @@ struct MatchArgs {
   int y_margin = CoarseToFineOptions{}.y_margin;
   int max_local_widenings = CoarseToFineOptions{}.max_local_widenings;
   bool warm_widening = CoarseToFineOptions{}.warm_widening;
+  double stuck_after = CoarseToFineOptions{}.stuck_after;
 };
 
 // auto: a GPU if there is one, else the native solver (lavapipe is for testing, not speed).
@@ -112,6 +113,7 @@ int run_match(const MatchArgs& args) {
   co.y_margin = args.y_margin;
   co.max_local_widenings = args.max_local_widenings;
   co.warm_widening = args.warm_widening;
+  co.stuck_after = args.stuck_after;
   co.matching = matching_options(args.pair, p);
   RoundingOptions& ro = co.rounding;
   ro.solver = solver_for(args);
@@ -304,7 +306,8 @@ int run_match(const MatchArgs& args) {
                               .set("widen_around", args.widen_around)
                               .set("y_margin", args.y_margin)
                               .set("max_local_widenings", args.max_local_widenings)
-                              .set("warm_widening", args.warm_widening));
+                              .set("warm_widening", args.warm_widening)
+                              .set("stuck_after", args.stuck_after));
     report.set("seconds", seconds);
     report.set("peak_rss_mb", peak_rss_mb());
     report.set("round_log", rounds);
@@ -322,6 +325,7 @@ int run_match(const MatchArgs& args) {
                       .set("local_widenings", l.local_widenings)
                       .set("margin_widenings", l.margin_widenings)
                       .set("widened_faces", l.widened_faces)
+                      .set("stuck_widenings", l.stuck_widenings)
                       .set("rounds", l.rounds)
                       .set("iterations", l.iterations)
                       .set("lower_bound", l.lower_bound)
@@ -437,6 +441,11 @@ Action add_match_command(CLI::App& app) {
                  "once propagation finds no more contradictions at a level where it found some, one more ring on "
                  "every X face within this many fine rings of those widened so far, before the first LP (0: off)")
       ->check(CLI::Range(0, 64))
+      ->capture_default_str();
+  app.add_option("--stuck-after", a->stuck_after,
+                 "where the LPs after the rounding's fixings at a refined level keep failing for this many times "
+                 "its first LP's seconds, widen the space around them and go on from its fixings (0: off)")
+      ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   app.add_option("--y-margin", a->y_margin,
                  "more fine rings on Y around every face's candidates, at every ring (fine neighbourhood)")

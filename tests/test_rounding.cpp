@@ -380,6 +380,62 @@ TEST_CASE("rounding: a fixing from an LP at its iteration cap is undone whole, a
   CHECK(r.rounds[1].fixed_to_one == 0);  // nothing of round 1's batch is left
 }
 
+TEST_CASE("rounding: where the LPs after its fixings keep failing it gives up with its fixings, if asked") {
+  // cycle_behind_a_fixing: round 2's LP is infeasible (a = 1 leaves the cycle no solution). With
+  // stuck_rounds 1 and any time at all, that one failed round is "stuck": a StuckError naming the
+  // failed rows (on the cycle) and carrying what is fixed to 1 after the proof trimmed a (b1,
+  // b2), with an iterate over the whole LP. Off (stuck_after 0) the same rounds go on to Γ.
+  RoundingOptions options;
+  options.stuck_rounds = 1;
+  options.stuck_after = 1e-12;
+  std::vector<double> cost;
+  const LpProblem lp = cycle_behind_a_fixing(cost);
+  try {
+    round_cycle(options);
+    FAIL("no StuckError");
+  } catch (const StuckError& e) {
+    CHECK(!e.rows().empty());
+    for (int64_t i : e.rows()) CHECK((i >= 1 && i <= 7));  // a' = c and the cycle's rows
+    CHECK(e.ones() == std::vector<int64_t>{10, 12});       // b1, b2
+    CHECK(e.x().size() == size_t(lp.cols()));
+    CHECK(e.y().size() == size_t(lp.rows()));
+  }
+  options.stuck_after = 0.0;
+  CHECK(round_cycle(options).energy == 10.0);
+  // Not yet stuck where fewer rounds failed than stuck_rounds.
+  options.stuck_after = 1e-12;
+  options.stuck_rounds = 2;
+  CHECK(round_cycle(options).energy == 10.0);
+}
+
+TEST_CASE("rounding: it starts from carried fixings to 1, trims them like any fixing, and certifies the bound given") {
+  const RoundingResult plain = round_cycle({});
+  // b1 and b2 carried: they are in Γ, and round 1's LP is what they leave.
+  RoundingOptions options;
+  options.start_ones = {10, 12};
+  RoundingResult r = round_cycle(options);
+  CHECK(r.energy == 10.0);
+  CHECK(std::find(r.gamma.begin(), r.gamma.end(), 10) != r.gamma.end());
+  CHECK(std::find(r.gamma.begin(), r.gamma.end(), 12) != r.gamma.end());
+  REQUIRE(!r.rounds.empty());
+  CHECK(r.rounds[0].variables < plain.rounds[0].variables);
+  // Without a dual for it, no bound is claimed (round 1's is the fixings' LP's, not the whole's).
+  CHECK(r.lower_bound == -std::numeric_limits<double>::infinity());
+  // With the whole LP's first dual, its certified bound: the plain run's exactly.
+  options.start_dual = plain.first_lp.y;
+  r = round_cycle(options);
+  CHECK(r.lower_bound == doctest::Approx(plain.lower_bound));
+  CHECK(r.gap == doctest::Approx(plain.gap));
+  // A carried fixing that leaves no binary solution (a = 1) is trimmed by the proof after it.
+  options.start_ones = {0, 10, 12};
+  r = round_cycle(options);
+  CHECK(r.energy == 10.0);
+  CHECK(std::find(r.gamma.begin(), r.gamma.end(), 0) == r.gamma.end());
+  // One naming no variable is invalid input.
+  options.start_ones = {99};
+  CHECK_THROWS_AS(round_cycle(options), InvalidInputError);
+}
+
 TEST_CASE("rounding: a big round fixes only candidates away from the LP's undecided part") {
   // cycle_behind_a_fixing: a = 0.8 with a' = c = 0.2 next to it, b1 = b2 = 1 with b1' = b2' =
   // 0. Where every round counts as big (greedy_above 0), round 1 fixes b1 and b2 but not a (its

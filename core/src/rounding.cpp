@@ -869,6 +869,20 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
   std::vector<Step> history;  // the fixings so far, to undo when a later LP is infeasible
   std::unordered_set<int64_t> refuted;  // fixings to 1 an infeasibility proof blamed, not tried again
   int backtracks = 0;
+  // A partial Γ carried over (start_ones): one fixing like any other, which backtracking may trim.
+  if (!options.start_ones.empty()) {
+    for (int64_t j : options.start_ones)
+      if (j < 0 || j >= lp.cols()) throw InvalidInputError("rounding: a start fixing names no variable");
+    std::vector<std::pair<int64_t, int>> batch;
+    for (int64_t j : options.start_ones) batch.push_back({j, 1});
+    Step step{fixer.mark(), fixer.state().ones, fixer.state().zeros, {}, false};
+    step.batch = shrink_and_fix(fixer, batch, step.mark, true);
+    spdlog::debug("rounding: starts from {} of {} carried fixings to 1", step.batch.size(), batch.size());
+    if (!step.batch.empty()) history.push_back(std::move(step));
+  }
+  // Rounds in a row whose LP failed, and their seconds (stuck_after).
+  int failing_rounds = 0;
+  double failing_seconds = 0.0;
   // Multiplies the later rounds' iteration cap: doubled each time a fixing from a capped LP is
   // undone whole (below), up to kMaxCapScale.
   double cap_scale = 1.0;
@@ -1051,6 +1065,13 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
     result.rounds.push_back(info);
     if (progress) progress(info);
   };
+  // Giving up where the caller can widen (stuck_after): the fixings to 1 so far and the iterate go with it.
+  const auto stuck = [&](const std::string& what, std::vector<int64_t> rows) {
+    std::vector<int64_t> ones;
+    for (int64_t j = 0; j < lp.cols(); ++j)
+      if (fixer.state().value[j] == 1) ones.push_back(j);
+    return StuckError(what, std::move(rows), std::move(ones), x_full, y_full);
+  };
   // The round's iterate over the whole LP, the next round's warm start.
   const auto keep_iterate = [&](const Reduced& red, const LpResult& r) {
     for (size_t j = 0; j < red.cols.size(); ++j) x_full[red.cols[j]] = r.x[j];
@@ -1059,10 +1080,12 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
   for (int round = 1, forward = 0; fixer.state().unsatisfied > 0; ++round) {
     // Out of rounds: no binary solution found in this space. An InfeasibleError with the open
     // rows lets coarse to fine widen there rather than give up the whole run.
-    if (forward >= options.max_rounds)
-      throw InfeasibleError("rounding did not reach a binary solution in " + std::to_string(options.max_rounds) +
-                                " rounds (raise --max-rounds or lower --threshold)",
-                            fixer.unsatisfied_rows());
+    if (forward >= options.max_rounds) {
+      const std::string what = "rounding did not reach a binary solution in " + std::to_string(options.max_rounds) +
+                               " rounds (raise --max-rounds or lower --threshold)";
+      if (options.stuck_after > 0.0) throw stuck(what, fixer.unsatisfied_rows());
+      throw InfeasibleError(what, fixer.unsatisfied_rows());
+    }
     Stopwatch clock;
     const Reduced red = reduce(lp, fixer.state());
     if (red.lp.cols() < fewest_free) {
@@ -1204,8 +1227,18 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
         info.fixed_to_zero = whole ? 0 : fixer.state().zeros - history.back().zeros;
       }
       record(info, clock);
+      ++failing_rounds;
+      failing_seconds += info.seconds;
+      std::vector<int64_t> where = failed.empty() ? certificate_rows(joined.proof, red.rows) : failed;
+      if (options.stuck_after > 0.0 && failing_rounds >= options.stuck_rounds && !where.empty() &&
+          failing_seconds > options.stuck_after * result.rounds.front().seconds)
+        throw stuck("rounding: stuck, the LPs after its fixings failed " + std::to_string(failing_rounds) +
+                        " rounds in a row (" + fmt::format("{:.0f}", failing_seconds) + " s)",
+                    std::move(where));
       continue;
     }
+    failing_rounds = 0;
+    failing_seconds = 0.0;
     if (r.status == LpStatus::NumericalTrouble || r.x.size() != size_t(red.lp.cols()))
       throw SolverError(std::string("rounding: LP solve failed (") + to_string(r.status) + ")");
     keep_iterate(red, r);
@@ -1294,14 +1327,18 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
   if (result.rounds.empty()) {  // propagation alone decided everything (tiny problems)
     result.first_lp = solver->solve(lp, options.lp);
   }
-  result.lower_bound = result.first_lp.lower_bound;
+  if (options.start_ones.empty()) result.lower_bound = result.first_lp.lower_bound;
+  else if (options.start_dual.size() == size_t(lp.rows())) result.lower_bound = certified_lower_bound(lp, options.start_dual);
+  else result.lower_bound = -std::numeric_limits<double>::infinity();
+  result.gap = relative_gap(result.energy, result.lower_bound);
+  return result;
+}
+
+double relative_gap(double energy, double bound) {
   // An energy that meets its bound to rounding error has no gap, also when both are ~0 (the
   // identity of a shape with itself), where the relative formula would read 100 %.
-  const double slack = result.energy - result.lower_bound;
-  result.gap = slack <= 1e-9 * std::max(1.0, std::abs(result.energy))
-                   ? 0.0
-                   : slack / std::max(std::abs(result.lower_bound), 1e-300);
-  return result;
+  const double slack = energy - bound;
+  return slack <= 1e-9 * std::max(1.0, std::abs(energy)) ? 0.0 : slack / std::max(std::abs(bound), 1e-300);
 }
 
 GraphSurfaceCheck check_graph_surface(const ProductSpace& space, const std::vector<int64_t>& gamma) {

@@ -32,10 +32,11 @@ public:
   // Fills params.initial_x / initial_y for `m` (nothing where empty).
   void apply(const MatchingLp& m, SolverParams& params) const;
 
-private:
   // The vertex pairs of a product triangle, hashed (its faces follow from them); a collision
-  // only misplaces a warm-start value.
+  // only misplaces a warm-start value (or a carried fixing, which propagation then checks).
   static uint64_t key(const ProductTriangle& t);
+
+private:
 
   std::vector<std::pair<uint64_t, double>> x_;  // sorted by key; only the nonzero values
   std::vector<int64_t> row_edge_;
@@ -75,6 +76,11 @@ struct CoarseToFineOptions {
   // there: no diverging attempt, but 12.96 M variables against 11.2 M and an LP bound of 20.72
   // against 23.47 — a more fractional LP whose rounding met infeasible LPs for 40 rounds.
   int widen_around = 0;
+  // Where the finer levels' rounding is stuck (RoundingOptions::stuck_after: LPs after its
+  // fixings failing round after round for this many times its first LP's seconds), widen the
+  // space around the failed parts as after an infeasible LP (a local widening), and go on from
+  // its fixings to 1 there, less those over the faces widened. 0: off (rounding goes on).
+  double stuck_after = 1.0;
   // More fine rings on Y at every ring (fine neighbourhood): a wider space from the start, paid
   // for in variables, against infeasible reduced LPs whose proof PDHG must find (slow at
   // 10 k faces).
@@ -125,6 +131,7 @@ struct LevelReport {
   int local_widenings = 0;     // times it was widened only near the proof of infeasibility
   int margin_widenings = 0;    // of those, past max_ring near the proof or with a margin around it
   int64_t widened_faces = 0;   // fine X faces widened locally, summed over those times
+  int stuck_widenings = 0;     // of the local widenings, those where rounding was stuck (stuck_after)
   int rounds = 0;
   int64_t iterations = 0;      // LP iterations over all rounds of the accepted ring (seconds
                                // include an infeasible attempt's, which ends within a few dozen)

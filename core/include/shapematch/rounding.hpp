@@ -1,6 +1,7 @@
 #pragma once
 // Rounding the LP relaxation to a binary discrete graph surface by iterative fixing (§4.1,
 // DESIGN.md §6), and reading the result (DESIGN.md §8).
+#include "shapematch/errors.hpp"
 #include "shapematch/lp.hpp"
 #include "shapematch/product_space.hpp"
 
@@ -84,6 +85,23 @@ struct RoundingOptions {
   int max_releases = 12;
   int max_backtracks = 200;    // fixings undone after an infeasible LP (each one more, smaller LP
                                // solve), then fail with InfeasibleError naming the open rows
+  // Fixings to 1 made before round 1: a partial Γ carried over from an attempt in a narrower
+  // space (coarse to fine, after widening where that attempt got stuck). Each that fits is
+  // fixed (in order; the rest are dropped), and round 1 solves what they leave, so its bound is
+  // no bound of the whole LP: the result's lower_bound is then certified from `start_dual` (one
+  // value per row, e.g. an earlier first LP's dual mapped over; −∞ without it).
+  std::vector<int64_t> start_ones;
+  std::vector<double> start_dual;
+  // Where the LPs after fixings have failed (infeasible, or looking it at their cap) round after
+  // round, at least stuck_rounds of them taking over this many times round 1's seconds in all,
+  // give up with a StuckError naming the last failed parts' rows and carrying the fixings to 1
+  // made so far, so that the caller can widen the space there and go on from them (coarse to
+  // fine does). Measured, FAUST_r 020-021 at full resolution: trimming the last fixing, and
+  // releasing the fixings around the failed part, both ran for 15+ minutes (docs/results.md).
+  // Running out of rounds (max_rounds) then ends in a StuckError too. 0: never (rounding goes on
+  // as before).
+  double stuck_after = 0.0;
+  int stuck_rounds = 4;
   std::string solver = "pdhg-cpu";
   // Parameters of every LP solve. Later rounds' warm starts are filled in; a warm start given
   // here over the whole LP (as many values as it has columns and rows) starts round 1.
@@ -126,10 +144,30 @@ struct RoundingResult {
   std::vector<RoundingRound> rounds;
 };
 
+// Rounding gave up where the LPs after its fixings kept failing (RoundingOptions::stuck_after):
+// rows() are the failed parts' rows; ones() the fixings to 1 it had made, and x(), y() its last
+// iterate over the whole LP, to go on from in a wider space.
+class StuckError : public InfeasibleError {
+public:
+  StuckError(const std::string& what, std::vector<int64_t> rows, std::vector<int64_t> ones, std::vector<double> x,
+             std::vector<double> y)
+      : InfeasibleError(what, std::move(rows)), ones_(std::move(ones)), x_(std::move(x)), y_(std::move(y)) {}
+  const std::vector<int64_t>& ones() const { return ones_; }
+  const std::vector<double>& x() const { return x_; }
+  const std::vector<double>& y() const { return y_; }
+
+private:
+  std::vector<int64_t> ones_;
+  std::vector<double> x_, y_;
+};
+
 // Calls `progress(round)` after each round (for a progress line); may be empty.
 RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem& lp, const std::vector<double>& energy,
                                       const RoundingOptions& options = {},
                                       const std::function<void(const RoundingRound&)>& progress = {});
+
+// (energy − bound) / |bound|, and 0 where the energy meets the bound to rounding error.
+double relative_gap(double energy, double bound);
 
 // Unit propagation of A x = b over binary x with nothing fixed, leaving out the rows marked in
 // `skip` (empty: none): the row where it finds a contradiction, or -1 if it finds none.
