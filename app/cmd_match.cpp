@@ -326,6 +326,8 @@ int run_match(const MatchArgs& args) {
                       .set("margin_widenings", l.margin_widenings)
                       .set("widened_faces", l.widened_faces)
                       .set("stuck_widenings", l.stuck_widenings)
+                      .set("carried_fixings", l.carried_fixings)
+                      .set("iterations_bound", l.iterations_bound)
                       .set("rounds", l.rounds)
                       .set("iterations", l.iterations)
                       .set("lower_bound", l.lower_bound)

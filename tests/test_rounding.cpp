@@ -421,7 +421,9 @@ TEST_CASE("rounding: it starts from carried fixings to 1, trims them like any fi
   CHECK(r.rounds[0].variables < plain.rounds[0].variables);
   // Without a dual for it, no bound is claimed (round 1's is the fixings' LP's, not the whole's).
   CHECK(r.lower_bound == -std::numeric_limits<double>::infinity());
-  // With the whole LP's first dual, its certified bound: the plain run's exactly.
+  // With the whole LP's first dual, its certified bound: the plain run's exactly. (Propagation
+  // decides nothing before round 1 here, so that LP's rows are the whole LP's.)
+  REQUIRE(plain.first_lp.y.size() == 10);
   options.start_dual = plain.first_lp.y;
   r = round_cycle(options);
   CHECK(r.lower_bound == doctest::Approx(plain.lower_bound));

@@ -418,6 +418,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
   std::vector<char> released_x;  // X vertices of the faces just widened: fixings over them go
   CarriedIterate first, last;
   int64_t first_iterations = 0;  // of the first LP of the attempt that started afresh
+  double first_seconds = 0.0;
   // One more fine ring on these faces (up to `cap` rings); false if none could grow. `last`: the
   // level's regional widening, which comes after max_local_widenings.
   auto widen_locally = [&](const std::vector<int>& faces, const char* why, int cap, bool last = false) {
@@ -538,6 +539,9 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
         SolverParams bound;
         first.apply(m, bound);
         ro.start_dual = std::move(bound.initial_y);
+        ro.reference_seconds = first_seconds;
+        ro.reference_iterations = first_iterations;
+        rep.carried_fixings = static_cast<int64_t>(ro.start_ones.size());
         spdlog::info("level {}: rounding goes on from {} of {} fixings to 1 in the widened space", l + 1,
                      ro.start_ones.size(), carried_ones.size());
       }
@@ -546,7 +550,10 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
         ro.stuck_after = options_.stuck_after;
       RoundingResult rr = round_to_graph_surface(m.space, m.lp, m.energy, ro,
                                                  [&](const RoundingRound& r) {
-                                                   if (r.round == 1 && !carrying) first_iterations = r.iterations;
+                                                   if (r.round == 1 && !carrying) {
+                                                     first_iterations = r.iterations;
+                                                     first_seconds = r.seconds;
+                                                   }
                                                    if (progress) progress(rep, r);
                                                  });
       if (carrying) {
@@ -558,10 +565,16 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
         bp.stop_on_divergence = false;
         first.apply(m, bp);
         bp.max_iterations = std::min<int64_t>(bp.max_iterations, std::max<int64_t>(first_iterations, 64));
-        const LpResult b = make_solver(ro.solver)->solve(m.lp, bp);
-        spdlog::info("level {}: the widened LP's bound {:.6g} (from the first LP's dual: {:.6g}), {} iterations", l + 1,
-                     b.lower_bound, rr.lower_bound, b.iterations);
-        if (std::isfinite(b.lower_bound) && !(b.lower_bound <= rr.lower_bound)) rr.lower_bound = b.lower_bound;
+        try {
+          const LpResult b = make_solver(ro.solver)->solve(m.lp, bp);
+          spdlog::info("level {}: the widened LP's bound {:.6g} (from the first LP's dual: {:.6g}), {} iterations",
+                       l + 1, b.lower_bound, rr.lower_bound, b.iterations);
+          if (std::isfinite(b.lower_bound) && !(b.lower_bound <= rr.lower_bound)) rr.lower_bound = b.lower_bound;
+          rep.iterations_bound = b.iterations;
+        } catch (const Error& e) {  // the Γ stands; only the bound is the weaker one
+          spdlog::warn("level {}: the widened LP's bound could not be solved for ({}); the first LP's dual gives {:.6g}",
+                       l + 1, e.what(), rr.lower_bound);
+        }
         rr.gap = relative_gap(rr.energy, rr.lower_bound);
       }
       accept(m, rr, rep, gamma);

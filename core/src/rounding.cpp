@@ -870,6 +870,7 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
   std::unordered_set<int64_t> refuted;  // fixings to 1 an infeasibility proof blamed, not tried again
   int backtracks = 0;
   // A partial Γ carried over (start_ones): one fixing like any other, which backtracking may trim.
+  bool carried = false;
   if (!options.start_ones.empty()) {
     for (int64_t j : options.start_ones)
       if (j < 0 || j >= lp.cols()) throw InvalidInputError("rounding: a start fixing names no variable");
@@ -878,11 +879,16 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
     Step step{fixer.mark(), fixer.state().ones, fixer.state().zeros, {}, false};
     step.batch = shrink_and_fix(fixer, batch, step.mark, true);
     spdlog::debug("rounding: starts from {} of {} carried fixings to 1", step.batch.size(), batch.size());
-    if (!step.batch.empty()) history.push_back(std::move(step));
+    carried = !step.batch.empty();
+    if (carried) history.push_back(std::move(step));
   }
   // Rounds in a row whose LP failed, and their seconds (stuck_after).
   int failing_rounds = 0;
   double failing_seconds = 0.0;
+  // Round 1's LP (or the reference given for a carried start): the scale of stuck_after and of
+  // the later rounds' iteration cap.
+  double first_seconds = 0.0;
+  int64_t first_iterations = 0;
   // Multiplies the later rounds' iteration cap: doubled each time a fixing from a capped LP is
   // undone whole (below), up to kMaxCapScale.
   double cap_scale = 1.0;
@@ -1066,10 +1072,14 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
     if (progress) progress(info);
   };
   // Giving up where the caller can widen (stuck_after): the fixings to 1 so far and the iterate go with it.
+  // Only the decisions: what propagation forced to 1 in this space need not follow in a wider one.
   const auto stuck = [&](const std::string& what, std::vector<int64_t> rows) {
     std::vector<int64_t> ones;
-    for (int64_t j = 0; j < lp.cols(); ++j)
-      if (fixer.state().value[j] == 1) ones.push_back(j);
+    for (const Step& st : history)
+      for (const auto& a : st.batch)
+        if (a.second == 1 && fixer.state().value[a.first] == 1) ones.push_back(a.first);
+    std::sort(ones.begin(), ones.end());
+    ones.erase(std::unique(ones.begin(), ones.end()), ones.end());
     return StuckError(what, std::move(rows), std::move(ones), x_full, y_full);
   };
   // The round's iterate over the whole LP, the next round's warm start.
@@ -1118,21 +1128,25 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
       for (size_t j = 0; j < red.cols.size(); ++j) params.initial_x[j] = wx[red.cols[j]];
       for (size_t i = 0; i < red.rows.size(); ++i) params.initial_y[i] = wy[red.rows[i]];
     }
+    // Rounds after a fixing; a start from carried fixings makes round 1 one of them (solved in
+    // parts, capped, its failures undone), only its bound is no one's.
+    const bool after_fixing = round > 1 || carried;
     // After a fixing, an infeasible LP undoes it: that needs a proof, not a suspicion.
-    if (round > 1) params.stop_on_divergence = false;
+    if (after_fixing) params.stop_on_divergence = false;
     // (Not the first round: its relaxation and bound are the chosen solver's.)
-    const bool exact = round > 1 && options.exact_below > 0 && options.solver != "clp-dual";
+    const bool exact = after_fixing && options.exact_below > 0 && options.solver != "clp-dual";
     if (exact && !exact_solver) exact_solver = make_solver("clp-dual");
     const SolverParams& exact_params = base_params;
     // A cap for the first-order solver only (simplex iterations are another unit); the exact
     // solver gets the parts below exact_below without it.
-    if (round > 1 && options.later_round_iterations > 0 && options.solver.rfind("pdhg", 0) == 0) {
+    if (after_fixing && options.later_round_iterations > 0 && options.solver.rfind("pdhg", 0) == 0) {
+      const int64_t reference = round > 1 ? first_iterations : options.reference_iterations;
       const double cap = std::max(double(options.later_round_min_iterations),
-                                  std::floor(options.later_round_iterations * double(result.first_lp.iterations)));
+                                  std::floor(options.later_round_iterations * double(reference)));
       params.max_iterations = std::min<int64_t>(params.max_iterations, static_cast<int64_t>(cap_scale * cap));
     }
     JoinedSolve joined;
-    if (round == 1) {
+    if (!after_fixing) {
       joined.r = solver->solve(red.lp, params);
       if (joined.r.status == LpStatus::Infeasible) joined.proof = joined.r.y;
     } else {
@@ -1163,6 +1177,10 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
     info.parts = joined.parts;
     info.exact_parts = joined.exact_parts;
     info.objective = r.objective + lp.objective_scale * red.fixed_cost;
+    if (round == 1) {
+      first_seconds = options.reference_seconds > 0.0 ? options.reference_seconds : clock.seconds();
+      first_iterations = options.reference_iterations > 0 ? options.reference_iterations : r.iterations;
+    }
     if (round == 1) {  // in the units of the full LP: add what propagation fixed to 1 before it
       result.first_lp = r;
       result.first_lp.objective += lp.objective_scale * red.fixed_cost;
@@ -1231,7 +1249,7 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
       failing_seconds += info.seconds;
       std::vector<int64_t> where = failed.empty() ? certificate_rows(joined.proof, red.rows) : failed;
       if (options.stuck_after > 0.0 && failing_rounds >= options.stuck_rounds && !where.empty() &&
-          failing_seconds > options.stuck_after * result.rounds.front().seconds)
+          failing_seconds > options.stuck_after * first_seconds)
         throw stuck("rounding: stuck, the LPs after its fixings failed " + std::to_string(failing_rounds) +
                         " rounds in a row (" + fmt::format("{:.0f}", failing_seconds) + " s)",
                     std::move(where));

@@ -132,6 +132,8 @@ struct LevelReport {
   int margin_widenings = 0;    // of those, past max_ring near the proof or with a margin around it
   int64_t widened_faces = 0;   // fine X faces widened locally, summed over those times
   int stuck_widenings = 0;     // of the local widenings, those where rounding was stuck (stuck_after)
+  int64_t carried_fixings = 0; // fixings to 1 the last of those went on from
+  int64_t iterations_bound = 0;  // of the LP solved again for the bound after one
   int rounds = 0;
   int64_t iterations = 0;      // LP iterations over all rounds of the accepted ring (seconds
                                // include an infeasible attempt's, which ends within a few dozen)

@@ -92,6 +92,11 @@ struct RoundingOptions {
   // value per row, e.g. an earlier first LP's dual mapped over; −∞ without it).
   std::vector<int64_t> start_ones;
   std::vector<double> start_dual;
+  // Round 1 of the attempt that began afresh, for a start from carried fixings (whose round 1
+  // is a smaller, warm LP): its seconds scale stuck_after, its iterations the later rounds' cap.
+  // 0: this rounding's own round 1.
+  double reference_seconds = 0.0;
+  int64_t reference_iterations = 0;
   // Where the LPs after fixings have failed (infeasible, or looking it at their cap) round after
   // round, at least stuck_rounds of them taking over this many times round 1's seconds in all,
   // give up with a StuckError naming the last failed parts' rows and carrying the fixings to 1
@@ -140,7 +145,7 @@ struct RoundingResult {
   int64_t pockets_closed = 0;  // pockets replaced after rounding (close_pockets)
   double lower_bound = 0.0;    // certified bound of the first LP
   double gap = 0.0;            // (energy − bound) / |bound|
-  LpResult first_lp;           // the relaxation before any fixing
+  LpResult first_lp;           // the relaxation before any fixing (with start_ones: after those)
   std::vector<RoundingRound> rounds;
 };
 
