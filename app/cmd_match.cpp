@@ -52,6 +52,7 @@ struct MatchArgs {
   int max_local_widenings = CoarseToFineOptions{}.max_local_widenings;
   bool warm_widening = CoarseToFineOptions{}.warm_widening;
   double stuck_after = CoarseToFineOptions{}.stuck_after;
+  bool stuck_carry = CoarseToFineOptions{}.stuck_carry;
 };
 
 // auto: a GPU if there is one, else the native solver (lavapipe is for testing, not speed).
@@ -114,6 +115,7 @@ int run_match(const MatchArgs& args) {
   co.max_local_widenings = args.max_local_widenings;
   co.warm_widening = args.warm_widening;
   co.stuck_after = args.stuck_after;
+  co.stuck_carry = args.stuck_carry;
   co.matching = matching_options(args.pair, p);
   RoundingOptions& ro = co.rounding;
   ro.solver = solver_for(args);
@@ -307,7 +309,8 @@ int run_match(const MatchArgs& args) {
                               .set("y_margin", args.y_margin)
                               .set("max_local_widenings", args.max_local_widenings)
                               .set("warm_widening", args.warm_widening)
-                              .set("stuck_after", args.stuck_after));
+                              .set("stuck_after", args.stuck_after)
+                              .set("stuck_carry", args.stuck_carry));
     report.set("seconds", seconds);
     report.set("peak_rss_mb", peak_rss_mb());
     report.set("round_log", rounds);
@@ -446,9 +449,13 @@ Action add_match_command(CLI::App& app) {
       ->capture_default_str();
   app.add_option("--stuck-after", a->stuck_after,
                  "where the LPs after the rounding's fixings at a refined level keep failing for this many times "
-                 "its first LP's seconds, widen the space around them and go on from its fixings (0: off)")
+                 "its first LP's seconds, or it runs out of rounds, widen the space around them and solve the level "
+                 "again (0: off)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
+  app.add_flag("--stuck-carry", a->stuck_carry,
+               "with --stuck-after: go on from the stuck rounding's fixings in the widened space instead of "
+               "afresh (measured slower)");
   app.add_option("--y-margin", a->y_margin,
                  "more fine rings on Y around every face's candidates, at every ring (fine neighbourhood)")
       ->check(CLI::Range(0, 8))

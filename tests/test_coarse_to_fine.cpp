@@ -414,29 +414,31 @@ TEST_CASE("coarse to fine: the second start solves the second level twice and ke
 
 TEST_CASE("coarse to fine: a stuck rounding widens around its failed parts and goes on from its fixings") {
   // Measured: with max_rounds 3 and a wide greedy margin (few fixings per round), this pair's
-  // finest rounding (ring 0) runs out of rounds with a few faces open; it widens there and goes
-  // on from the fixings to 1 elsewhere, and certifies the widened LP's bound by solving it again.
+  // finest rounding (ring 0) runs out of rounds with a few faces open. Stuck (stuck_after), it
+  // widens there and solves the level again: afresh, or (stuck_carry) from the fixings to 1
+  // elsewhere, the widened LP then solved again for a certified bound. Off, running out of
+  // rounds widens too, as an infeasible LP (not counted as stuck).
   CoarseToFineOptions o = two_levels(24);
   o.ring = 0;
   o.rounding.max_rounds = 3;
   o.rounding.greedy_above = 0;
   o.rounding.greedy_margin = 2;
-  o.stuck_after = 1e-12;
-  for (const bool carry : {true, false}) {
-    CAPTURE(carry);
-    if (!carry) o.stuck_after = 0.0;  // as before: a fresh attempt in the widened space
+  for (const int mode : {0, 1, 2}) {  // off, afresh, carried
+    CAPTURE(mode);
+    o.stuck_after = mode == 0 ? 0.0 : 1e-12;
+    o.stuck_carry = mode == 2;
     const CoarseToFineMatcher matcher(decimate(shapes::bent_finger(10, 8, 8), 120),
                                       decimate(shapes::bent_finger(60, 8, 8), 130), o);
     const CoarseToFineResult r = matcher.run();
     const LevelReport& l = r.levels.back();
-    CHECK(l.stuck_widenings == (carry ? 1 : 0));
-    CHECK((l.carried_fixings > 0) == carry);  // the fixings did go on
-    CHECK((l.iterations_bound > 0) == carry);
+    CHECK(l.stuck_widenings == (mode > 0 ? 1 : 0));
+    CHECK((l.carried_fixings > 0) == (mode == 2));  // the fixings did go on
+    CHECK((l.iterations_bound > 0) == (mode == 2));
     CHECK(check_graph_surface(r.finest.space, r.rounding.gamma).ok());
     CHECK(satisfies_exactly(r.finest.lp, r.rounding.gamma));
     CHECK(std::isfinite(l.lower_bound));
     CHECK(l.lower_bound <= l.energy + 1e-9);
-    MESSAGE("carry ", carry, ": bound ", l.lower_bound, " energy ", l.energy, " gap ", l.gap, " widened faces ",
+    MESSAGE("mode ", mode, ": bound ", l.lower_bound, " energy ", l.energy, " gap ", l.gap, " widened faces ",
             l.widened_faces, " variables ", l.variables);
   }
 }

@@ -594,11 +594,12 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
         for (int64_t i : s->rows()) proof.add(m, i);
         if (widen_at(m, proof, "stuck in rounding")) {
           ++rep.stuck_widenings;
+          carried_ones.clear();
+          if (!options_.stuck_carry) continue;  // afresh in the widened space
           released_x.assign(lx.mesh.num_vertices(), 0);
           for (int f = 0; f < lx.mesh.num_faces(); ++f)
             if (extra[f] > before[f])
               for (int v : lx.mesh.faces[f]) released_x[v] = 1;
-          carried_ones.clear();
           for (int64_t j : s->ones()) carried_ones.push_back(CarriedIterate::key(m.space[j]));
           if (!s->x().empty()) last.keep(m, s->x(), s->y());
           continue;
