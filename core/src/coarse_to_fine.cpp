@@ -522,10 +522,11 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
       if (l > 0 && options_.warm_widening && !carrying) {
         if (!warm.empty()) warm.apply(m, ro.lp);
       }
-      if (l > 0 && (options_.warm_widening || options_.stuck_after > 0.0) && !carrying)
+      const bool may_carry = options_.stuck_after > 0.0 && options_.stuck_carry;
+      if (l > 0 && (options_.warm_widening || may_carry) && !carrying)
         ro.first_iterate = [&](const std::vector<double>& x, const std::vector<double>& y) {
           if (options_.warm_widening) warm.keep(m, x, y);
-          if (options_.stuck_after > 0.0) first.keep(m, x, y);
+          if (may_carry) first.keep(m, x, y);
         };
       if (carrying) {
         std::sort(carried_ones.begin(), carried_ones.end());
