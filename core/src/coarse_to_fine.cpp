@@ -410,10 +410,10 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
   bool regional_done = false;
   bool around_done = false;
   CarriedIterate warm;  // the last attempt's first LP, for the next
-  // Where rounding got stuck (StuckError) and the space widened around it: its fixings to 1 (by
-  // key), except those over the X faces just widened, go on in the widened space, warm-started
-  // from its last iterate; `first` (the first LP of the attempt that started afresh) certifies
-  // the widened LP's bound.
+  // With stuck_carry, where rounding got stuck (StuckError) and the space widened around it: its
+  // fixings to 1 (by key), except those over the X faces just widened, go on in the widened
+  // space, warm-started from its last iterate; `first` (the first LP of the attempt that started
+  // afresh) certifies the widened LP's bound.
   std::vector<uint64_t> carried_ones;
   std::vector<char> released_x;  // X vertices of the faces just widened: fixings over them go
   CarriedIterate first, last;
@@ -546,7 +546,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
         spdlog::info("level {}: rounding goes on from {} of {} fixings to 1 in the widened space", l + 1,
                      ro.start_ones.size(), carried_ones.size());
       }
-      // Where rounding gets stuck, widen around it (as for an infeasible LP) and go on from its fixings.
+      // Where rounding gets stuck, widen around it (as for an infeasible LP) and solve again.
       if (l > 0 && options_.local_widening && local < options_.max_local_widenings)
         ro.stuck_after = options_.stuck_after;
       RoundingResult rr = round_to_graph_surface(m.space, m.lp, m.energy, ro,
@@ -586,8 +586,9 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
       break;
     } catch (const InfeasibleError& e) {
       if (l == 0) throw;
-      // Stuck in rounding: widen around its failed parts and go on from its fixings, but those
-      // over the faces just widened (what failed there). Out of local widenings, as below.
+      // Stuck in rounding: widen around its failed parts and solve again, afresh or (stuck_carry)
+      // from its fixings but those over the faces just widened (what failed there). Out of local
+      // widenings, as below.
       if (const auto* s = dynamic_cast<const StuckError*>(&e)) {
         std::vector<int> before = extra;
         before.resize(lx.mesh.num_faces(), 0);

@@ -1177,11 +1177,9 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
     info.parts = joined.parts;
     info.exact_parts = joined.exact_parts;
     info.objective = r.objective + lp.objective_scale * red.fixed_cost;
-    if (round == 1) {
+    if (round == 1) {  // in the units of the full LP: add what propagation fixed to 1 before it
       first_seconds = options.reference_seconds > 0.0 ? options.reference_seconds : clock.seconds();
       first_iterations = options.reference_iterations > 0 ? options.reference_iterations : r.iterations;
-    }
-    if (round == 1) {  // in the units of the full LP: add what propagation fixed to 1 before it
       result.first_lp = r;
       result.first_lp.objective += lp.objective_scale * red.fixed_cost;
       result.first_lp.lower_bound += lp.objective_scale * red.fixed_cost;
