@@ -37,7 +37,6 @@ public:
   static uint64_t key(const ProductTriangle& t);
 
 private:
-
   std::vector<std::pair<uint64_t, double>> x_;  // sorted by key; only the nonzero values
   std::vector<int64_t> row_edge_;
   std::vector<double> y_;
@@ -80,15 +79,15 @@ struct CoarseToFineOptions {
   // fixings failing round after round for this many times its first LP's seconds, or out of
   // rounds), widen the space around the failed parts as after an infeasible LP (a local
   // widening) and solve the level again. 0: off (rounding goes on; out of rounds, the level
-  // starts afresh in a space widened around the open rows). Measured, FAUST_r 020-021 at full
-  // resolution: stuck after 20 rounds, 925 + 401 faces widened, and the level's second attempt
-  // verified (energy 27.559, gap 1.5 %), the first completed run of that pair.
+  // starts afresh in a space widened around the open rows). Measured at full resolution: FAUST_r
+  // 020-021 stuck after 21 rounds, 2 112 faces widened, the level's second attempt verified (gap
+  // 2.0 %); 021-024 likewise (gap 1.0 %): the first completed runs of those pairs.
   double stuck_after = 1.0;
   // With stuck_after: go on from the stuck rounding's fixings to 1 (less those over the faces
   // widened) instead of starting afresh, the widened LP solved again at the end for its bound.
   // Off: measured on FAUST_r 020-021, the carried attempt's LPs (2-3 M variables, capped at the
   // first LP's iterations) stayed unconverged, and its rounds failed and were trimmed for
-  // 10+ minutes, where the fresh attempt finished in 4.
+  // 10+ minutes, where a fresh attempt finished in 7 (its first LP included).
   bool stuck_carry = false;
   // More fine rings on Y at every ring (fine neighbourhood): a wider space from the start, paid
   // for in variables, against infeasible reduced LPs whose proof PDHG must find (slow at

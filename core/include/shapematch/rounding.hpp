@@ -101,10 +101,10 @@ struct RoundingOptions {
   // round, at least stuck_rounds of them taking over this many times round 1's seconds in all,
   // give up with a StuckError naming the last failed parts' rows and carrying the fixings to 1
   // made so far, so that the caller can widen the space there and solve again, afresh or from
-  // them (coarse to fine does). Measured, FAUST_r 020-021 at full resolution: trimming the last fixing, and
-  // releasing the fixings around the failed part, both ran for 15+ minutes (docs/results.md).
-  // Running out of rounds (max_rounds) then ends in a StuckError too. 0: never (rounding goes on
-  // as before).
+  // them (coarse to fine does). Measured, FAUST_r 020-021 at full resolution: trimming the last
+  // fixing, and releasing the fixings around the failed part, both ran for 15+ minutes
+  // (docs/results.md). Running out of rounds (max_rounds) then ends in a StuckError too. 0: never
+  // (rounding goes on as before).
   double stuck_after = 0.0;
   int stuck_rounds = 4;
   std::string solver = "pdhg-cpu";
