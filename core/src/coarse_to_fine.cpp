@@ -586,14 +586,15 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
       break;
     } catch (const InfeasibleError& e) {
       if (l == 0) throw;
+      ProofPlace proof(m);
+      for (int64_t i : e.rows()) proof.add(m, i);
       // Stuck in rounding: widen around its failed parts and solve again, afresh or (stuck_carry)
-      // from its fixings but those over the faces just widened (what failed there). Out of local
-      // widenings, as below.
-      if (const auto* s = dynamic_cast<const StuckError*>(&e)) {
+      // from its fixings but those over the faces just widened (what failed there). Where nothing
+      // could widen there, on as below (without trying the same place again).
+      const auto* s = dynamic_cast<const StuckError*>(&e);
+      if (s) {
         std::vector<int> before = extra;
         before.resize(lx.mesh.num_faces(), 0);
-        ProofPlace proof(m);
-        for (int64_t i : s->rows()) proof.add(m, i);
         if (widen_at(m, proof, "stuck in rounding")) {
           ++rep.stuck_widenings;
           carried_ones.clear();
@@ -608,9 +609,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
         }
       }
       carried_ones.clear();  // the widenings below start afresh
-      ProofPlace proof(m);
-      for (int64_t i : e.rows()) proof.add(m, i);
-      if (widen_at(m, proof, e.certified() ? "infeasible" : "probably infeasible (PDHG diverging)")) continue;
+      if (!s && widen_at(m, proof, e.certified() ? "infeasible" : "probably infeasible (PDHG diverging)")) continue;
       if (!e.certified()) {  // nothing left to widen locally on a suspicion: solve for a proof
         trust_divergence = false;
         continue;
