@@ -150,3 +150,20 @@ TEST_CASE("hierarchy: a fine face's parent is the coarse face it lies on, not th
   fine.faces = {{0, 2, 1}};
   CHECK(parent_faces(fine, coarse) == std::vector<int>{0});
 }
+
+TEST_CASE("hierarchy: given the kept vertices, a parent comes from near on the surface, not across a gap") {
+  // Two coarse faces facing the same way, B a little above A; the fine face starts at A's kept
+  // corner and rises towards B (like a leg lying against a belly): nearest in space is B.
+  Mesh coarse;
+  coarse.vertices = {{0, 0, 0}, {4, 0, 0}, {0, 4, 0}, {-1, -1, 0.3}, {4, -1, 0.3}, {-1, 4, 0.3}};
+  coarse.faces = {{0, 1, 2}, {3, 4, 5}};
+  Mesh fine;
+  fine.vertices = {{0, 0, 0}, {1, 0, 0.3}, {0, 1, 0.3}, {4, 0, 0}, {0, 4, 0}, {-1, -1, 0.3}, {4, -1, 0.3}, {-1, 4, 0.3}};
+  fine.faces = {{0, 1, 2}};
+  CHECK(parent_faces(fine, coarse) == std::vector<int>{1});
+  // Coarse vertex v is fine vertex kept[v]; only fine vertex 0 (coarse 0, on A) is on the face's
+  // side of the surface.
+  const std::vector<int> kept{0, 3, 4, 5, 6, 7};
+  CHECK(parent_faces(fine, coarse, kept) == std::vector<int>{0});
+  CHECK_THROWS_AS(parent_faces(fine, coarse, {0, 3}), InvalidInputError);
+}

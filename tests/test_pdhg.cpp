@@ -1,3 +1,4 @@
+#include "divergence_watch.hpp"
 #include "pdhg_backend.hpp"
 #include "shapematch/errors.hpp"
 #include "shapematch/matching.hpp"
@@ -320,4 +321,36 @@ TEST_CASE("pdhg-cpu: feasible LPs never stop as diverging") {
   const Mesh y = test::deformed(x, [](const Eigen::Vector3d& q) { return Eigen::Vector3d(1.5 * q.x(), q.y(), 0.7 * q.z()); });
   const MatchingLp m = build_matching_lp(x, compute_geometry(x), y, compute_geometry(y));
   CHECK(solve_lp(m.lp, "pdhg-cpu", params).status == LpStatus::Optimal);
+}
+
+TEST_CASE("pdhg: the divergence watch on the windows of measured full-resolution LPs") {
+  // (primal residual, gap, objective, bound) at the end of each 512-iteration window, tolerance
+  // 3e-3, from the logs of the FAUST_r and TOSCA_r runs in docs/results.md.
+  struct Window {
+    double primal, gap, objective, bound;
+  };
+  auto first_stop = [](const std::vector<Window>& windows) {
+    detail::DivergenceWatch watch(3e-3);
+    for (size_t w = 0; w < windows.size(); ++w)
+      if (watch.diverging(windows[w].primal, windows[w].gap, windows[w].objective, windows[w].bound)) return int(w);
+    return -1;
+  };
+  // FAUST_r 020-024's infeasible finest LP: the gap doubles each window, the residual still falls.
+  CHECK(first_stop({{2.55e-2, 1.74e-2, 21.31, 22.06}, {1.22e-2, 3.67e-2, 23.21, 24.98},
+                    {8.25e-3, 6.45e-2, 24.24, 27.58}, {7.53e-3, 1.14e-1, 24.79, 31.15}}) == 1);
+  // Its widened, feasible LP: the gap stays near the tolerance.
+  CHECK(first_stop({{2.38e-2, 1.33e-3, 20.28, 20.33}, {9.97e-3, 1.15e-3, 21.75, 21.80},
+                    {4.89e-3, 2.02e-3, 22.27, 22.36}, {2.79e-3, 1.14e-3, 22.60, 22.65}}) == -1);
+  // A feasible LP of FAUST_r 020-021 (1.6 M variables) whose gap grew for a window before it
+  // converged: the nearest any optimal LP came (gap 2.2e-2, bound 4 % above).
+  CHECK(first_stop({{4.44e-2, 2.43e-2, 14.00, 14.70}, {6.18e-3, 8.91e-3, 15.53, 15.81},
+                    {5.40e-3, 2.15e-2, 15.67, 16.36}, {2.62e-3, 4.87e-3, 16.32, 16.48},
+                    {7.39e-5, 3.55e-3, 16.79, 16.67}}) == -1);
+  // TOSCA_r horse0-5's finest LP: a slow climb, caught by counting windows (the fifth here).
+  CHECK(first_stop({{1.54e-3, 4.07e-3, 62.05, 62.56}, {1.27e-3, 6.30e-3, 62.24, 63.03},
+                    {1.16e-3, 9.16e-3, 62.34, 63.49}, {1.12e-3, 1.31e-2, 62.41, 64.07},
+                    {1.10e-3, 1.69e-2, 62.46, 64.60}}) == 4);
+  // A flat residual with the bound far above and rising stops whatever the gap (made-up first
+  // window; the second is FAUST_r 021-024's at 1 536 iterations with a smaller gap).
+  CHECK(first_stop({{1.20e-2, 2.0e-2, 44.80, 46.0}, {1.16e-2, 2.5e-2, 45.56, 58.84}}) == 1);
 }

@@ -104,7 +104,9 @@ double squared_distance_to_triangle(const Eigen::Vector3d& p, const Eigen::Vecto
   return (ap - ab * (vb / denom) - ac * (vc / denom)).squaredNorm();
 }
 
-std::vector<int> parent_faces(const Mesh& fine, const Mesh& coarse) {
+std::vector<int> parent_faces(const Mesh& fine, const Mesh& coarse, const std::vector<int>& kept) {
+  if (!kept.empty() && kept.size() != size_t(coarse.num_vertices()))
+    throw InvalidInputError("parent faces: need one kept fine vertex per coarse vertex");
   auto centroid = [](const Mesh& m, int f) {
     const auto& t = m.faces[f];
     return Eigen::Vector3d((m.vertices[t[0]] + m.vertices[t[1]] + m.vertices[t[2]]) / 3.0);
@@ -115,23 +117,61 @@ std::vector<int> parent_faces(const Mesh& fine, const Mesh& coarse) {
   };
   std::vector<Eigen::Vector3d> cn(coarse.num_faces());
   for (int g = 0; g < coarse.num_faces(); ++g) cn[g] = normal(coarse, g);
-  // Brute force: |F_fine|·|F_coarse| is at most a few times 10^7 between consecutive levels.
   // The coarse face nearest to the centroid, not the one with the nearest centroid: next to a
   // long coarse triangle the nearest centroid is often a neighbour's, and a wrong parent leaves
   // the reduced product space of the finer level without a surface there (measured on FAUST_r at
   // full resolution: local widenings at every level above 2 000 faces).
-  std::vector<int> parent(fine.num_faces());
-  detail::parallel_for(fine.num_faces(), 0, [&](int64_t f) {
-    const Eigen::Vector3d p = centroid(fine, static_cast<int>(f)), n = normal(fine, static_cast<int>(f));
+  auto nearest = [&](const Eigen::Vector3d& p, const Eigen::Vector3d& n, auto&& candidates) {
     double best = std::numeric_limits<double>::infinity(), best_any = best;
     int arg = -1, arg_any = -1;
-    for (int g = 0; g < coarse.num_faces(); ++g) {
+    candidates([&](int g) {
       const auto& t = coarse.faces[g];
       const double d = squared_distance_to_triangle(p, coarse.vertices[t[0]], coarse.vertices[t[1]], coarse.vertices[t[2]]);
       if (d < best_any) best_any = d, arg_any = g;
       if (d < best && cn[g].dot(n) > 0) best = d, arg = g;
+    });
+    return arg >= 0 ? arg : arg_any;
+  };
+  std::vector<int> parent(fine.num_faces());
+  if (kept.empty()) {
+    // Brute force: |F_fine|·|F_coarse| is at most a few times 10^7 between consecutive levels.
+    detail::parallel_for(fine.num_faces(), 0, [&](int64_t f) {
+      parent[f] = nearest(centroid(fine, int(f)), normal(fine, int(f)), [&](auto&& visit) {
+        for (int g = 0; g < coarse.num_faces(); ++g) visit(g);
+      });
+    });
+    return parent;
+  }
+  // Only coarse faces around the kept vertices nearest on the fine surface (breadth first, the
+  // first ring of the fine mesh that holds one, and the ring after it): the nearest in space can
+  // lie across a gap, on another part of the shape (measured on the deformation-transfer cat: a
+  // leg's faces took parents on the belly, and the reduced space of the next level had no surface
+  // there through a dozen widenings).
+  std::vector<int> coarse_of(fine.num_vertices(), -1);
+  for (int v = 0; v < coarse.num_vertices(); ++v) coarse_of[kept[v]] = v;
+  const auto fine_vf = vertex_face_table(fine), coarse_vf = vertex_face_table(coarse);
+  detail::parallel_for(fine.num_faces(), 0, [&](int64_t f) {
+    std::vector<int> frontier(fine.faces[f].begin(), fine.faces[f].end()), seen = frontier, found, next;
+    int extra = -1;  // rings still to take once a kept vertex is found
+    while (!frontier.empty() && extra != 0) {
+      if (extra > 0) --extra;
+      for (int u : frontier)
+        if (coarse_of[u] >= 0) found.push_back(coarse_of[u]);
+      if (!found.empty() && extra < 0) extra = 1;
+      next.clear();
+      for (int u : frontier)
+        for (int g : fine_vf[u])
+          for (int w : fine.faces[g])
+            if (std::find(seen.begin(), seen.end(), w) == seen.end()) seen.push_back(w), next.push_back(w);
+      frontier.swap(next);
     }
-    parent[f] = arg >= 0 ? arg : arg_any;
+    std::vector<int> faces;
+    for (int v : found) faces.insert(faces.end(), coarse_vf[v].begin(), coarse_vf[v].end());
+    std::sort(faces.begin(), faces.end());
+    faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
+    const Eigen::Vector3d p = centroid(fine, int(f)), n = normal(fine, int(f));
+    parent[f] = faces.empty() ? nearest(p, n, [&](auto&& visit) { for (int g = 0; g < coarse.num_faces(); ++g) visit(g); })
+                              : nearest(p, n, [&](auto&& visit) { for (int g : faces) visit(g); });
   });
   return parent;
 }
@@ -151,7 +191,7 @@ MeshHierarchy build_hierarchy(const Mesh& input, const std::vector<int>& face_co
     level.mesh = decimate(finer.mesh, face_counts[l], &kept);
     level.input_vertex.resize(kept.size());
     for (size_t v = 0; v < kept.size(); ++v) level.input_vertex[v] = finer.input_vertex[kept[v]];
-    finer.parent_face = parent_faces(finer.mesh, level.mesh);
+    finer.parent_face = parent_faces(finer.mesh, level.mesh, kept);
   }
   for (auto& level : h.levels) level.geometry = compute_geometry(level.mesh);
   return h;

@@ -2,6 +2,7 @@
 // termination. The kernels live in a PdhgBackend (native C++ or Vulkan).
 #include "shapematch/pdhg.hpp"
 
+#include "divergence_watch.hpp"
 #include "pdhg_backend.hpp"
 #include "shapematch/errors.hpp"
 #include "shapematch/system.hpp"
@@ -172,13 +173,11 @@ LpResult PdhgSolver::solve(const LpProblem& problem, const SolverParams& params)
 
   int64_t total = 0, k = 0;
   double restart_base = -1.0, previous = std::numeric_limits<double>::infinity();
-  // Divergence watch (params.stop_on_divergence): the iterate at the start of each window.
-  constexpr int64_t kDivergenceWindow = 512;
-  constexpr int kCreepingWindows = 4;
-  int64_t window_end = kDivergenceWindow;
+  // Divergence watch (params.stop_on_divergence); the dual at the start of each window gives
+  // the growth returned as the ray.
+  detail::DivergenceWatch watch(params.tolerance);
+  int64_t window_end = detail::DivergenceWatch::kWindow;
   std::vector<double> window_y;
-  double window_primal = 0.0, window_dual = 0.0, window_gap = 0.0;
-  int creeping = 0;  // windows in a row with the residual flat and the gap growing
   int restarts = 0;
   result.status = LpStatus::IterationLimit;
   while (true) {
@@ -226,34 +225,14 @@ LpResult PdhgSolver::solve(const LpProblem& problem, const SolverParams& params)
       }
     }
 
-    // An infeasible LP's primal residual stalls while its dual bound climbs without limit. Where
-    // that held over a whole window (measured on a 10 k-face reduced matching LP: residual flat
-    // at 2e-2 while the bound rose from 35 to 48 in 1024 iterations; feasible LPs of that size
-    // cut their residual 20x in such a window), stop and return the dual's growth over it. The
-    // residual need only be above the tolerance: at tolerance 1e-3, a 10 k-face LP's residual
-    // went from 8.5e-3 to 7.8e-3 in a window while its bound rose from 36 to 54 against an
-    // objective of 28, and on to 108 (asking for 100 × the tolerance, as before, let it run on).
     // The window is 512 iterations: FAUST_r 020-024's finest reduced LP (10.9 M variables) had
     // its residual at 8.2e-3, 7.5e-3, 7.4e-3 after 1536, 2048, 3072 iterations while its bound
     // rose 27.6, 31.1, 43.6 against an objective of 25; a 1024-iteration window stopped it at
-    // 3072 (4.3 min on 2 cores), this one at 2048.
+    // 3072 (4.3 min on 2 cores).
     if (params.stop_on_divergence && total >= window_end) {
       std::vector<double> xh, yh;
       backend->read(xh, yh);
-      const double scale = 1.0 + std::abs(s.cx);
-      // Below the tolerance, the primal residual alone says little: there the gap must be far
-      // above it and have grown over the window (measured: a 1 474-face reduced LP at tolerance
-      // 1e-3 sat at residual 5.6e-4 with its bound 4.3 above an objective of 8.6, still rising,
-      // for 35 000 iterations).
-      const bool stalled = primal > params.tolerance || (gap > 10.0 * params.tolerance && gap > window_gap);
-      // A slower climb counts too where it held for kCreepingWindows windows in a row: the bound
-      // above the objective, the gap growing, the residual flat (TOSCA_r horse0-5's finest LP:
-      // residual 1.2e-3 → 1.0e-3 while the gap grew 4.3e-3 → 3.8e-2 over 3 600 iterations, its
-      // bound rising about 1.1 per window against an objective of 63, short of the 5 % above).
-      const bool flat = !window_y.empty() && primal >= 0.8 * window_primal;
-      creeping = flat && dual_obj > s.cx && gap > params.tolerance && gap > window_gap ? creeping + 1 : 0;
-      if ((flat && stalled && dual_obj - s.cx > 0.1 * scale && dual_obj - window_dual > 0.05 * scale) ||
-          creeping >= kCreepingWindows) {
+      if (watch.diverging(primal, gap, s.cx, dual_obj) && !window_y.empty()) {
         result.status = LpStatus::Diverging;
         result.y.resize(m);
         result.last_y.resize(m);
@@ -266,10 +245,7 @@ LpResult PdhgSolver::solve(const LpProblem& problem, const SolverParams& params)
         break;
       }
       window_y = std::move(yh);
-      window_primal = primal;
-      window_dual = dual_obj;
-      window_gap = gap;
-      window_end = total + kDivergenceWindow;
+      window_end = total + detail::DivergenceWatch::kWindow;
     }
 
     // Restarts on the fixed-point residual (cuPDLPx): sufficient decay, necessary decay without

@@ -43,8 +43,10 @@ MeshHierarchy build_hierarchy(const Mesh& input, const std::vector<int>& face_co
 
 // The parent of every fine face: the coarse face nearest to its centroid (point-to-triangle
 // distance) among those whose normal does not point away from the fine face's (so thin parts do
-// not take parents from the opposite side); the nearest of all if none qualifies.
-std::vector<int> parent_faces(const Mesh& fine, const Mesh& coarse);
+// not take parents from the opposite side); the nearest of all if none qualifies. With `kept`
+// (for every coarse vertex its fine vertex, as decimation gives it) only the coarse faces around
+// the kept vertices nearest on the fine surface compete, so that no parent lies across a gap.
+std::vector<int> parent_faces(const Mesh& fine, const Mesh& coarse, const std::vector<int>& kept = {});
 
 // Squared distance from p to the triangle abc (closest point on its interior, edges or corners).
 double squared_distance_to_triangle(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
