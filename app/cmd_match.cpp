@@ -300,6 +300,7 @@ int run_match(const MatchArgs& args) {
                               .set("levels", matcher.x_levels().size())
                               .set("coarsest_faces", args.hierarchy.coarsest_faces)
                               .set("second_faces", args.hierarchy.second_faces)
+                              .set("surface_parents", args.hierarchy.surface_parents)
                               .set("level_ratio", args.hierarchy.ratio)
                               .set("ring", args.ring)
                               .set("neighbourhood", args.neighbourhood)
@@ -413,6 +414,10 @@ Action add_match_command(CLI::App& app) {
   app.add_option("--coarsest-faces", a->hierarchy.coarsest_faces, "faces of the coarsest level")
       ->check(CLI::Range(4, 1 << 30))
       ->capture_default_str();
+  app.add_flag_function(
+      "--nearest-parents", [a](int64_t) { a->hierarchy.surface_parents = false; },
+      "a fine face's parent is the nearest coarse face in space, not the nearest among those around the "
+               "kept vertices nearest on the surface");
   app.add_option("--second-faces", a->hierarchy.second_faces,
                  "faces of the level above the coarsest, which is also solved over its full product space (the "
                  "lower-energy Γ goes on); 0: off, levels geometric from the coarsest")

@@ -295,8 +295,8 @@ CoarseToFineMatcher::CoarseToFineMatcher(const Mesh& x, const Mesh& y, CoarseToF
     ho.levels = static_cast<int>(
         std::max(level_face_counts(x.num_faces(), ho).size(), level_face_counts(y.num_faces(), ho).size()));
   const std::vector<int> cx = level_face_counts(x.num_faces(), ho), cy = level_face_counts(y.num_faces(), ho);
-  hx_ = build_hierarchy(x, cx);
-  hy_ = build_hierarchy(y, cy);
+  hx_ = build_hierarchy(x, cx, ho.surface_parents);
+  hy_ = build_hierarchy(y, cy, ho.surface_parents);
   // A second start only where both shapes have the second level of that size (not where a small
   // input made the levels plain geometric).
   second_level_ = options_.second_start && ho.second_faces > 0 && cx.size() > 1 && cx[1] == ho.second_faces &&

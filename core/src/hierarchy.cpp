@@ -176,7 +176,7 @@ std::vector<int> parent_faces(const Mesh& fine, const Mesh& coarse, const std::v
   return parent;
 }
 
-MeshHierarchy build_hierarchy(const Mesh& input, const std::vector<int>& face_counts) {
+MeshHierarchy build_hierarchy(const Mesh& input, const std::vector<int>& face_counts, bool surface_parents) {
   if (face_counts.empty()) throw InvalidInputError("hierarchy: no levels");
   MeshHierarchy h;
   h.levels.resize(face_counts.size());
@@ -191,7 +191,7 @@ MeshHierarchy build_hierarchy(const Mesh& input, const std::vector<int>& face_co
     level.mesh = decimate(finer.mesh, face_counts[l], &kept);
     level.input_vertex.resize(kept.size());
     for (size_t v = 0; v < kept.size(); ++v) level.input_vertex[v] = finer.input_vertex[kept[v]];
-    finer.parent_face = parent_faces(finer.mesh, level.mesh, kept);
+    finer.parent_face = parent_faces(finer.mesh, level.mesh, surface_parents ? kept : std::vector<int>{});
   }
   for (auto& level : h.levels) level.geometry = compute_geometry(level.mesh);
   return h;

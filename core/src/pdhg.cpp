@@ -67,7 +67,7 @@ void compute_scaling(const LpProblem& p, int ruiz_iterations, int threads, std::
 double estimate_norm(const LpProblem& p, const std::vector<double>& r, const std::vector<double>& d, int iterations,
                      int threads, double margin, double cap) {
   const int64_t m = p.rows(), n = p.cols();
-  std::vector<double> v(n), u(m), w(n);
+  std::vector<double> v(n), w(n), dv(n), ru(m);  // dv = d∘v, ru = r∘(Ãv): one gather per entry
   std::mt19937 rng(12345);
   std::uniform_real_distribution<double> uni(0.5, 1.5);
   for (auto& x : v) x = uni(rng);
@@ -75,20 +75,20 @@ double estimate_norm(const LpProblem& p, const std::vector<double>& r, const std
   for (int it = 0; it < iterations; ++it) {
     const double nv = std::sqrt(std::inner_product(v.begin(), v.end(), v.begin(), 0.0));
     if (nv == 0.0) return 1.0;
-    for (auto& x : v) x /= nv;
+    for (int64_t j = 0; j < n; ++j) dv[j] = d[j] * (v[j] /= nv);
     detail::parallel_for(m, threads, [&](int64_t i) {
       double s = 0.0;
       for (uint32_t k = p.a.row_ptr[i]; k < p.a.row_ptr[i + 1]; ++k) {
         const uint32_t e = p.a.entry[k];
-        s += (is_negative(e) ? -1.0 : 1.0) * d[col_of(e)] * v[col_of(e)];
+        s += is_negative(e) ? -dv[col_of(e)] : dv[col_of(e)];
       }
-      u[i] = r[i] * s;
+      ru[i] = r[i] * (r[i] * s);
     });
     detail::parallel_for(n, threads, [&](int64_t j) {
       double s = 0.0;
       for (uint32_t k = p.at.row_ptr[j]; k < p.at.row_ptr[j + 1]; ++k) {
         const uint32_t e = p.at.entry[k];
-        s += (is_negative(e) ? -1.0 : 1.0) * r[col_of(e)] * u[col_of(e)];
+        s += is_negative(e) ? -ru[col_of(e)] : ru[col_of(e)];
       }
       w[j] = d[j] * s;
     });
