@@ -21,8 +21,10 @@ struct HierarchyOptions {
   // Parents from around the kept vertices nearest on the fine surface (parent_faces with `kept`),
   // not the nearest coarse face in space, which can lie across a gap (measured on the
   // deformation-transfer cat 0001-0005 at full resolution: its level 4 widened 14 times, 1.7 M →
-  // 6.3 M variables, and went on failing; with these parents 4 times, to 2.1 M, and solved).
-  bool surface_parents = true;
+  // 6.3 M variables, and went on failing; with these parents 4 times, to 2.1 M, and solved). Off
+  // by default: on FAUST_r 020-024 it moves one parent at 1 414 faces and 31 at full resolution,
+  // and that run's level 6 rounding then went on for 15 minutes without an end (8 before).
+  bool surface_parents = false;
 };
 
 struct MeshLevel {
@@ -44,7 +46,7 @@ std::vector<int> level_face_counts(int input_faces, const HierarchyOptions& opti
 
 // Decimates level by level from the input (each level from the next finer one, so that vertex
 // subsets nest) and links every face to a parent.
-MeshHierarchy build_hierarchy(const Mesh& input, const std::vector<int>& face_counts, bool surface_parents = true);
+MeshHierarchy build_hierarchy(const Mesh& input, const std::vector<int>& face_counts, bool surface_parents = false);
 
 // The parent of every fine face: the coarse face nearest to its centroid (point-to-triangle
 // distance) among those whose normal does not point away from the fine face's (so thin parts do
