@@ -53,6 +53,8 @@ struct MatchArgs {
   bool warm_widening = CoarseToFineOptions{}.warm_widening;
   double stuck_after = CoarseToFineOptions{}.stuck_after;
   bool stuck_carry = CoarseToFineOptions{}.stuck_carry;
+  int price_widenings = CoarseToFineOptions{}.price_widenings;
+  double price_threshold = CoarseToFineOptions{}.price_threshold;
 };
 
 // auto: a GPU if there is one, else the native solver (lavapipe is for testing, not speed).
@@ -116,6 +118,8 @@ int run_match(const MatchArgs& args) {
   co.warm_widening = args.warm_widening;
   co.stuck_after = args.stuck_after;
   co.stuck_carry = args.stuck_carry;
+  co.price_widenings = args.price_widenings;
+  co.price_threshold = args.price_threshold;
   co.matching = matching_options(args.pair, p);
   RoundingOptions& ro = co.rounding;
   ro.solver = solver_for(args);
@@ -311,7 +315,9 @@ int run_match(const MatchArgs& args) {
                               .set("max_local_widenings", args.max_local_widenings)
                               .set("warm_widening", args.warm_widening)
                               .set("stuck_after", args.stuck_after)
-                              .set("stuck_carry", args.stuck_carry));
+                              .set("stuck_carry", args.stuck_carry)
+                              .set("price_widenings", args.price_widenings)
+                              .set("price_threshold", args.price_threshold));
     report.set("seconds", seconds);
     report.set("peak_rss_mb", peak_rss_mb());
     report.set("round_log", rounds);
@@ -330,6 +336,7 @@ int run_match(const MatchArgs& args) {
                       .set("margin_widenings", l.margin_widenings)
                       .set("widened_faces", l.widened_faces)
                       .set("stuck_widenings", l.stuck_widenings)
+                      .set("price_widenings", l.price_widenings)
                       .set("carried_fixings", l.carried_fixings)
                       .set("iterations_bound", l.iterations_bound)
                       .set("rounds", l.rounds)
@@ -460,6 +467,15 @@ Action add_match_command(CLI::App& app) {
   app.add_flag("--stuck-carry", a->stuck_carry,
                "with --stuck-after: go on from the stuck rounding's fixings in the widened space instead of "
                "afresh (measured slower)");
+  app.add_option("--price-widenings", a->price_widenings,
+                 "after a refined level's first LP, price the columns one ring out against its dual and widen the X "
+                 "faces of those below zero, up to this many times per level, before rounding (0: off)")
+      ->check(CLI::Range(0, 16))
+      ->capture_default_str();
+  app.add_option("--price-threshold", a->price_threshold,
+                 "with --price-widenings: how far below zero (energy units) a column's reduced cost must be")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
   app.add_option("--y-margin", a->y_margin,
                  "more fine rings on Y around every face's candidates, at every ring (fine neighbourhood)")
       ->check(CLI::Range(0, 8))

@@ -69,6 +69,88 @@ std::vector<int> faces_to_widen(const MatchingLp& m, const ProofPlace& p, int ma
   return faces_on(X, x, 1 + margin);
 }
 
+// Pricing one ring out: the product triangles that one more fine ring on every X face would add,
+// priced against the dual of the reduced LP's first solve (reduced cost c_j − A_jᵀy, in energy
+// units; rows the reduced LP lacks at 0). Where the reduced space cuts off a lower-energy Γ, such
+// columns price below zero, and the X faces they sit on can be widened before rounding rather
+// than after it gets stuck there. `noise`: the same reduced cost of the kept columns at 0 in the
+// first LP's iterate, whose low tail says how far below zero an approximate dual reaches by itself.
+struct Pricing {
+  int64_t columns = 0;     // priced: those the reduced space lacks
+  int64_t below = 0;       // of them, below −threshold
+  double lowest = 0.0;     // their lowest reduced cost
+  double noise = 0.0;      // the kept columns' reduced cost at the 1e-4 quantile (≤ 0)
+  double threshold = 0.0;  // what counted as below zero
+  std::vector<int> faces;  // X faces of the columns below −threshold
+};
+
+double reduced_cost(const LpProblem& lp, int64_t j, const std::vector<double>& y) {
+  double s = 0.0;
+  for (uint32_t k = lp.at.row_ptr[j]; k < lp.at.row_ptr[j + 1]; ++k) {
+    const uint32_t e = lp.at.entry[k];
+    s += is_negative(e) ? -y[col_of(e)] : y[col_of(e)];
+  }
+  return (lp.c[j] - s) * lp.objective_scale;
+}
+
+// `wider`: the space one ring out (a superset of m's); `x`, `y`: m's first iterate.
+Pricing price_wider_space(const MatchingLp& m, std::vector<ProductTriangle> wider, const EnergyModel& model,
+                          bool scale_costs, const std::vector<double>& x, const std::vector<double>& y,
+                          double min_threshold) {
+  Pricing p;
+  // The approximate dual's own low tail, over the kept columns the iterate leaves at 0.
+  std::vector<double> kept;
+  for (int64_t j = 0; j < m.lp.cols(); ++j)
+    if (x[j] < 1e-6) kept.push_back(reduced_cost(m.lp, j, y));
+  if (!kept.empty()) {
+    const size_t q = kept.size() / 10000;
+    std::nth_element(kept.begin(), kept.begin() + q, kept.end());
+    p.noise = std::min(0.0, kept[q]);
+  }
+  p.threshold = std::max(min_threshold, -p.noise);
+  std::vector<uint64_t> keys(m.lp.cols());
+  for (int64_t j = 0; j < m.lp.cols(); ++j) keys[j] = CarriedIterate::key(m.space[j]);
+  std::sort(keys.begin(), keys.end());
+  std::erase_if(wider, [&](const ProductTriangle& t) {
+    return std::binary_search(keys.begin(), keys.end(), CarriedIterate::key(t));
+  });
+  keys = {};
+  p.columns = static_cast<int64_t>(wider.size());
+  const Mesh& X = m.space.x();
+  const std::vector<std::vector<int>> vf = vertex_face_table(X);
+  std::vector<char> mark(X.num_faces(), 0);
+  // In slices, so that the priced LP never holds more than a slice's columns and rows.
+  constexpr size_t kSlice = 2'000'000;
+  for (size_t begin = 0; begin < wider.size(); begin += kSlice) {
+    std::vector<ProductTriangle> slice(wider.begin() + begin, wider.begin() + std::min(wider.size(), begin + kSlice));
+    const MatchingLp ms = build_matching_lp(ProductSpace::from_list(X, m.space.y(), std::move(slice)), model, scale_costs);
+    const std::vector<double> rcs = reduced_costs(m, y, ms);
+    for (int64_t j = 0; j < ms.lp.cols(); ++j) {
+      const double rc = rcs[j];
+      p.lowest = std::min(p.lowest, rc);
+      if (rc >= -p.threshold) continue;
+      ++p.below;
+      const ProductTriangle t = ms.space[j];
+      if (t.fa >= 0) {
+        mark[t.fa] = 1;
+        continue;
+      }
+      // A degenerate X part (an edge or a vertex): every face on it.
+      for (int f : vf[t.a[0]]) {
+        const auto& fv = X.faces[f];
+        auto has = [&](int v) { return fv[0] == v || fv[1] == v || fv[2] == v; };
+        if (has(t.a[1]) && has(t.a[2])) mark[f] = 1;
+      }
+    }
+  }
+  for (int f = 0; f < X.num_faces(); ++f)
+    if (mark[f]) p.faces.push_back(f);
+  return p;
+}
+
+// Thrown from round 1's progress to leave the rounding once pricing has widened the space.
+struct PricedWider {};
+
 // Each place costs a propagation pass and a scan of the space; past this many, widen what was
 // found and look again on the widened space.
 constexpr int kMaxConflictPlaces = 256;
@@ -350,10 +432,10 @@ CoarseToFineResult CoarseToFineMatcher::run(const Progress& progress) const {
 }
 
 void CarriedIterate::keep(const MatchingLp& m, const std::vector<double>& x, const std::vector<double>& y) {
-  if (x.size() != size_t(m.lp.cols()) || y.size() != size_t(m.lp.rows()))
-    throw InvalidInputError("carried iterate: need one value per column and per row");
+  if ((!x.empty() && x.size() != size_t(m.lp.cols())) || y.size() != size_t(m.lp.rows()))
+    throw InvalidInputError("carried iterate: need one value per column (or none) and per row");
   x_.clear();
-  for (int64_t j = 0; j < m.lp.cols(); ++j)  // mostly 0: keep the rest
+  for (int64_t j = 0; j < int64_t(x.size()); ++j)  // mostly 0: keep the rest
     if (x[j] > 1e-9) x_.emplace_back(key(m.space[j]), x[j]);
   std::sort(x_.begin(), x_.end());
   row_edge_ = m.row_edge;
@@ -391,6 +473,16 @@ uint64_t CarriedIterate::key(const ProductTriangle& t) {
   return h ^ (h >> 31);
 }
 
+std::vector<double> reduced_costs(const MatchingLp& m, const std::vector<double>& y, const MatchingLp& other) {
+  CarriedIterate dual;
+  dual.keep(m, {}, y);
+  SolverParams mapped;
+  dual.apply(other, mapped);
+  std::vector<double> rc(other.lp.cols());
+  for (int64_t j = 0; j < other.lp.cols(); ++j) rc[j] = reduced_cost(other.lp, j, mapped.initial_y);
+  return rc;
+}
+
 RoundingOptions CoarseToFineMatcher::rounding_for(int l) const {
   RoundingOptions ro = options_.rounding;
   if (l + 1 < hx_.size() && options_.coarse_tolerance > 0.0) ro.lp.tolerance = options_.coarse_tolerance;
@@ -418,6 +510,12 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
   std::vector<char> released_x;  // X vertices of the faces just widened: fixings over them go
   CarriedIterate first, last;
   int64_t first_iterations = 0;  // of the first LP of the attempt that started afresh
+  // Pricing (price_widenings): the first LP's iterate, and after a widening it called for, the
+  // same kept by identity to start the widened LP from (it was optimal, unlike after divergence).
+  int priced = 0;
+  std::vector<double> first_x, first_y;
+  CarriedIterate priced_from;
+  bool price_warm = false;
   double first_seconds = 0.0;
   // One more fine ring on these faces (up to `cap` rings); false if none could grow. `last`: the
   // level's regional widening, which comes after max_local_widenings.
@@ -480,6 +578,23 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
       }
     return false;
   };
+  // Prices the space one ring out against the first LP's dual (first_x, first_y) and widens the
+  // X faces of the columns below zero; false where none did or none could widen.
+  auto price_and_widen = [&](const MatchingLp& m) {
+    Stopwatch clock;
+    std::vector<int> wider_extra = extra;
+    wider_extra.resize(lx.mesh.num_faces(), 0);
+    for (int& e : wider_extra) ++e;
+    const Pricing p = price_wider_space(
+        m,
+        reduced_product_space(lx, ly, hx_.levels[l - 1].mesh, hy_.levels[l - 1].mesh, gamma, ring,
+                              options_.neighbourhood, wider_extra, options_.y_margin),
+        model, options_.matching.scale_costs, first_x, first_y, options_.price_threshold);
+    spdlog::info("level {}: priced {} columns one ring out: {} below -{:.3g} (lowest {:.3g}, the kept columns' "
+                 "noise {:.3g}) on {} X faces ({:.2f} s)",
+                 l + 1, p.columns, p.below, p.threshold, p.lowest, p.noise, p.faces.size(), clock.seconds());
+    return !p.faces.empty() && widen_locally(p.faces, "cutting off columns that price below zero", options_.max_ring);
+  };
   for (;;) {
     MatchingLp m;
     if (l == 0) {
@@ -522,11 +637,19 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
       if (l > 0 && options_.warm_widening && !carrying) {
         if (!warm.empty()) warm.apply(m, ro.lp);
       }
+      if (price_warm && !carrying) priced_from.apply(m, ro.lp);
+      price_warm = false;
+      const bool pricing = l > 0 && !carrying && priced < options_.price_widenings && options_.local_widening &&
+                           local < options_.max_local_widenings;
       const bool may_carry = options_.stuck_after > 0.0 && options_.stuck_carry;
-      if (l > 0 && (options_.warm_widening || may_carry) && !carrying)
+      if (l > 0 && (options_.warm_widening || may_carry || pricing) && !carrying)
         ro.first_iterate = [&](const std::vector<double>& x, const std::vector<double>& y) {
           if (options_.warm_widening) warm.keep(m, x, y);
           if (may_carry) first.keep(m, x, y);
+          if (pricing) {
+            first_x = x;
+            first_y = y;
+          }
         };
       if (carrying) {
         std::sort(carried_ones.begin(), carried_ones.end());
@@ -556,6 +679,10 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
                                                      first_seconds = r.seconds;
                                                    }
                                                    if (progress) progress(rep, r);
+                                                   if (pricing && r.round == 1 && r.status == LpStatus::Optimal &&
+                                                       first_y.size() == size_t(m.lp.rows()) &&
+                                                       price_and_widen(m))
+                                                     throw PricedWider{};
                                                  });
       if (carrying) {
         // Round 1 solved only what the carried fixings left: the widened LP's bound is certified
@@ -584,6 +711,14 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
         result.rounding = std::move(rr);
       }
       break;
+    } catch (const PricedWider&) {
+      ++rep.price_widenings;
+      ++priced;
+      priced_from.keep(m, first_x, first_y);
+      price_warm = true;
+      first_x = {};
+      first_y = {};
+      continue;
     } catch (const InfeasibleError& e) {
       if (l == 0) throw;
       ProofPlace proof(m);

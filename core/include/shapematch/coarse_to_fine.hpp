@@ -28,6 +28,7 @@ enum class Neighbourhood { Coarse, Fine };
 class CarriedIterate {
 public:
   bool empty() const { return scale_ == 0.0; }
+  // `x` may be empty: the dual alone (every variable then starts at 0).
   void keep(const MatchingLp& m, const std::vector<double>& x, const std::vector<double>& y);
   // Fills params.initial_x / initial_y for `m` (nothing where empty).
   void apply(const MatchingLp& m, SolverParams& params) const;
@@ -89,6 +90,13 @@ struct CoarseToFineOptions {
   // first LP's iterations) stayed unconverged, and its rounds failed and were trimmed for
   // 10+ minutes, where a fresh attempt finished in 7 (its first LP included).
   bool stuck_carry = false;
+  // After a refined level's first LP (optimal), price the product triangles that one more fine
+  // ring on every X face would add against its dual; where some price below zero (by more than
+  // price_threshold, in energy units, and than the dual's own noise on the kept columns), widen
+  // their X faces by one ring and solve again from that LP's iterate, before rounding: up to
+  // this many times per level. 0: off.
+  int price_widenings = 0;
+  double price_threshold = 1e-4;
   // More fine rings on Y at every ring (fine neighbourhood): a wider space from the start, paid
   // for in variables, against infeasible reduced LPs whose proof PDHG must find (slow at
   // 10 k faces).
@@ -115,6 +123,13 @@ struct CoarseToFineOptions {
   double second_start_fractional_batch = 0.125;
 };
 
+// Pricing: the reduced costs c_j − A_jᵀy of `other`'s columns, in energy units, against a dual
+// `y` of `m`'s LP mapped to `other`'s rows by identity (rows `m` lacks at 0). Where `other` is a
+// wider space of the same meshes and `y` is optimal for `m`, none below zero means `m`'s optimum
+// is `other`'s too (the mapped y stays dual feasible with the same objective); one below zero
+// says the narrower space may cut off a lower energy there.
+std::vector<double> reduced_costs(const MatchingLp& m, const std::vector<double>& y, const MatchingLp& other);
+
 // The reduced product space of eq. (17): every product triangle (f_a, f_b) of the fine meshes
 // such that some (f'_a, f'_b) of the coarse Γ has χ(f_a) ∈ N(f'_a) and ψ(f_b) ∈ N(f'_b).
 // Degenerate fine elements (vertices, edges) inherit the parents of their incident faces.
@@ -140,6 +155,7 @@ struct LevelReport {
   int margin_widenings = 0;    // of those, past max_ring near the proof or with a margin around it
   int64_t widened_faces = 0;   // fine X faces widened locally, summed over those times
   int stuck_widenings = 0;     // of the local widenings, those where rounding was stuck (stuck_after)
+  int price_widenings = 0;     // of the local widenings, those where pricing found columns below zero
   int64_t carried_fixings = 0; // fixings to 1 the last of those went on from
   int64_t iterations_bound = 0;  // of the LP solved again for the bound after one
   int rounds = 0;
