@@ -510,13 +510,13 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
   std::vector<char> released_x;  // X vertices of the faces just widened: fixings over them go
   CarriedIterate first, last;
   int64_t first_iterations = 0;  // of the first LP of the attempt that started afresh
+  double first_seconds = 0.0;
   // Pricing (price_widenings): the first LP's iterate, and after a widening it called for, the
   // same kept by identity to start the widened LP from (it was optimal, unlike after divergence).
   int priced = 0;
   std::vector<double> first_x, first_y;
   CarriedIterate priced_from;
   bool price_warm = false;
-  double first_seconds = 0.0;
   // One more fine ring on these faces (up to `cap` rings); false if none could grow. `last`: the
   // level's regional widening, which comes after max_local_widenings.
   auto widen_locally = [&](const std::vector<int>& faces, const char* why, int cap, bool last = false) {
