@@ -35,6 +35,33 @@ std::set<int64_t> full_indices(const ProductSpace& full, const std::vector<Produ
   for (const auto& t : list) s.insert(full.index_in_full(t));
   return s;
 }
+// The finger pair at two levels (`coarse` and `fine` faces per shape), the coarse level matched,
+// and the LP of the fine level's ring-1 space with `extra` rings on some X faces.
+struct FingerLevels {
+  FingerLevels(int coarse_faces, int fine_faces)
+      : hx(build_hierarchy(decimate(shapes::bent_finger(10, 8, 8), fine_faces), {coarse_faces, fine_faces})),
+        hy(build_hierarchy(decimate(shapes::bent_finger(60, 8, 8), fine_faces), {coarse_faces, fine_faces})),
+        gx(compute_geometry(x())), gy(compute_geometry(y())), model(x(), gx, y(), gy) {
+    const Mesh& xc = hx.levels[0].mesh;
+    const Mesh& yc = hy.levels[0].mesh;
+    const MatchingLp coarse = build_matching_lp(xc, compute_geometry(xc), yc, compute_geometry(yc));
+    const RoundingResult cr = round_to_graph_surface(coarse.space, coarse.lp, coarse.energy);
+    for (int64_t j : cr.gamma) gamma.push_back(coarse.space[j]);
+  }
+  const Mesh& x() const { return hx.levels[1].mesh; }
+  const Mesh& y() const { return hy.levels[1].mesh; }
+  MatchingLp lp_at(const std::vector<int>& extra) const {
+    return build_matching_lp(ProductSpace::from_list(x(), y(), reduced_product_space(hx.levels[1], hy.levels[1],
+                                                                                     hx.levels[0].mesh, hy.levels[0].mesh,
+                                                                                     gamma, 1, Neighbourhood::Fine, extra)),
+                             model);
+  }
+
+  MeshHierarchy hx, hy;
+  Geometry gx, gy;  // the model refers to them
+  EnergyModel model;
+  std::vector<ProductTriangle> gamma;
+};
 }  // namespace
 
 TEST_CASE("coarse to fine: the reduced space is a duplicate-free subset that grows with the ring") {
@@ -301,23 +328,10 @@ TEST_CASE("coarse to fine: an infeasible reduced LP is widened near the proof, n
 TEST_CASE("coarse to fine: an iterate carried to a wider space keeps its values by identity and starts near the optimum") {
   // The finger pair's two levels; the fine LP over ring 1 solved, its iterate carried to the LP
   // of a space widened on some faces.
-  const Mesh xf = decimate(shapes::bent_finger(10, 8, 8), 320), yf = decimate(shapes::bent_finger(60, 8, 8), 320);
-  const MeshHierarchy hx = build_hierarchy(xf, {40, 320}), hy = build_hierarchy(yf, {40, 320});
-  const Mesh& xc = hx.levels[0].mesh;
-  const Mesh& yc = hy.levels[0].mesh;
-  const Mesh& x = hx.levels[1].mesh;
-  const Mesh& y = hy.levels[1].mesh;
-  const MatchingLp coarse = build_matching_lp(xc, compute_geometry(xc), yc, compute_geometry(yc));
-  const RoundingResult cr = round_to_graph_surface(coarse.space, coarse.lp, coarse.energy);
-  std::vector<ProductTriangle> gamma;
-  for (int64_t j : cr.gamma) gamma.push_back(coarse.space[j]);
-  const Geometry gx = compute_geometry(x), gy = compute_geometry(y);  // the model refers to them
-  const EnergyModel model(x, gx, y, gy);
-  auto lp_at = [&](const std::vector<int>& extra) {
-    return build_matching_lp(ProductSpace::from_list(x, y, reduced_product_space(hx.levels[1], hy.levels[1], xc, yc,
-                                                                                 gamma, 1, Neighbourhood::Fine, extra)),
-                             model);
-  };
+  const FingerLevels f(40, 320);
+  const Mesh& x = f.x();
+  const Mesh& y = f.y();
+  auto lp_at = [&](const std::vector<int>& extra) { return f.lp_at(extra); };
   // As a local widening does: one more ring on a few faces (every tenth).
   std::vector<int> extra(x.num_faces(), 0);
   for (int f = 0; f < x.num_faces(); f += 10) extra[f] = 1;
@@ -466,23 +480,9 @@ TEST_CASE("coarse to fine: a stuck rounding widens around its failed parts and g
 TEST_CASE("coarse to fine: pricing a wider space against an exact dual says whether it lowers the optimum") {
   // The finger pair's fine level at ring 1 (narrow) and with one more ring on every X face
   // (wide), both solved exactly by Clp: the narrow dual prices the wide columns.
-  const Mesh xf = decimate(shapes::bent_finger(10, 8, 8), 48), yf = decimate(shapes::bent_finger(60, 8, 8), 48);
-  const MeshHierarchy hx = build_hierarchy(xf, {16, 48}), hy = build_hierarchy(yf, {16, 48});
-  const Mesh& xc = hx.levels[0].mesh;
-  const Mesh& yc = hy.levels[0].mesh;
-  const Mesh& x = hx.levels[1].mesh;
-  const Mesh& y = hy.levels[1].mesh;
-  const MatchingLp coarse = build_matching_lp(xc, compute_geometry(xc), yc, compute_geometry(yc));
-  const RoundingResult cr = round_to_graph_surface(coarse.space, coarse.lp, coarse.energy);
-  std::vector<ProductTriangle> gamma;
-  for (int64_t j : cr.gamma) gamma.push_back(coarse.space[j]);
-  const Geometry gx = compute_geometry(x), gy = compute_geometry(y);
-  const EnergyModel model(x, gx, y, gy);
-  auto lp_at = [&](const std::vector<int>& extra) {
-    return build_matching_lp(ProductSpace::from_list(x, y, reduced_product_space(hx.levels[1], hy.levels[1], xc, yc,
-                                                                                 gamma, 1, Neighbourhood::Fine, extra)),
-                             model);
-  };
+  const FingerLevels f(16, 48);
+  const Mesh& x = f.x();
+  auto lp_at = [&](const std::vector<int>& extra) { return f.lp_at(extra); };
   const MatchingLp narrow = lp_at({}), wide = lp_at(std::vector<int>(x.num_faces(), 1));
   REQUIRE(narrow.lp.cols() < wide.lp.cols());
   const LpResult a = solve_lp(narrow.lp, "clp-dual"), b = solve_lp(wide.lp, "clp-dual");
