@@ -679,10 +679,13 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
                                                      first_seconds = r.seconds;
                                                    }
                                                    if (progress) progress(rep, r);
-                                                   if (pricing && r.round == 1 && r.status == LpStatus::Optimal &&
-                                                       first_y.size() == size_t(m.lp.rows()) &&
-                                                       price_and_widen(m))
-                                                     throw PricedWider{};
+                                                   if (pricing && r.round == 1) {
+                                                     if (r.status == LpStatus::Optimal &&
+                                                         first_y.size() == size_t(m.lp.rows()) && price_and_widen(m))
+                                                       throw PricedWider{};
+                                                     first_x = {};  // not needed for the rest of the rounding
+                                                     first_y = {};
+                                                   }
                                                  });
       if (carrying) {
         // Round 1 solved only what the carried fixings left: the widened LP's bound is certified
