@@ -96,7 +96,9 @@ struct CoarseToFineOptions {
   // their X faces by one ring and solve again from that LP's iterate, before rounding: up to
   // this many times per level. 0: off. Measured at full resolution (FAUST_r, 2 cores): 020-024
   // energy 20.48 -> 15.11 (error 0.0210 -> 0.0173, 17:48 -> 16:28), 020-021 27.30 -> 21.64
-  // (23:08 -> 15:25: no stuck rounding); at 4000 faces 14.97 -> 11.96, but 71 -> 136 s.
+  // (23:08 -> 15:25: no stuck rounding), TOSCA_r horse0-horse5 61.86 -> 52.81 (gap 2.32 % ->
+  // 0.91 %); at 4000 faces 14.97 -> 11.96, but 71 -> 136 s. 021-024 did not finish with it (its
+  // level 6 spent every local widening on propagation conflicts).
   int price_widenings = 2;
   double price_threshold = 1e-4;
   // More fine rings on Y at every ring (fine neighbourhood): a wider space from the start, paid
