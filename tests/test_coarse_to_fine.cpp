@@ -438,12 +438,12 @@ TEST_CASE("coarse to fine: a stuck rounding widens around its failed parts and g
   o.rounding.greedy_above = 0;
   o.rounding.greedy_margin = 2;
   o.price_widenings = 0;  // pricing widens this ring-0 space before rounding, which then is not stuck
+  const Mesh x = decimate(shapes::bent_finger(10, 8, 8), 120), y = decimate(shapes::bent_finger(60, 8, 8), 130);
   for (const int mode : {0, 1, 2}) {  // off, afresh, carried
     CAPTURE(mode);
     o.stuck_after = mode == 0 ? 0.0 : 1e-12;
     o.stuck_carry = mode == 2;
-    const CoarseToFineMatcher matcher(decimate(shapes::bent_finger(10, 8, 8), 120),
-                                      decimate(shapes::bent_finger(60, 8, 8), 130), o);
+    const CoarseToFineMatcher matcher(x, y, o);
     const CoarseToFineResult r = matcher.run();
     const LevelReport& l = r.levels.back();
     CHECK(l.stuck_widenings == (mode > 0 ? 1 : 0));
@@ -462,11 +462,11 @@ TEST_CASE("coarse to fine: a stuck rounding widens around its failed parts and g
   // here, the stuck widening more; pricing only ever adds to a space).
   o.stuck_after = 1e-12;
   o.stuck_carry = false;
-  const CoarseToFineMatcher off(decimate(shapes::bent_finger(10, 8, 8), 120), decimate(shapes::bent_finger(60, 8, 8), 130), o);
+  const CoarseToFineMatcher off(x, y, o);
   const CoarseToFineResult without = off.run();
   o.price_widenings = CoarseToFineOptions{}.price_widenings;
   REQUIRE(o.price_widenings > 0);
-  const CoarseToFineMatcher on(decimate(shapes::bent_finger(10, 8, 8), 120), decimate(shapes::bent_finger(60, 8, 8), 130), o);
+  const CoarseToFineMatcher on(x, y, o);
   const CoarseToFineResult priced = on.run();
   const LevelReport& l = priced.levels.back();
   CHECK(l.price_widenings > 0);

@@ -93,6 +93,15 @@ double reduced_cost(const LpProblem& lp, int64_t j, const std::vector<double>& y
   return (lp.c[j] - s) * lp.objective_scale;
 }
 
+// reduced_costs with the dual already carried (kept once for every slice priced).
+std::vector<double> priced_against(const CarriedIterate& dual, const MatchingLp& other) {
+  SolverParams mapped;
+  dual.apply(other, mapped);
+  std::vector<double> rc(other.lp.cols());
+  for (int64_t j = 0; j < other.lp.cols(); ++j) rc[j] = reduced_cost(other.lp, j, mapped.initial_y);
+  return rc;
+}
+
 // `wider`: the space one ring out (a superset of m's); `x`, `y`: m's first iterate.
 Pricing price_wider_space(const MatchingLp& m, std::vector<ProductTriangle> wider, const EnergyModel& model,
                           bool scale_costs, const std::vector<double>& x, const std::vector<double>& y,
@@ -116,6 +125,8 @@ Pricing price_wider_space(const MatchingLp& m, std::vector<ProductTriangle> wide
   });
   keys = {};
   p.columns = static_cast<int64_t>(wider.size());
+  CarriedIterate dual;
+  dual.keep(m, {}, y);
   const Mesh& X = m.space.x();
   const std::vector<std::vector<int>> vf = vertex_face_table(X);
   std::vector<char> mark(X.num_faces(), 0);
@@ -124,7 +135,7 @@ Pricing price_wider_space(const MatchingLp& m, std::vector<ProductTriangle> wide
   for (size_t begin = 0; begin < wider.size(); begin += kSlice) {
     std::vector<ProductTriangle> slice(wider.begin() + begin, wider.begin() + std::min(wider.size(), begin + kSlice));
     const MatchingLp ms = build_matching_lp(ProductSpace::from_list(X, m.space.y(), std::move(slice)), model, scale_costs);
-    const std::vector<double> rcs = reduced_costs(m, y, ms);
+    const std::vector<double> rcs = priced_against(dual, ms);
     for (int64_t j = 0; j < ms.lp.cols(); ++j) {
       const double rc = rcs[j];
       p.lowest = std::min(p.lowest, rc);
@@ -476,11 +487,7 @@ uint64_t CarriedIterate::key(const ProductTriangle& t) {
 std::vector<double> reduced_costs(const MatchingLp& m, const std::vector<double>& y, const MatchingLp& other) {
   CarriedIterate dual;
   dual.keep(m, {}, y);
-  SolverParams mapped;
-  dual.apply(other, mapped);
-  std::vector<double> rc(other.lp.cols());
-  for (int64_t j = 0; j < other.lp.cols(); ++j) rc[j] = reduced_cost(other.lp, j, mapped.initial_y);
-  return rc;
+  return priced_against(dual, other);
 }
 
 RoundingOptions CoarseToFineMatcher::rounding_for(int l) const {
