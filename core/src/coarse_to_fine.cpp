@@ -78,10 +78,10 @@ std::vector<int> faces_to_widen(const MatchingLp& m, const ProofPlace& p, int ma
 // finger pair under Clp's exact dual 80 of 80). What selects is `noise`, the 1e-4 quantile of
 // the same reduced cost over the kept columns at 0, and that low tail is not PDHG's error (over
 // the columns the LP solved it is -1e-7 to 0): it comes from the columns propagation fixed to 0
-// before the LP, which no dual prices (-0.016 to -0.043 on FAUST_r 020-021 at 2000 faces, where it
-// picks 6 to 86 faces; -0.06 to -0.72 on the cat). A heuristic scale
-// of how far below zero the dual leaves a column it never saw, kept because it is what the
-// measured runs used; a dual for the new rows would make the test exact.
+// before the LP, which no dual prices (-0.016 to -0.043 on FAUST_r 020-021 at 2000 faces, where
+// it picks 6 to 86 faces; -0.06 to -0.72 on the cat). A heuristic scale of how far below zero the
+// dual leaves a column it never saw, kept because the measured runs used it; a dual for the new
+// rows would make the test exact.
 struct Pricing {
   int64_t columns = 0;     // priced: those the reduced space lacks
   int64_t below = 0;       // of them, below −threshold

@@ -92,8 +92,8 @@ struct CoarseToFineOptions {
   bool stuck_carry = false;
   // After a refined level's first LP (optimal), price the product triangles that one more fine
   // ring on every X face would add against its dual; where some price below zero (by more than
-  // price_threshold, in energy units, and than the kept columns' low tail, which the columns
-  // propagation fixed to 0 before the LP set: see price_wider_space), widen
+  // price_threshold, in energy units, and than the kept columns' low tail, set by the columns
+  // propagation fixed to 0 before the LP: see price_wider_space), widen
   // their X faces by one ring and solve again from that LP's iterate, before rounding: up to
   // this many times per level. 0: off. Measured at full resolution (FAUST_r, 2 cores): 020-024
   // energy 20.48 -> 15.11 (error 0.0210 -> 0.0173, 17:48 -> 16:28), 020-021 27.30 -> 21.64
