@@ -193,6 +193,28 @@ TEST_CASE("rounding: round 1 starts from a warm start over the whole LP and hand
   CHECK(warm.first_lp.lower_bound == doctest::Approx(cold.first_lp.lower_bound).epsilon(1e-2));
 }
 
+TEST_CASE("rounding: round 1 stops at its own cap, rounds from its iterate, and its bound stays below the optimum") {
+  const MatchingLp& m = dolphins_60();
+  RoundingOptions o;
+  o.solver = "pdhg-cpu";
+  const RoundingResult full = round_to_graph_surface(m.space, m.lp, m.energy, o);
+  REQUIRE(full.first_lp.status == LpStatus::Optimal);
+  REQUIRE(full.first_lp.iterations > 128);
+  o.first_max_iterations = 64;
+  const RoundingResult capped = round_to_graph_surface(m.space, m.lp, m.energy, o);
+  CHECK(capped.first_lp.status == LpStatus::IterationLimit);
+  CHECK(capped.first_lp.iterations <= 64);
+  // Later rounds keep their own caps (round 1's is not theirs): some runs past 64.
+  int64_t longest = 0;
+  for (size_t i = 1; i < capped.rounds.size(); ++i) longest = std::max(longest, capped.rounds[i].iterations);
+  CHECK(longest > 64);
+  CHECK(satisfies_exactly(m.lp, capped.gamma));
+  CHECK(check_graph_surface(m.space, capped.gamma).covers_x);
+  // An unconverged dual still gives a valid (weaker) bound.
+  CHECK(capped.lower_bound <= full.first_lp.objective * (1 + 1e-3));
+  CHECK(capped.lower_bound <= capped.energy);
+}
+
 TEST_CASE("rounding: limits end in an error, never a wrong answer") {
   const Mesh x = shapes::tetrahedron();
   const Mesh y = test::deformed(x, [](const Eigen::Vector3d& p) { return Eigen::Vector3d(p.x(), 2 * p.y(), p.z()); });

@@ -5,6 +5,7 @@
 #include "divergence_watch.hpp"
 #include "parallel.hpp"
 #include "pdhg_backend.hpp"
+#include "scaled_norm.hpp"
 #include "shapematch/errors.hpp"
 #include "shapematch/system.hpp"
 
@@ -12,8 +13,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numeric>
-#include <random>
 
 namespace shapematch {
 namespace {
@@ -59,46 +58,6 @@ void compute_scaling(const LpProblem& p, int ruiz_iterations, int threads, std::
     if (col[j] > 0) d[j] /= std::sqrt(col[j]);
 }
 
-// ‖D_r A D_c‖₂ by power iteration on ÃᵀÃ (a slight overestimate is safe; the step has a margin).
-// The products run in parallel (row by row, the same result); the norms add in order. The
-// estimate never falls from one step to the next (‖Mv‖² ≤ ‖M²v‖ for unit v and symmetric M), so
-// once `margin` times it reaches `cap` the rest cannot change the capped result (each step costs
-// about 1.5 PDHG iterations: 9 s of 100 steps on a 5.4 M-column finest LP on 2 cores).
-double estimate_norm(const LpProblem& p, const std::vector<double>& r, const std::vector<double>& d, int iterations,
-                     int threads, double margin, double cap) {
-  const int64_t m = p.rows(), n = p.cols();
-  std::vector<double> v(n), w(n), dv(n), ru(m);  // dv = d∘v, ru = r∘(Ãv): one gather per entry
-  std::mt19937 rng(12345);
-  std::uniform_real_distribution<double> uni(0.5, 1.5);
-  for (auto& x : v) x = uni(rng);
-  double lambda = 0.0;
-  for (int it = 0; it < iterations; ++it) {
-    const double nv = std::sqrt(std::inner_product(v.begin(), v.end(), v.begin(), 0.0));
-    if (nv == 0.0) return 1.0;
-    for (int64_t j = 0; j < n; ++j) dv[j] = d[j] * (v[j] /= nv);
-    detail::parallel_for(m, threads, [&](int64_t i) {
-      double s = 0.0;
-      for (uint32_t k = p.a.row_ptr[i]; k < p.a.row_ptr[i + 1]; ++k) {
-        const uint32_t e = p.a.entry[k];
-        s += is_negative(e) ? -dv[col_of(e)] : dv[col_of(e)];
-      }
-      ru[i] = r[i] * (r[i] * s);
-    });
-    detail::parallel_for(n, threads, [&](int64_t j) {
-      double s = 0.0;
-      for (uint32_t k = p.at.row_ptr[j]; k < p.at.row_ptr[j + 1]; ++k) {
-        const uint32_t e = p.at.entry[k];
-        s += is_negative(e) ? -ru[col_of(e)] : ru[col_of(e)];
-      }
-      w[j] = d[j] * s;
-    });
-    lambda = std::sqrt(std::inner_product(w.begin(), w.end(), w.begin(), 0.0));  // ≈ σ_max² as v converges
-    v.swap(w);
-    if (margin * std::sqrt(lambda) >= cap) break;
-  }
-  return std::sqrt(lambda);
-}
-
 // A row whose achievable range over the box excludes b_i proves infeasibility at once
 // (e.g. a face of X left with no product triangle after fixing).
 bool row_bounds_infeasible(const LpProblem& p) {
@@ -133,11 +92,12 @@ LpResult PdhgSolver::solve(const LpProblem& problem, const SolverParams& params)
   std::vector<double> r, d;
   compute_scaling(problem, options_.ruiz_iterations, params.threads, r, d);
   const double scaling_seconds = clock.seconds();
-  // Power iteration approaches ‖Ã‖ from below (40 steps were 1 % short on the 100-face pair), so
-  // add a margin; Pock–Chambolle scaling with α = 1 guarantees ‖Ã‖ ≤ 1, which caps it.
-  double norm =
-      std::min(1.0, 1.01 * estimate_norm(problem, r, d, options_.power_iterations, params.threads, 1.01, 1.0));
-  if (!(norm > 1e-12)) norm = 1.0;  // no nonzeros (or no power steps): the Pock–Chambolle bound
+  // The Lanczos estimate approaches ‖Ã‖ from below (within norm_tolerance of an eigenvalue when it
+  // stops), so add a margin; Pock–Chambolle scaling with α = 1 guarantees ‖Ã‖ ≤ 1, which caps it.
+  const detail::NormEstimate estimate = detail::scaled_norm(problem.a, problem.at, r, d, options_.norm_steps,
+                                                            options_.norm_tolerance, params.threads, 1.01, 1.0);
+  double norm = std::min(1.0, 1.01 * estimate.norm);
+  if (!(norm > 1e-12)) norm = 1.0;  // no nonzeros (or no Lanczos steps): the Pock–Chambolle bound
   const double eta = options_.step_safety / norm;
   const double norm_seconds = clock.seconds() - scaling_seconds;
 
@@ -180,8 +140,8 @@ LpResult PdhgSolver::solve(const LpProblem& problem, const SolverParams& params)
   result.device = backend->device();
   backend->load(lp, x0, y0);
   result.setup_seconds = clock.seconds();
-  spdlog::debug("{}: set up in {:.2f} s (scaling {:.2f} s, norm {:.2f} s)", name(), result.setup_seconds,
-                scaling_seconds, norm_seconds);
+  spdlog::debug("{}: set up in {:.2f} s (scaling {:.2f} s, norm {:.2f} s in {} Lanczos steps)", name(),
+                result.setup_seconds, scaling_seconds, norm_seconds, estimate.steps);
   spdlog::debug("{}: {} x {}, ‖Ã‖ ≈ {:.4g}, step {:.4g}, primal weight {:.4g}, on {}", name(), m, n, norm, eta,
                 omega, result.device);
 

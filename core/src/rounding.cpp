@@ -1145,6 +1145,8 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
                                   std::floor(options.later_round_iterations * double(reference)));
       params.max_iterations = std::min<int64_t>(params.max_iterations, static_cast<int64_t>(cap_scale * cap));
     }
+    if (!after_fixing && options.first_max_iterations > 0)
+      params.max_iterations = std::min(params.max_iterations, options.first_max_iterations);
     JoinedSolve joined;
     if (!after_fixing) {
       joined.r = solver->solve(red.lp, params);

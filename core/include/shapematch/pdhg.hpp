@@ -8,7 +8,8 @@ namespace shapematch {
 
 struct PdhgOptions {
   int ruiz_iterations = 10;        // Ruiz equilibration passes before Pock–Chambolle scaling
-  int power_iterations = 100;      // for the estimate of ‖Ã‖₂ that sets the step (+1 %, see pdhg.cpp)
+  int norm_steps = 100;            // Lanczos steps at most for the estimate of ‖Ã‖₂ that sets the step (+1 %)
+  double norm_tolerance = 1e-3;    // … done when its Ritz pair's relative residual is below this
   double step_safety = 0.998;      // η = step_safety / ‖Ã‖₂
   double reflection = 1.0;         // γ in z⁺ = (k+1)/(k+2)((1+γ)T(z) − γz) + z⁰/(k+2)
   int check_interval = 64;         // iterations between termination/restart checks
