@@ -378,10 +378,29 @@ TEST_CASE("pdhg: the divergence watch on the windows of measured full-resolution
   CHECK(first_stop({{4.44e-2, 2.43e-2, 14.00, 14.70}, {6.18e-3, 8.91e-3, 15.53, 15.81},
                     {5.40e-3, 2.15e-2, 15.67, 16.36}, {2.62e-3, 4.87e-3, 16.32, 16.48},
                     {7.39e-5, 3.55e-3, 16.79, 16.67}}) == -1);
-  // TOSCA_r horse0-5's finest LP: a slow climb, caught by counting windows (the fifth here).
+  // TOSCA_r horse0-5's finest LP: a slow climb, the bound pulling away from the objective (0.51,
+  // 0.79, 1.15 above it): the third window (counting windows with a flat residual: the fifth).
   CHECK(first_stop({{1.54e-3, 4.07e-3, 62.05, 62.56}, {1.27e-3, 6.30e-3, 62.24, 63.03},
                     {1.16e-3, 9.16e-3, 62.34, 63.49}, {1.12e-3, 1.31e-2, 62.41, 64.07},
-                    {1.10e-3, 1.69e-2, 62.46, 64.60}}) == 4);
+                    {1.10e-3, 1.69e-2, 62.46, 64.60}}) == 2);
+  // FAUST_r 020-024's second infeasible finest LPs (sixteenth session), the residual still
+  // falling: the bound 0.17, 0.48, 0.98 above the objective (the gap rule: the fourth window) …
+  CHECK(first_stop({{2.51e-2, 4.16e-3, 20.20, 20.37}, {8.05e-3, 1.11e-2, 21.48, 21.96},
+                    {5.13e-3, 2.17e-2, 21.99, 22.96}, {4.81e-3, 3.31e-2, 22.31, 23.84}}) == 2);
+  // … and 0.15, 0.25, 0.26, 0.43, 0.54 (the gap rule: the seventh).
+  CHECK(first_stop({{2.82e-2, 5.28e-3, 14.11, 14.26}, {1.23e-2, 8.26e-3, 15.15, 15.40},
+                    {3.34e-3, 8.23e-3, 15.62, 15.88}, {2.49e-3, 1.35e-2, 15.79, 16.22},
+                    {2.04e-3, 1.68e-2, 15.94, 16.48}, {1.89e-3, 2.53e-2, 16.00, 16.83},
+                    {1.82e-3, 3.48e-2, 16.05, 17.21}}) == 4);
+  // The widened, feasible LP after the first: the bound below the objective from 512 iterations.
+  CHECK(first_stop({{3.74e-2, 3.57e-3, 18.93, 18.79}, {1.36e-2, 4.18e-3, 20.02, 19.85},
+                    {4.00e-3, 4.59e-3, 20.38, 20.20}, {1.26e-3, 3.79e-3, 20.53, 20.38},
+                    {8.21e-4, 3.14e-3, 20.56, 20.44}}) == -1);
+  // The cat's feasible warm re-solve after pricing at full resolution: the bound above and
+  // rising slowly for 11 000 iterations (0.77, 1.15, 1.30, 1.34, 1.27, 1.28 …), never twice as far.
+  CHECK(first_stop({{3.53e-3, 3.83e-3, 99.60, 100.37}, {2.61e-3, 5.72e-3, 99.81, 100.96},
+                    {2.26e-3, 6.48e-3, 99.90, 101.20}, {2.09e-3, 6.64e-3, 100.00, 101.34},
+                    {2.13e-3, 6.30e-3, 100.10, 101.37}, {2.16e-3, 6.33e-3, 100.20, 101.48}}) == -1);
   // A flat residual with the bound far above and rising stops whatever the gap (made-up first
   // window; the second is FAUST_r 021-024's at 1 536 iterations with a smaller gap).
   CHECK(first_stop({{1.20e-2, 2.0e-2, 44.80, 46.0}, {1.16e-2, 2.5e-2, 45.56, 58.84}}) == 1);
