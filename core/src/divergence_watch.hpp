@@ -17,8 +17,9 @@ public:
   // At the end of a window: true where the LP is to be stopped as diverging.
   bool diverging(double primal, double gap, double objective, double bound) {
     const double scale = 1.0 + std::abs(objective);
+    const double excess = bound - objective;
     bool stop = false;
-    if (seen_) {
+    if (windows_ > 0) {
       // A residual that stopped falling, with the bound far above the objective and rising
       // (measured on a 10 k-face reduced matching LP: residual flat at 2e-2 while the bound rose
       // from 35 to 48 in 1 024 iterations; feasible LPs of that size cut their residual 20× in
@@ -47,16 +48,12 @@ public:
       // 2 048, or at 3 584 with 0.15, 0.25, 0.26, 0.43, 0.54, …; the cat's at 2 560 instead of
       // 3 584). No LP that ended optimal in this session's full-resolution logs met it (155;
       // feasible LPs' excess shrinks or changes sign within three windows).
-      const double excess = bound - objective;
       stop = stop || (windows_ >= 2 && excess_[0] > 0.0 && excess_[1] > excess_[0] && excess > excess_[1] &&
                       excess > 2.0 * excess_[0] && gap > tolerance_);
-      excess_[0] = excess_[1];
-      excess_[1] = excess;
-    } else {
-      excess_[1] = bound - objective;
     }
     ++windows_;
-    seen_ = true;
+    excess_[0] = excess_[1];
+    excess_[1] = excess;
     primal_ = primal;
     gap_ = gap;
     bound_ = bound;
@@ -66,10 +63,9 @@ public:
 private:
   static constexpr int kCreepingWindows = 4;
   double tolerance_;
-  bool seen_ = false;
   double primal_ = 0.0, gap_ = 0.0, bound_ = 0.0;
   int creeping_ = 0;
-  int windows_ = 0;
+  int windows_ = 0;                // seen so far
   double excess_[2] = {0.0, 0.0};  // bound − objective two windows back and one back
 };
 
