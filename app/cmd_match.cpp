@@ -53,7 +53,9 @@ struct MatchArgs {
   bool warm_widening = CoarseToFineOptions{}.warm_widening;
   double stuck_after = CoarseToFineOptions{}.stuck_after;
   bool stuck_carry = CoarseToFineOptions{}.stuck_carry;
+  int stuck_stalled = RoundingOptions{}.stuck_stalled;
   int price_widenings = CoarseToFineOptions{}.price_widenings;
+  int lookahead_levels = CoarseToFineOptions{}.lookahead_levels;
   double price_threshold = CoarseToFineOptions{}.price_threshold;
 };
 
@@ -119,6 +121,7 @@ int run_match(const MatchArgs& args) {
   co.stuck_after = args.stuck_after;
   co.stuck_carry = args.stuck_carry;
   co.price_widenings = args.price_widenings;
+  co.lookahead_levels = args.lookahead_levels;
   co.price_threshold = args.price_threshold;
   co.matching = matching_options(args.pair, p);
   RoundingOptions& ro = co.rounding;
@@ -132,6 +135,7 @@ int run_match(const MatchArgs& args) {
   ro.greedy_above = args.greedy_above;
   ro.greedy_margin = args.greedy_margin;
   ro.search_below = args.search_below;
+  ro.stuck_stalled = args.stuck_stalled;
   ro.converged_first = args.converged_first;
   ro.lp.tolerance = args.tolerance;
   ro.lp.time_limit = args.time_limit;
@@ -304,6 +308,7 @@ int run_match(const MatchArgs& args) {
                               .set("levels", matcher.x_levels().size())
                               .set("coarsest_faces", args.hierarchy.coarsest_faces)
                               .set("second_faces", args.hierarchy.second_faces)
+                              .set("lookahead_levels", args.lookahead_levels)
                               .set("surface_parents", args.hierarchy.surface_parents)
                               .set("level_ratio", args.hierarchy.ratio)
                               .set("ring", args.ring)
@@ -316,6 +321,7 @@ int run_match(const MatchArgs& args) {
                               .set("warm_widening", args.warm_widening)
                               .set("stuck_after", args.stuck_after)
                               .set("stuck_carry", args.stuck_carry)
+                              .set("stuck_stalled", args.stuck_stalled)
                               .set("price_widenings", args.price_widenings)
                               .set("price_threshold", args.price_threshold));
     report.set("seconds", seconds);
@@ -346,6 +352,8 @@ int run_match(const MatchArgs& args) {
                       .set("gap", l.gap)
                       .set("second_start_energy", l.second_start_energy)
                       .set("second_start_kept", l.second_start_kept)
+                      .set("lookahead_other_energy", l.lookahead_other_energy)
+                      .set("lookahead_switched", l.lookahead_switched)
                       .set("seconds", l.seconds)
                       .set("peak_rss_mb", l.peak_rss_mb));
     report.set("levels", levels);
@@ -429,6 +437,11 @@ Action add_match_command(CLI::App& app) {
                  "lower-energy Γ goes on); 0: off, levels geometric from the coarsest")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
+  app.add_option("--lookahead-levels", a->lookahead_levels,
+                 "where the second start and the refined Γ both exist, refine both through this many more levels "
+                 "(never the finest) and go on with the lower energy there; 0: decide at the second level")
+      ->check(CLI::Range(0, 16))
+      ->capture_default_str();
   app.add_option("--ring", a->ring, "neighbourhood rings of the reduced product space (eq. 17)")
       ->check(CLI::Range(0, 8))
       ->capture_default_str();
@@ -462,6 +475,11 @@ Action add_match_command(CLI::App& app) {
                  "where the LPs after the rounding's fixings at a refined level keep failing for this many times "
                  "its first LP's seconds, or it runs out of rounds, widen the space around them and solve the level "
                  "again (0: off)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  app.add_option("--stuck-stalled", a->stuck_stalled,
+                 "with --stuck-after: also where the rounding's free variables reach no new low for this many "
+                 "rounds taking that long (0: off)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   app.add_flag("--stuck-carry", a->stuck_carry,

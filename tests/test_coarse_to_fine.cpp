@@ -438,6 +438,47 @@ TEST_CASE("coarse to fine: the second start solves the second level twice and ke
   CHECK(satisfies_exactly(r.finest.lp, r.rounding.gamma));
 }
 
+TEST_CASE("coarse to fine: lookahead refines both Γ of the second level and keeps the lower energy further up") {
+  CoarseToFineOptions o;
+  o.hierarchy.coarsest_faces = 12;
+  o.hierarchy.second_faces = 24;
+  o.hierarchy.ratio = 1.6;
+  o.rounding.solver = "pdhg-cpu";
+  const CoarseToFineMatcher plain_matcher = finger_matcher(o);  // decided at the second level
+  REQUIRE(plain_matcher.x_levels().size() == 5);
+  const CoarseToFineResult plain = plain_matcher.run();
+  o.second_start = false;
+  const CoarseToFineMatcher refined_matcher = finger_matcher(o);  // the refined chain alone
+  const CoarseToFineResult refined = refined_matcher.run();
+  o.second_start = true;
+  o.lookahead_levels = 2;
+  const CoarseToFineMatcher matcher = finger_matcher(o);
+  const CoarseToFineResult r = matcher.run();
+  REQUIRE(r.levels.size() == 5);
+  CHECK(check_graph_surface(r.finest.space, r.rounding.gamma).ok());
+  CHECK(satisfies_exactly(r.finest.lp, r.rounding.gamma));
+  // Compared at level 4 (two levels past the second, below the finest), and only there.
+  for (int l : {0, 1, 2, 4}) CHECK(std::isnan(r.levels[l].lookahead_other_energy));
+  const LevelReport& d = r.levels[3];
+  REQUIRE(std::isfinite(d.lookahead_other_energy));
+  CHECK(d.energy <= d.lookahead_other_energy);
+  MESSAGE("level 2: second start ", plain.levels[1].second_start_energy, ", refined ", refined.levels[1].energy,
+          "; level 4: kept ", d.energy, ", other ", d.lookahead_other_energy, ", switched ", d.lookahead_switched);
+  // Levels 1-2 solve the same LPs as without lookahead; the chain leading at level 2 is the one
+  // the plain run kept, and the other one, where it is the refined chain, the run without second start.
+  CHECK(r.levels[0].energy == plain.levels[0].energy);
+  CHECK(r.levels[1].second_start_energy == plain.levels[1].second_start_energy);
+  const double lead = d.lookahead_switched ? d.lookahead_other_energy : d.energy;
+  const double other = d.lookahead_switched ? d.energy : d.lookahead_other_energy;
+  CHECK(lead == doctest::Approx(plain.levels[3].energy).epsilon(1e-12));
+  if (plain.levels[1].second_start_kept) CHECK(other == doctest::Approx(refined.levels[3].energy).epsilon(1e-12));
+  // The reports below the decision are the kept chain's: it started at the full space iff
+  // second_start_kept, and if it is the leading chain, they are the plain run's.
+  CHECK(r.levels[1].second_start_kept == (plain.levels[1].second_start_kept != d.lookahead_switched));
+  if (!d.lookahead_switched)
+    for (int l : {1, 2}) CHECK(r.levels[l].energy == doctest::Approx(plain.levels[l].energy).epsilon(1e-12));
+}
+
 TEST_CASE("coarse to fine: a stuck rounding widens around its failed parts and goes on from its fixings") {
   // Measured: with max_rounds 3 and a wide greedy margin (few fixings per round), this pair's
   // finest rounding (ring 0) runs out of rounds with a few faces open. Stuck (stuck_after), it

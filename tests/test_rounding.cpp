@@ -427,6 +427,30 @@ TEST_CASE("rounding: where the LPs after its fixings keep failing it gives up wi
   // Not yet stuck where fewer rounds failed than stuck_rounds.
   options.stuck_after = 1e-12;
   options.stuck_rounds = 2;
+  options.stuck_stalled = 0;
+  CHECK(round_cycle(options).energy == 10.0);
+}
+
+TEST_CASE("rounding: where the free variables reach no new low for long it gives up, if asked") {
+  // cycle_behind_a_fixing: round 2 starts with b1, b2 and a fixed, round 3 with a undone, more
+  // free variables than round 2 had: one round without a new low. Only one LP fails, so the rule
+  // on failing rounds (stuck_rounds 2) does not act.
+  RoundingOptions options;
+  options.stuck_rounds = 2;
+  options.stuck_after = 1e-12;
+  options.stuck_stalled = 1;
+  try {
+    round_cycle(options);
+    FAIL("no StuckError");
+  } catch (const StuckError& e) {
+    CHECK(std::string(e.what()).find("no fewer free variables") != std::string::npos);
+    CHECK(!e.rows().empty());  // the rows still open
+    CHECK(e.ones() == std::vector<int64_t>{10, 12});  // b1, b2
+  }
+  options.stuck_stalled = 100;  // not that many rounds
+  CHECK(round_cycle(options).energy == 10.0);
+  options.stuck_stalled = 1;
+  options.stuck_after = 1e3;  // nor that long
   CHECK(round_cycle(options).energy == 10.0);
 }
 

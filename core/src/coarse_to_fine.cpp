@@ -7,6 +7,7 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <exception>
 #include <limits>
 
 namespace shapematch {
@@ -417,35 +418,105 @@ void CoarseToFineMatcher::set_features(Eigen::MatrixXd fx, Eigen::MatrixXd fy) {
 
 CoarseToFineResult CoarseToFineMatcher::run(const Progress& progress) const {
   CoarseToFineResult result;
-  std::vector<ProductTriangle> coarse_gamma;
-  for (int l = 0; l < hx_.size(); ++l) {
+  // The Γ that goes on, or with lookahead from the second level two: the refined one and the
+  // second start's, the lower energy first ("leading"), refined side by side up to `decide_at`,
+  // where the lower energy goes on. A chain's reports wait there until it is the only one.
+  struct Chain {
+    std::vector<ProductTriangle> gamma;
+    std::vector<LevelReport> pending;
+    bool leading = true;
+  };
+  std::vector<Chain> chains(1);
+  const int levels = hx_.size();
+  int decide_at = -1;
+  bool split = false;  // two chains went on from the second level, not yet decided
+  for (int l = 0; l < levels; ++l) {
     const MeshLevel& lx = hx_.levels[l];
     const MeshLevel& ly = hy_.levels[l];
     Stopwatch clock;
-    LevelReport rep;
-    rep.level = l;
-    rep.faces_x = lx.mesh.num_faces();
-    rep.faces_y = ly.mesh.num_faces();
-    rep.full_variables = ProductSpace::full_size(lx.mesh, ly.mesh);
+    LevelReport header;
+    header.level = l;
+    header.faces_x = lx.mesh.num_faces();
+    header.faces_y = ly.mesh.num_faces();
+    header.full_variables = ProductSpace::full_size(lx.mesh, ly.mesh);
 
     EnergyModel model(lx.mesh, lx.geometry, ly.mesh, ly.geometry, options_.matching.energy);
     if (fx_.size() > 0) model.set_features(select_rows(fx_, lx.input_vertex), select_rows(fy_, ly.input_vertex));
 
     // The second start (CoarseToFineOptions::second_start) also rescues a level whose refined
-    // space stayed infeasible at the largest ring.
+    // space stayed infeasible at the largest ring; of two chains, one that finds no Γ drops out.
     const bool second_start = l == 1 && second_level_;
-    bool refined = true;
-    try {
-      solve_refined(l, model, rep, coarse_gamma, result, progress);
-    } catch (const InfeasibleError& e) {
-      if (!second_start) throw;
-      refined = false;
-      spdlog::warn("level {}: no Γ in the refined space ({}); trying the full space", l + 1, e.what());
+    std::vector<Chain> next;
+    std::exception_ptr failure;
+    for (Chain& c : chains) {
+      LevelReport rep = header;
+      try {
+        solve_refined(l, model, rep, c.gamma, result, progress);
+      } catch (const InfeasibleError& e) {
+        if (!second_start && chains.size() == 1) throw;
+        spdlog::warn("level {}: no Γ in the refined space ({}); {}", l + 1, e.what(),
+                     second_start ? "trying the full space" : "that chain drops out");
+        failure = std::current_exception();
+        continue;
+      }
+      c.pending.push_back(rep);
+      next.push_back(std::move(c));
     }
-    if (second_start) solve_second_start(l, model, refined, rep, coarse_gamma, result, progress);
-    rep.seconds = clock.seconds();
-    rep.peak_rss_mb = peak_rss_mb();
-    result.levels.push_back(rep);
+    if (second_start) {
+      Chain s;
+      LevelReport rep = header;
+      CoarseToFineResult finest;
+      if (solve_second_start(l, model, rep, s.gamma, finest, progress)) {
+        rep.second_start_energy = rep.energy;
+        rep.second_start_kept = true;
+        for (Chain& c : next) c.pending.back().second_start_energy = rep.energy;
+        const bool lower = next.empty() || rep.energy < next.front().pending.back().energy;
+        decide_at = std::min(l + options_.lookahead_levels, levels - 2);
+        const bool both = !next.empty() && decide_at > l;
+        spdlog::info("level {}: second start energy {:.6g}, refined {}: {}", l + 1, rep.energy,
+                     next.empty() ? std::string("none") : fmt::format("{:.6g}", next.front().pending.back().energy),
+                     both ? fmt::format("both go on to level {}", decide_at + 1)
+                          : (lower ? "the second start's Γ goes on" : "the refined Γ goes on"));
+        s.pending.push_back(rep);
+        if (both) {
+          split = true;
+          next.front().leading = !lower;
+          s.leading = lower;
+          next.insert(lower ? next.begin() : next.end(), std::move(s));
+        } else if (lower) {
+          next.clear();
+          next.push_back(std::move(s));
+          if (l + 1 == levels) {
+            result.finest = std::move(finest.finest);
+            result.rounding = std::move(finest.rounding);
+          }
+        }
+      }
+    }
+    if (next.empty()) std::rethrow_exception(failure);
+    chains = std::move(next);
+    const double seconds = clock.seconds(), rss = peak_rss_mb();  // the level's, every chain's
+    for (Chain& c : chains) {
+      c.pending.back().seconds = seconds;
+      c.pending.back().peak_rss_mb = rss;
+    }
+    if (chains.size() > 1 && l >= decide_at) {
+      const size_t best = chains[1].pending.back().energy < chains[0].pending.back().energy ? 1 : 0;
+      chains[best].pending.back().lookahead_other_energy = chains[1 - best].pending.back().energy;
+      spdlog::info("level {}: lookahead energies {:.6g} (the chain leading at level 2) and {:.6g}: the {} goes on",
+                   l + 1, chains[0].pending.back().energy, chains[1].pending.back().energy,
+                   best == 0 ? "leading one" : "other one");
+      Chain kept = std::move(chains[best]);
+      chains.clear();
+      chains.push_back(std::move(kept));
+    }
+    if (chains.size() == 1) {
+      Chain& c = chains.front();
+      if (split) c.pending.back().lookahead_switched = !c.leading;
+      split = false;
+      for (LevelReport& r : c.pending) result.levels.push_back(r);
+      c.pending.clear();
+    }
   }
   return result;
 }
@@ -800,42 +871,33 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
   }
 }
 
-void CoarseToFineMatcher::solve_second_start(int l, const EnergyModel& model, bool refined, LevelReport& rep,
-                                             std::vector<ProductTriangle>& gamma, CoarseToFineResult& result,
+bool CoarseToFineMatcher::solve_second_start(int l, const EnergyModel& model, LevelReport& rep,
+                                             std::vector<ProductTriangle>& gamma, CoarseToFineResult& finest,
                                              const Progress& progress) const {
   const MeshLevel& lx = hx_.levels[l];
   const MeshLevel& ly = hy_.levels[l];
-  const bool finest = l + 1 == hx_.size();
   MatchingLp m = build_matching_lp(ProductSpace::full(lx.mesh, ly.mesh), model, options_.matching.scale_costs);
   spdlog::info("level {}: second start over the full product space, {} variables", l + 1, m.lp.cols());
   RoundingOptions ro = rounding_for(l);
   ro.fractional_batch = options_.second_start_fractional_batch;
-  LevelReport shown = rep;
-  shown.ring = -1;
+  rep.ring = -1;
   RoundingResult rr;
   try {
     rr = round_to_graph_surface(m.space, m.lp, m.energy, ro, [&](const RoundingRound& r) {
-      if (progress) progress(shown, r);
+      if (progress) progress(rep, r);
     });
   } catch (const InfeasibleError& e) {
-    if (!refined) throw;
-    spdlog::warn("level {}: the second start found no Γ ({}); the refined one goes on", l + 1, e.what());
-    return;
+    spdlog::warn("level {}: the second start found no Γ ({})", l + 1, e.what());
+    return false;
   }
-  rep.second_start_energy = rr.energy;
-  rep.second_start_kept = !refined || rr.energy < rep.energy;
-  spdlog::info("level {}: second start energy {:.6g}, refined {}: {} goes on", l + 1, rr.energy,
-               refined ? fmt::format("{:.6g}", rep.energy) : std::string("none"),
-               rep.second_start_kept ? "the second start's Γ" : "the refined Γ");
-  if (!rep.second_start_kept) return;
-  rep.ring = -1;
   rep.variables = m.lp.cols();
   rep.constraints = m.lp.rows();
   accept(m, rr, rep, gamma);
-  if (finest) {
-    result.finest = std::move(m);
-    result.rounding = std::move(rr);
+  if (l + 1 == hx_.size()) {
+    finest.finest = std::move(m);
+    finest.rounding = std::move(rr);
   }
+  return true;
 }
 
 }  // namespace shapematch

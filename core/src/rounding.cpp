@@ -1065,6 +1065,7 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
   };
   int64_t fewest_free = std::numeric_limits<int64_t>::max();
   int stalled = 0;
+  Stopwatch since_low;  // since fewest_free was set
   bool waited = false;  // the last round fixed nothing: only capped parts were left
   const auto record = [&](RoundingRound& info, const Stopwatch& clock) {
     info.seconds = clock.seconds();
@@ -1101,6 +1102,7 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
     if (red.lp.cols() < fewest_free) {
       fewest_free = red.lp.cols();
       stalled = 0;
+      since_low.reset();
     } else {
       ++stalled;
     }
@@ -1116,6 +1118,11 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
       record(info, clock);
       continue;
     }
+    if (options.stuck_after > 0.0 && options.stuck_stalled > 0 && round > 1 && stalled >= options.stuck_stalled &&
+        since_low.seconds() > options.stuck_after * first_seconds)
+      throw stuck("rounding: stuck, no fewer free variables than " + std::to_string(fewest_free) + " for " +
+                      std::to_string(stalled) + " rounds (" + fmt::format("{:.0f}", since_low.seconds()) + " s)",
+                  fixer.unsatisfied_rows());
     SolverParams params = base_params;
     // The warm start over the whole LP (the last round's iterate, or round 1's given one) cut to
     // what propagation left free.

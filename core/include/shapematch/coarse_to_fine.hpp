@@ -126,6 +126,12 @@ struct CoarseToFineOptions {
   // (fractional_batch below): a poor Γ there only loses the comparison.
   bool second_start = true;
   double second_start_fractional_batch = 0.125;
+  // Where the second start and the refined Γ both exist, both go on, each refined, through this
+  // many more levels (never the finest), and the chain of lower energy there goes on: at full
+  // resolution one run's outcome hung on that choice at 200 faces (FAUST_r 020-024: energies
+  // 2.906 and 2.958 there, 15.1 and 19.9 at the finest, errors 0.017 and 0.036). 0: decide at
+  // the second level by its energy.
+  int lookahead_levels = 0;
 };
 
 // Pricing: the reduced costs c_j − A_jᵀy of `other`'s columns, in energy units, against a dual
@@ -172,7 +178,12 @@ struct LevelReport {
   // The second start (level 1 only): its energy, NaN where it did not run or found no Γ, and
   // whether its Γ was kept.
   double second_start_energy = std::numeric_limits<double>::quiet_NaN();
-  bool second_start_kept = false;
+  bool second_start_kept = false;  // with lookahead: whether the chain that went on started there
+  // Lookahead (CoarseToFineOptions::lookahead_levels), at the level where the two chains were
+  // compared: the other chain's energy (NaN elsewhere, or where it found no Γ), and whether the
+  // chain of higher energy at the second level won.
+  double lookahead_other_energy = std::numeric_limits<double>::quiet_NaN();
+  bool lookahead_switched = false;
 };
 
 struct CoarseToFineResult {
@@ -201,11 +212,11 @@ private:
   // infeasible; throws InfeasibleError when the largest ring is. Replaces `gamma` with level l's.
   void solve_refined(int l, const EnergyModel& model, LevelReport& rep, std::vector<ProductTriangle>& gamma,
                      CoarseToFineResult& result, const Progress& progress) const;
-  // The second start at level l: the full product space, rounded; keeps whichever Γ has the
-  // lower energy (or the full space's alone where `refined` is false).
-  void solve_second_start(int l, const EnergyModel& model, bool refined, LevelReport& rep,
-                          std::vector<ProductTriangle>& gamma, CoarseToFineResult& result,
-                          const Progress& progress) const;
+  // The second start at level l: the full product space, rounded. Fills `rep` (a copy of the
+  // level's, with the second start's numbers), `gamma`, and at the finest level `finest`'s LP
+  // and rounding; false where it found no Γ.
+  bool solve_second_start(int l, const EnergyModel& model, LevelReport& rep, std::vector<ProductTriangle>& gamma,
+                          CoarseToFineResult& finest, const Progress& progress) const;
 
   CoarseToFineOptions options_;
   MeshHierarchy hx_, hy_;
