@@ -50,6 +50,7 @@ struct MatchArgs {
   int widen_around = CoarseToFineOptions{}.widen_around;
   int y_margin = CoarseToFineOptions{}.y_margin;
   int max_local_widenings = CoarseToFineOptions{}.max_local_widenings;
+  int max_propagation_widenings = CoarseToFineOptions{}.max_propagation_widenings;
   bool warm_widening = CoarseToFineOptions{}.warm_widening;
   double stuck_after = CoarseToFineOptions{}.stuck_after;
   bool stuck_carry = CoarseToFineOptions{}.stuck_carry;
@@ -117,6 +118,7 @@ int run_match(const MatchArgs& args) {
   co.widen_around = args.widen_around;
   co.y_margin = args.y_margin;
   co.max_local_widenings = args.max_local_widenings;
+  co.max_propagation_widenings = args.max_propagation_widenings;
   co.warm_widening = args.warm_widening;
   co.stuck_after = args.stuck_after;
   co.stuck_carry = args.stuck_carry;
@@ -318,6 +320,7 @@ int run_match(const MatchArgs& args) {
                               .set("widen_around", args.widen_around)
                               .set("y_margin", args.y_margin)
                               .set("max_local_widenings", args.max_local_widenings)
+                              .set("max_propagation_widenings", args.max_propagation_widenings)
                               .set("warm_widening", args.warm_widening)
                               .set("stuck_after", args.stuck_after)
                               .set("stuck_carry", args.stuck_carry)
@@ -343,6 +346,7 @@ int run_match(const MatchArgs& args) {
                       .set("widened_faces", l.widened_faces)
                       .set("stuck_widenings", l.stuck_widenings)
                       .set("price_widenings", l.price_widenings)
+                      .set("propagation_widenings", l.propagation_widenings)
                       .set("carried_fixings", l.carried_fixings)
                       .set("iterations_bound", l.iterations_bound)
                       .set("rounds", l.rounds)
@@ -460,7 +464,12 @@ Action add_match_command(CLI::App& app) {
                "start the LP of a widened space from the previous attempt's iterate (measured slower after a "
                "diverging attempt)");
   app.add_option("--max-local-widenings", a->max_local_widenings,
-                 "local widenings per level before the ring widens everywhere")
+                 "local widenings per level before the ring widens everywhere (those where propagation found the "
+                 "contradiction not counted)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  app.add_option("--max-propagation-widenings", a->max_propagation_widenings,
+                 "local widenings per level where unit propagation found the contradiction (before any LP)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   app.add_option("--widen-margin", a->widen_margin, "fine rings of faces around the proof that widen with it")

@@ -302,6 +302,7 @@ TEST_CASE("coarse to fine: an infeasible reduced LP is widened near the proof, n
   o.ring = 0;
   o.max_ring = 2;
   o.widen_margin = 0;
+  o.price_widenings = 0;  // (they are local widenings too)
   int64_t variables[2] = {0, 0};
   for (const bool local : {true, false}) {
     CAPTURE(local);
@@ -313,6 +314,7 @@ TEST_CASE("coarse to fine: an infeasible reduced LP is widened near the proof, n
     CHECK(satisfies_exactly(r.finest.lp, r.rounding.gamma));
     if (local) {
       CHECK(l.local_widenings >= 1);
+      CHECK(l.propagation_widenings == l.local_widenings);  // all found by propagation
       CHECK(l.widenings == 0);
       CHECK(l.widened_faces > 0);
       CHECK(l.widened_faces < l.faces_x);
@@ -323,6 +325,17 @@ TEST_CASE("coarse to fine: an infeasible reduced LP is widened near the proof, n
     variables[local ? 0 : 1] = l.variables;
   }
   CHECK(variables[0] < variables[1]);
+  // Propagation's widenings have a budget of their own: the same without any of the other kind.
+  o.local_widening = true;
+  o.max_local_widenings = 0;
+  const CoarseToFineMatcher matcher = finger_matcher(o);
+  const CoarseToFineResult r = matcher.run();
+  CHECK(r.levels.back().widenings == 0);
+  CHECK(r.levels.back().variables == variables[0]);
+  // And with that budget at 0 as well, the ring widens everywhere as without local widening.
+  o.max_propagation_widenings = 0;
+  const CoarseToFineMatcher global = finger_matcher(o);
+  CHECK(global.run().levels.back().widenings == 1);
 }
 
 TEST_CASE("coarse to fine: an iterate carried to a wider space keeps its values by identity and starts near the optimum") {
@@ -444,6 +457,7 @@ TEST_CASE("coarse to fine: lookahead refines both Γ of the second level and kee
   o.hierarchy.second_faces = 24;
   o.hierarchy.ratio = 1.6;
   o.rounding.solver = "pdhg-cpu";
+  o.lookahead_levels = 0;
   const CoarseToFineMatcher plain_matcher = finger_matcher(o);  // decided at the second level
   REQUIRE(plain_matcher.x_levels().size() == 5);
   const CoarseToFineResult plain = plain_matcher.run();

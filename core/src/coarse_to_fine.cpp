@@ -606,8 +606,15 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
   bool price_warm = false;
   // One more fine ring on these faces (up to `cap` rings); false if none could grow. `last`: the
   // level's regional widening, which comes after max_local_widenings.
+  // Widenings where propagation found the conflict have a budget of their own
+  // (max_propagation_widenings): they cost a rebuild, not an LP.
+  int propagated = 0;
+  bool propagating = false;
   auto widen_locally = [&](const std::vector<int>& faces, const char* why, int cap, bool last = false) {
-    if (!options_.local_widening || (local >= options_.max_local_widenings && !last)) return false;
+    if (!options_.local_widening) return false;
+    if (propagating ? propagated >= options_.max_propagation_widenings
+                    : local >= options_.max_local_widenings && !last)
+      return false;
     extra.resize(lx.mesh.num_faces(), 0);
     int64_t widened = 0;
     for (int f : faces)
@@ -616,7 +623,12 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
         ++widened;
       }
     if (widened == 0) return false;
-    if (!last) ++local;  // the regional one is not counted against the limit
+    if (propagating) {
+      ++propagated;
+      ++rep.propagation_widenings;
+    } else if (!last) {
+      ++local;  // the regional one is not counted against the limit
+    }
     ++rep.local_widenings;
     rep.widened_faces += widened;
     spdlog::warn("level {}: the reduced LP is {}; widening {} of {} faces by one ring", l + 1, why, widened,
@@ -703,9 +715,12 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
     // Propagation alone proves most reduced LPs infeasible, and says where: widen there first.
     if (l > 0 && options_.local_widening) {
       ProofPlace place(m);
-      if (conflict_places(m, kMaxConflictPlaces, options_.widen_margin, place) > 0 && widen_at(m, place, "infeasible"))
-        continue;
-      if (options_.widen_around > 0 && !around_done && local > 0) {
+      propagating = true;
+      const bool widened =
+          conflict_places(m, kMaxConflictPlaces, options_.widen_margin, place) > 0 && widen_at(m, place, "infeasible");
+      propagating = false;
+      if (widened) continue;
+      if (options_.widen_around > 0 && !around_done && local + propagated > 0) {
         around_done = true;
         if (widen_locally(around_widened(options_.widen_around), "infeasible nearby (pre-emptively)",
                           options_.max_ring + kMaxRingBeyond, true)) {
@@ -854,7 +869,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
       // the next one next to it; ring 2 everywhere then meant 23.9 M variables against 14.1 M).
       // Measured there in the tenth session: it widened 5 179 of 9 998 faces and one conflict
       // (a Y face's coverage row) remained, so it saves nothing on that pair.
-      if (!regional_done && local > 0) {
+      if (!regional_done && local + propagated > 0) {
         regional_done = true;
         if (widen_locally(around_widened(kRegionRings), "infeasible", options_.max_ring + kMaxRingBeyond, true)) {
           spdlog::info("level {}: widened around all earlier local widenings ({} rings)", l + 1, kRegionRings);

@@ -58,6 +58,13 @@ struct CoarseToFineOptions {
   // local widenings (of 9 to 1006 faces); after 6 the global one made 22.8 M variables.
   bool local_widening = true;
   int max_local_widenings = 24;
+  // Local widenings where unit propagation found the contradiction (before any LP) are counted
+  // apart, up to this many per level: each costs a rebuild of the space (about 4 s at 4 000 faces,
+  // 12 s at full resolution), not an LP. Measured, FAUST_r 026-029 and 016-026 at 4 000 faces:
+  // 24 such widenings of 5-300 faces each, each revealing the next contradiction next to it, used
+  // up max_local_widenings, and the ring then widened everywhere (4.9 M → 9.0 M and 10.1 M
+  // variables; 508 s with a gap of 7.4 %, and over 600 s).
+  int max_propagation_widenings = 64;
   // Start the first LP of a widened space from the previous attempt's iterate (its dual reset
   // where it diverged), by variable and row identity. Off: measured at full resolution (FAUST_r
   // 020-024) after a diverging attempt, the widened LP took 3 008 iterations warm against 2 048
@@ -127,11 +134,12 @@ struct CoarseToFineOptions {
   bool second_start = true;
   double second_start_fractional_batch = 0.125;
   // Where the second start and the refined Γ both exist, both go on, each refined, through this
-  // many more levels (never the finest), and the chain of lower energy there goes on: at full
-  // resolution one run's outcome hung on that choice at 200 faces (FAUST_r 020-024: energies
-  // 2.906 and 2.958 there, 15.1 and 19.9 at the finest, errors 0.017 and 0.036). 0: decide at
-  // the second level by its energy.
-  int lookahead_levels = 0;
+  // many more levels (never the finest), and the chain of lower energy there goes on. Measured
+  // on 8 FAUST_r pairs at 4 000 faces (6 levels, decided at the fourth, 1 474 faces): the chain
+  // that led at 200 faces stayed ahead in 6 (the same Γ, 15-25 % more time); in 065-069 the other
+  // one won, and the finest energy went 16.51 → 13.07, the error 0.035 → 0.028. 0: decide at the
+  // second level by its energy.
+  int lookahead_levels = 2;
 };
 
 // Pricing: the reduced costs c_j − A_jᵀy of `other`'s columns, in energy units, against a dual
@@ -167,6 +175,7 @@ struct LevelReport {
   int64_t widened_faces = 0;   // fine X faces widened locally, summed over those times
   int stuck_widenings = 0;     // of the local widenings, those where rounding was stuck (stuck_after)
   int price_widenings = 0;     // of the local widenings, those where pricing found columns below zero
+  int propagation_widenings = 0;  // of the local widenings, those where propagation found the contradiction
   int64_t carried_fixings = 0; // fixings to 1 the last of those went on from
   int64_t iterations_bound = 0;  // of the LP solved again for the bound after one
   int rounds = 0;
