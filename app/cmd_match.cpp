@@ -433,9 +433,10 @@ Action add_match_command(CLI::App& app) {
   app.add_option("--coarsest-faces", a->hierarchy.coarsest_faces, "faces of the coarsest level")
       ->check(CLI::Range(4, 1 << 30))
       ->capture_default_str();
-  app.add_flag("--surface-parents", a->hierarchy.surface_parents,
+  app.add_flag("--surface-parents,!--space-parents", a->hierarchy.surface_parents,
                "a fine face's parent is the nearest coarse face among those around the kept vertices nearest on the "
-               "fine surface, not the nearest in space (which can lie across a gap)");
+               "fine surface (default), or (--space-parents) the nearest in space, which can lie across a gap")
+      ->capture_default_str();
   app.add_option("--second-faces", a->hierarchy.second_faces,
                  "faces of the level above the coarsest, which is also solved over its full product space (the "
                  "lower-energy Γ goes on); 0: off, levels geometric from the coarsest")

@@ -21,10 +21,13 @@ struct HierarchyOptions {
   // Parents from around the kept vertices nearest on the fine surface (parent_faces with `kept`),
   // not the nearest coarse face in space, which can lie across a gap (measured on the
   // deformation-transfer cat 0001-0005 at full resolution: its level 4 widened 14 times, 1.7 M →
-  // 6.3 M variables, and went on failing; with these parents 4 times, to 2.1 M, and solved). Off
-  // by default: on FAUST_r 020-024 it moves one parent at 1 414 faces and 31 at full resolution,
-  // and that run's level 6 rounding then went on for 15 minutes without an end (8 before).
-  bool surface_parents = false;
+  // 6.3 M variables, and went on failing; with these parents 4 times, to 2.1 M, and solved). On
+  // 8 FAUST_r pairs at 4 000 faces: 026-029 and 016-026 took 130 s and 145 s where nearest parents
+  // widened by propagation 24 times, then everywhere (9-10 M variables; 508 s, gap 7.4 %, and
+  // over 600 s); four pairs ended the same, 043-063 lower (17.71 against 18.18), 021-024 higher
+  // (12.40 against 12.22). (In the thirteenth session, on FAUST_r 020-024 at full resolution,
+  // it moved 31 parents and that run's level-6 rounding went on for 15 minutes without an end.)
+  bool surface_parents = true;
 };
 
 struct MeshLevel {
