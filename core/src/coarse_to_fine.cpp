@@ -604,12 +604,12 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
   std::vector<double> first_x, first_y;
   CarriedIterate priced_from;
   bool price_warm = false;
-  // One more fine ring on these faces (up to `cap` rings); false if none could grow. `last`: the
-  // level's regional widening, which comes after max_local_widenings.
   // Widenings where propagation found the conflict have a budget of their own
   // (max_propagation_widenings): they cost a rebuild, not an LP.
   int propagated = 0;
   bool propagating = false;
+  // One more fine ring on these faces (up to `cap` rings); false if none could grow. `last`: the
+  // level's regional widening, which comes after max_local_widenings.
   auto widen_locally = [&](const std::vector<int>& faces, const char* why, int cap, bool last = false) {
     if (!options_.local_widening) return false;
     if (propagating ? propagated >= options_.max_propagation_widenings
