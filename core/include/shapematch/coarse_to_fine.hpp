@@ -135,7 +135,7 @@ struct CoarseToFineOptions {
   double second_start_fractional_batch = 0.125;
   // Where the second start and the refined Γ both exist, both go on, each refined, through this
   // many more levels (never the finest), and the chain of lower energy there goes on. Measured
-  // on 8 FAUST_r pairs at 4 000 faces (6 levels, decided at the fourth, 1 474 faces): the chain
+  // on 8 FAUST_r pairs at 4 000 faces (6 levels, decided at the fourth, 894 faces): the chain
   // that led at 200 faces stayed ahead in 6 (the same Γ, 15-25 % more time); in 065-069 the other
   // one won, and the finest energy went 16.51 → 13.07, the error 0.035 → 0.028. 0: decide at the
   // second level by its energy.
