@@ -429,7 +429,6 @@ CoarseToFineResult CoarseToFineMatcher::run(const Progress& progress) const {
   std::vector<Chain> chains(1);
   const int levels = hx_.size();
   int decide_at = -1;
-  bool split = false;  // two chains went on from the second level, not yet decided
   for (int l = 0; l < levels; ++l) {
     const MeshLevel& lx = hx_.levels[l];
     const MeshLevel& ly = hy_.levels[l];
@@ -479,7 +478,6 @@ CoarseToFineResult CoarseToFineMatcher::run(const Progress& progress) const {
                           : (lower ? "the second start's Γ goes on" : "the refined Γ goes on"));
         s.pending.push_back(rep);
         if (both) {
-          split = true;
           next.front().leading = !lower;
           s.leading = lower;
           next.insert(lower ? next.begin() : next.end(), std::move(s));
@@ -512,8 +510,7 @@ CoarseToFineResult CoarseToFineMatcher::run(const Progress& progress) const {
     }
     if (chains.size() == 1) {
       Chain& c = chains.front();
-      if (split) c.pending.back().lookahead_switched = !c.leading;
-      split = false;
+      if (c.pending.size() > 1) c.pending.back().lookahead_switched = !c.leading;  // reports held since a split
       for (LevelReport& r : c.pending) result.levels.push_back(r);
       c.pending.clear();
     }
