@@ -52,6 +52,8 @@ struct MatchArgs {
   int max_local_widenings = CoarseToFineOptions{}.max_local_widenings;
   int max_propagation_widenings = CoarseToFineOptions{}.max_propagation_widenings;
   bool warm_widening = CoarseToFineOptions{}.warm_widening;
+  bool carry_primal_weight = CoarseToFineOptions{}.carry_primal_weight;
+  int inherit_widening = CoarseToFineOptions{}.inherit_widening;
   double stuck_after = CoarseToFineOptions{}.stuck_after;
   bool stuck_carry = CoarseToFineOptions{}.stuck_carry;
   int stuck_stalled = RoundingOptions{}.stuck_stalled;
@@ -120,6 +122,8 @@ int run_match(const MatchArgs& args) {
   co.max_local_widenings = args.max_local_widenings;
   co.max_propagation_widenings = args.max_propagation_widenings;
   co.warm_widening = args.warm_widening;
+  co.carry_primal_weight = args.carry_primal_weight;
+  co.inherit_widening = args.inherit_widening;
   co.stuck_after = args.stuck_after;
   co.stuck_carry = args.stuck_carry;
   co.price_widenings = args.price_widenings;
@@ -322,6 +326,8 @@ int run_match(const MatchArgs& args) {
                               .set("max_local_widenings", args.max_local_widenings)
                               .set("max_propagation_widenings", args.max_propagation_widenings)
                               .set("warm_widening", args.warm_widening)
+                              .set("carry_primal_weight", args.carry_primal_weight)
+                              .set("inherit_widening", args.inherit_widening)
                               .set("stuck_after", args.stuck_after)
                               .set("stuck_carry", args.stuck_carry)
                               .set("stuck_stalled", args.stuck_stalled)
@@ -347,6 +353,7 @@ int run_match(const MatchArgs& args) {
                       .set("stuck_widenings", l.stuck_widenings)
                       .set("price_widenings", l.price_widenings)
                       .set("propagation_widenings", l.propagation_widenings)
+                      .set("inherited_faces", l.inherited_faces)
                       .set("carried_fixings", l.carried_fixings)
                       .set("iterations_bound", l.iterations_bound)
                       .set("rounds", l.rounds)
@@ -464,6 +471,13 @@ Action add_match_command(CLI::App& app) {
   app.add_flag("--warm-widening", a->warm_widening,
                "start the LP of a widened space from the previous attempt's iterate (measured slower after a "
                "diverging attempt)");
+  app.add_flag("--carry-primal-weight,!--no-carry-primal-weight", a->carry_primal_weight,
+               "warm starts (a pricing's re-solve, --warm-widening) also start from the primal weight their "
+               "iterate's solve ended with (default off: measured no faster)");
+  app.add_option("--inherit-widening", a->inherit_widening,
+                 "fine X faces whose parent's space was widened at the level before start with that many extra "
+                 "rings, up to this (0: off)")
+      ->check(CLI::Range(0, 8));
   app.add_option("--max-local-widenings", a->max_local_widenings,
                  "local widenings per level before the ring widens everywhere (those where propagation found the "
                  "contradiction not counted)")

@@ -160,6 +160,42 @@ TEST_CASE("pdhg-cpu: matching LPs agree with Clp within 1e-4 relative") {
   CHECK(warm.iterations * 4 <= r.iterations);
 }
 
+TEST_CASE("pdhg-cpu: a warm start goes on with the primal weight its solve ended with") {
+  const Mesh x = shapes::octahedron();
+  const Mesh y = test::deformed(x, [](const Eigen::Vector3d& p) {
+    return Eigen::Vector3d(1.3 * p.x() + 0.1 * p.z(), p.y(), 0.8 * p.z() + 0.05 * p.x() * p.y());
+  });
+  const MatchingLp m = build_matching_lp(x, compute_geometry(x), y, compute_geometry(y));
+  SolverParams params = tight(1e-5);
+  const LpResult r = solve_lp(m.lp, "pdhg-cpu", params);
+  REQUIRE(r.status == LpStatus::Optimal);
+  REQUIRE(std::isfinite(r.primal_weight));
+  CHECK(r.primal_weight > 0.0);
+  CHECK(std::isnan(solve_lp(m.lp, "clp-dual").primal_weight));
+
+  // The same LP with its costs moved a little: from the old optimum, with the old ω, and with
+  // PDHG's own initial ω (1).
+  LpProblem moved = m.lp;
+  for (int64_t j = 0; j < moved.cols(); ++j) moved.c[j] *= 1.0 + 0.05 * std::sin(double(j));
+  params.initial_x = r.x;
+  params.initial_y = r.y;
+  const LpResult reset = solve_lp(moved, "pdhg-cpu", params);
+  params.initial_primal_weight = r.primal_weight;
+  const LpResult carried = solve_lp(moved, "pdhg-cpu", params);
+  params.initial_x.clear();
+  params.initial_y.clear();
+  params.initial_primal_weight = 0.0;
+  const LpResult cold = solve_lp(moved, "pdhg-cpu", params);
+  REQUIRE(reset.status == LpStatus::Optimal);
+  REQUIRE(carried.status == LpStatus::Optimal);
+  REQUIRE(cold.status == LpStatus::Optimal);
+  MESSAGE("iterations: cold " << cold.iterations << ", warm at ω 1 " << reset.iterations << ", warm at ω "
+                              << r.primal_weight << " " << carried.iterations);
+  CHECK(std::abs(carried.objective - cold.objective) <= 1e-4 * std::abs(cold.objective));
+  CHECK(carried.iterations <= reset.iterations);
+  CHECK(carried.iterations < cold.iterations);
+}
+
 TEST_CASE("thread pool: every chunk runs exactly once, loop after loop") {
   for (const int threads : {1, 2, 3, 5}) {
     detail::ThreadPool pool(threads);

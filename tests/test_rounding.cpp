@@ -166,7 +166,7 @@ TEST_CASE("rounding: round 1 starts from a warm start over the whole LP and hand
   o.solver = "pdhg-cpu";
   std::vector<double> x0, y0;
   int calls = 0;
-  o.first_iterate = [&](const std::vector<double>& xs, const std::vector<double>& ys) {
+  o.first_iterate = [&](const std::vector<double>& xs, const std::vector<double>& ys, double) {
     x0 = xs;
     y0 = ys;
     ++calls;

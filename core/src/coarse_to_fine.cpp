@@ -425,6 +425,7 @@ CoarseToFineResult CoarseToFineMatcher::run(const Progress& progress) const {
     std::vector<ProductTriangle> gamma;
     std::vector<LevelReport> pending;
     bool leading = true;
+    std::vector<int> widened;  // the last level's extra rings per X face
   };
   std::vector<Chain> chains(1);
   const int levels = hx_.size();
@@ -450,7 +451,7 @@ CoarseToFineResult CoarseToFineMatcher::run(const Progress& progress) const {
     for (Chain& c : chains) {
       LevelReport rep = header;
       try {
-        solve_refined(l, model, rep, c.gamma, result, progress);
+        solve_refined(l, model, rep, c.gamma, result, progress, c.widened);
       } catch (const InfeasibleError& e) {
         if (!second_start && chains.size() == 1) throw;
         spdlog::warn("level {}: no Γ in the refined space ({}); {}", l + 1, e.what(),
@@ -518,7 +519,8 @@ CoarseToFineResult CoarseToFineMatcher::run(const Progress& progress) const {
   return result;
 }
 
-void CarriedIterate::keep(const MatchingLp& m, const std::vector<double>& x, const std::vector<double>& y) {
+void CarriedIterate::keep(const MatchingLp& m, const std::vector<double>& x, const std::vector<double>& y,
+                          double primal_weight) {
   if ((!x.empty() && x.size() != size_t(m.lp.cols())) || y.size() != size_t(m.lp.rows()))
     throw InvalidInputError("carried iterate: need one value per column (or none) and per row");
   x_.clear();
@@ -529,6 +531,7 @@ void CarriedIterate::keep(const MatchingLp& m, const std::vector<double>& x, con
   y_ = y;
   closedness_rows_ = m.closedness_rows;
   scale_ = m.lp.objective_scale;
+  primal_weight_ = primal_weight > 0.0 && std::isfinite(primal_weight) ? primal_weight : 0.0;
 }
 
 void CarriedIterate::apply(const MatchingLp& m, SolverParams& params) const {
@@ -541,6 +544,8 @@ void CarriedIterate::apply(const MatchingLp& m, SolverParams& params) const {
     if (it != x_.end() && it->first == k) params.initial_x[j] = it->second;
   }
   const double ratio = scale_ / m.lp.objective_scale;  // y scales with the costs
+  // ω balances the dual's steps against the primal's: it scales with y.
+  if (primal_weight_ > 0.0) params.initial_primal_weight = ratio * primal_weight_;
   for (int64_t i = 0; i < m.closedness_rows; ++i) {
     const auto it = std::lower_bound(row_edge_.begin(), row_edge_.end(), m.row_edge[i]);
     if (it != row_edge_.end() && *it == m.row_edge[i]) params.initial_y[i] = ratio * y_[it - row_edge_.begin()];
@@ -574,10 +579,22 @@ RoundingOptions CoarseToFineMatcher::rounding_for(int l) const {
 
 void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelReport& rep,
                                         std::vector<ProductTriangle>& gamma, CoarseToFineResult& result,
-                                        const Progress& progress) const {
+                                        const Progress& progress, std::vector<int>& widened) const {
   const MeshLevel& lx = hx_.levels[l];
   const MeshLevel& ly = hy_.levels[l];
   std::vector<int> extra;  // local widening: more fine rings per fine X face
+  if (l > 0 && options_.inherit_widening > 0 && options_.local_widening &&
+      widened.size() == size_t(hx_.levels[l - 1].mesh.num_faces())) {
+    extra.assign(lx.mesh.num_faces(), 0);
+    for (int f = 0; f < lx.mesh.num_faces(); ++f) {
+      const int e = std::min({widened[lx.parent_face[f]], options_.inherit_widening,
+                              std::max(0, options_.max_ring - options_.ring)});
+      if (e > 0) extra[f] = e, ++rep.inherited_faces;
+    }
+    if (rep.inherited_faces > 0)
+      spdlog::info("level {}: {} of {} faces start with the extra rings of their parent", l + 1, rep.inherited_faces,
+                   lx.mesh.num_faces());
+  }
   std::vector<int> last_widened;
   int local = 0;
   int ring = options_.ring;
@@ -599,6 +616,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
   // same kept by identity to start the widened LP from (it was optimal, unlike after divergence).
   int priced = 0;
   std::vector<double> first_x, first_y;
+  double first_omega = 0.0;
   CarriedIterate priced_from;
   bool price_warm = false;
   // Widenings where propagation found the conflict have a budget of their own
@@ -750,12 +768,14 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
                            local < options_.max_local_widenings;
       const bool may_carry = options_.stuck_after > 0.0 && options_.stuck_carry;
       if (l > 0 && (options_.warm_widening || may_carry || pricing) && !carrying)
-        ro.first_iterate = [&](const std::vector<double>& x, const std::vector<double>& y) {
-          if (options_.warm_widening) warm.keep(m, x, y);
-          if (may_carry) first.keep(m, x, y);
+        ro.first_iterate = [&](const std::vector<double>& x, const std::vector<double>& y, double omega) {
+          if (!options_.carry_primal_weight) omega = 0.0;
+          if (options_.warm_widening) warm.keep(m, x, y, omega);
+          if (may_carry) first.keep(m, x, y, omega);
           if (pricing) {
             first_x = x;
             first_y = y;
+            first_omega = omega;
           }
         };
       if (carrying) {
@@ -825,7 +845,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
     } catch (const PricedWider&) {
       ++rep.price_widenings;
       ++priced;
-      priced_from.keep(m, first_x, first_y);
+      priced_from.keep(m, first_x, first_y, first_omega);
       price_warm = true;
       first_x = {};
       first_y = {};
@@ -881,6 +901,8 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
       for (int& x : extra) x = std::max(0, std::min(x, options_.max_ring - ring));
     }
   }
+  widened = std::move(extra);  // what the next level inherits
+  widened.resize(lx.mesh.num_faces(), 0);
 }
 
 bool CoarseToFineMatcher::solve_second_start(int l, const EnergyModel& model, LevelReport& rep,

@@ -125,7 +125,8 @@ LpResult PdhgSolver::solve(const LpProblem& problem, const SolverParams& params)
   cnorm = std::sqrt(cnorm);
   bnorm = std::sqrt(bnorm);
   bnorm_orig = std::sqrt(bnorm_orig);
-  double omega = options_.initial_primal_weight > 0 ? options_.initial_primal_weight
+  double omega = params.initial_primal_weight > 0 ? params.initial_primal_weight
+                 : options_.initial_primal_weight > 0 ? options_.initial_primal_weight
                  : (cnorm > 1e-10 && bnorm > 1e-10) ? cnorm / bnorm
                                                     : 1.0;
 
@@ -260,6 +261,7 @@ LpResult PdhgSolver::solve(const LpProblem& problem, const SolverParams& params)
     result.lower_bound = certified_lower_bound(problem, result.y);
   }
   result.iterations = total;
+  result.primal_weight = omega;
   result.seconds = clock.seconds();
   spdlog::debug("{}: {} after {} iterations and {} restarts ({:.3f} s)", name(), to_string(result.status), total,
                 restarts, result.seconds);

@@ -1175,7 +1175,7 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
       if (dual.size() == red.rows.size())
         for (size_t i = 0; i < red.rows.size(); ++i)
           if (!diverged || i >= r.y.size() || std::abs(r.y[i]) <= 0.01 * growth) y[red.rows[i]] = dual[i];
-      options.first_iterate(x, y);
+      options.first_iterate(x, y, r.primal_weight);
     }
     RoundingRound info;
     info.round = round;

@@ -28,9 +28,12 @@ enum class Neighbourhood { Coarse, Fine };
 class CarriedIterate {
 public:
   bool empty() const { return scale_ == 0.0; }
-  // `x` may be empty: the dual alone (every variable then starts at 0).
-  void keep(const MatchingLp& m, const std::vector<double>& x, const std::vector<double>& y);
-  // Fills params.initial_x / initial_y for `m` (nothing where empty).
+  // `x` may be empty: the dual alone (every variable then starts at 0). `primal_weight`: the
+  // solver's ω with that iterate (0 or NaN: none).
+  void keep(const MatchingLp& m, const std::vector<double>& x, const std::vector<double>& y,
+            double primal_weight = 0.0);
+  // Fills params.initial_x / initial_y (and initial_primal_weight, where kept) for `m` (nothing
+  // where empty).
   void apply(const MatchingLp& m, SolverParams& params) const;
 
   // The vertex pairs of a product triangle, hashed (its faces follow from them); a collision
@@ -43,6 +46,7 @@ private:
   std::vector<double> y_;
   int64_t closedness_rows_ = 0;
   double scale_ = 0.0;
+  double primal_weight_ = 0.0;
 };
 
 struct CoarseToFineOptions {
@@ -71,6 +75,19 @@ struct CoarseToFineOptions {
   // cold, and stopped at a worse point (objective 24.15 against 23.47); on a feasible narrower
   // LP (test) it saves 60 %.
   bool warm_widening = false;
+  // Warm starts (a pricing's re-solve, warm_widening, stuck_carry) also start from the primal
+  // weight ω their iterate's solve ended with, not from PDHG's initial one (see
+  // SolverParams::initial_primal_weight). Off: measured on FAUST_r 026-029 at 4 000 faces, the
+  // re-solves after pricing took 320/192, 832/384, 576/768 (cap), 1 280 (cap), 768/448
+  // iterations at levels 2-6 against 320/256, 896/384, 384/384, 960/576, 640/… with ω from 1
+  // (122 s against 128 s, energy 10.70 against 10.62): the new rows' duals at 0, not ω, are
+  // what the re-solve spends its iterations on.
+  bool carry_primal_weight = false;
+  // Fine X faces whose parent's space was widened locally at the level before (for whatever
+  // reason) start with that many extra rings, up to this: where the coarser level needed room,
+  // the finer one tends to need it too, and each widening found there costs a rebuild and often
+  // an LP (at full resolution a diverging first LP takes 55-85 s). 0: off.
+  int inherit_widening = 0;
   // Fine rings of X faces around the proof that widen with it. Measured: 4 kept 021-029 at 1000
   // faces slightly closer to the global widening (error 0.065 against 0.070 at 0, 25 s against
   // 20 s), but on 020-024 at 2000 faces it widened 1311 of 2000 faces and still left an LP that
@@ -176,6 +193,7 @@ struct LevelReport {
   int stuck_widenings = 0;     // of the local widenings, those where rounding was stuck (stuck_after)
   int price_widenings = 0;     // of the local widenings, those where pricing found columns below zero
   int propagation_widenings = 0;  // of the local widenings, those where propagation found the contradiction
+  int64_t inherited_faces = 0; // fine X faces that started with extra rings (inherit_widening)
   int64_t carried_fixings = 0; // fixings to 1 the last of those went on from
   int64_t iterations_bound = 0;  // of the LP solved again for the bound after one
   int rounds = 0;
@@ -219,8 +237,10 @@ private:
   RoundingOptions rounding_for(int l) const;
   // Level l from the coarser level's Γ (the full space at l = 0), widening where it is
   // infeasible; throws InfeasibleError when the largest ring is. Replaces `gamma` with level l's.
+  // `widened`: on entry the coarser level's extra rings per X face (inherit_widening; empty:
+  // none), on return this level's.
   void solve_refined(int l, const EnergyModel& model, LevelReport& rep, std::vector<ProductTriangle>& gamma,
-                     CoarseToFineResult& result, const Progress& progress) const;
+                     CoarseToFineResult& result, const Progress& progress, std::vector<int>& widened) const;
   // The second start at level l: the full product space, rounded. Fills `rep` (a copy of the
   // level's, with the second start's numbers), `gamma`, and at the finest level `finest`'s LP
   // and rounding; false where it found no Γ.

@@ -53,6 +53,11 @@ struct SolverParams {
   // Warm start (first-order methods): both empty or of the right sizes.
   std::vector<double> initial_x;
   std::vector<double> initial_y;
+  // PDHG's primal weight ω to start from (0: the solver's own choice). A warm start near an
+  // optimum wants the ω that solve ended with: started at 1, a re-solve moved its iterate away
+  // from the optimum it was given before ω came back (FAUST_r 026-029's finest LP after pricing:
+  // the primal residual went 2.5e-3 → 0.21 in 64 iterations, and took 768 to come back).
+  double initial_primal_weight = 0.0;
 };
 
 struct LpResult {
@@ -67,6 +72,8 @@ struct LpResult {
   // Diverging only (y holds the dual's growth there): the dual iterate where it stopped.
   std::vector<double> last_y;
   int64_t iterations = 0;
+  // PDHG's primal weight ω where it stopped (scaled space); NaN for other solvers.
+  double primal_weight = std::numeric_limits<double>::quiet_NaN();
   double seconds = 0.0;
   // Of `seconds`, the part before the first iteration: scaling, the ‖A‖ estimate, the device's
   // set-up and the upload (PDHG; 0 for Clp). Time per iteration excludes it.

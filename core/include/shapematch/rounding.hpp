@@ -128,7 +128,8 @@ struct RoundingOptions {
   // default: measured slower). After divergence, the rows on
   // which the dual grew (over 1 % of the largest growth) are 0: there it had left for infinity.
   // Not called after a proven infeasible LP (no iterate).
-  std::function<void(const std::vector<double>& x, const std::vector<double>& y)> first_iterate;
+  // `primal_weight`: the solver's ω where it stopped (LpResult::primal_weight; NaN if none).
+  std::function<void(const std::vector<double>& x, const std::vector<double>& y, double primal_weight)> first_iterate;
 };
 
 struct RoundingRound {
