@@ -54,6 +54,7 @@ struct MatchArgs {
   bool warm_widening = CoarseToFineOptions{}.warm_widening;
   bool carry_primal_weight = CoarseToFineOptions{}.carry_primal_weight;
   int inherit_widening = CoarseToFineOptions{}.inherit_widening;
+  int price_dual_sweeps = CoarseToFineOptions{}.price_dual_sweeps;
   double stuck_after = CoarseToFineOptions{}.stuck_after;
   bool stuck_carry = CoarseToFineOptions{}.stuck_carry;
   int stuck_stalled = RoundingOptions{}.stuck_stalled;
@@ -124,6 +125,7 @@ int run_match(const MatchArgs& args) {
   co.warm_widening = args.warm_widening;
   co.carry_primal_weight = args.carry_primal_weight;
   co.inherit_widening = args.inherit_widening;
+  co.price_dual_sweeps = args.price_dual_sweeps;
   co.stuck_after = args.stuck_after;
   co.stuck_carry = args.stuck_carry;
   co.price_widenings = args.price_widenings;
@@ -328,6 +330,7 @@ int run_match(const MatchArgs& args) {
                               .set("warm_widening", args.warm_widening)
                               .set("carry_primal_weight", args.carry_primal_weight)
                               .set("inherit_widening", args.inherit_widening)
+                              .set("price_dual_sweeps", args.price_dual_sweeps)
                               .set("stuck_after", args.stuck_after)
                               .set("stuck_carry", args.stuck_carry)
                               .set("stuck_stalled", args.stuck_stalled)
@@ -474,6 +477,10 @@ Action add_match_command(CLI::App& app) {
   app.add_flag("--carry-primal-weight,!--no-carry-primal-weight", a->carry_primal_weight,
                "warm starts (a pricing's re-solve, --warm-widening) also start from the primal weight their "
                "iterate's solve ended with (default off: measured no faster)");
+  app.add_option("--price-dual-sweeps", a->price_dual_sweeps,
+                 "with --price-widenings: the re-solve starts the new rows' duals where this many sweeps of "
+                 "coordinate ascent on the Lagrangian bound put them, not at 0 (0: off)")
+      ->check(CLI::Range(0, 100));
   app.add_option("--inherit-widening", a->inherit_widening,
                  "fine X faces whose parent's space was widened at the level before start with that many extra "
                  "rings, up to this (0: off)")

@@ -534,8 +534,29 @@ void CarriedIterate::keep(const MatchingLp& m, const std::vector<double>& x, con
   primal_weight_ = primal_weight > 0.0 && std::isfinite(primal_weight) ? primal_weight : 0.0;
 }
 
-void CarriedIterate::apply(const MatchingLp& m, SolverParams& params) const {
-  if (empty()) return;
+namespace {
+// The y_i that maximises Σ_j min(0, s_j − a_ij y_i) over row i's entries (s_j: column j's reduced
+// cost without row i), the one nearest `current` where several do. The sum is concave and
+// piecewise linear with its kinks at y = a_ij s_j, so the maximum is at `current` or a kink.
+double best_row_dual(const std::vector<std::pair<double, bool>>& entries, double current) {
+  auto value = [&](double v) {
+    double sum = 0.0;
+    for (const auto& [s, negative] : entries) sum += std::min(0.0, negative ? s + v : s - v);
+    return sum;
+  };
+  double best = current, best_value = value(current);
+  for (const auto& [s, negative] : entries) {
+    const double v = negative ? -s : s;
+    const double f = value(v);
+    if (f > best_value + 1e-12 || (f >= best_value - 1e-12 && std::abs(v - current) < std::abs(best - current)))
+      best = v, best_value = f;
+  }
+  return best;
+}
+}  // namespace
+
+int64_t CarriedIterate::apply(const MatchingLp& m, SolverParams& params, int ascend) const {
+  if (empty()) return 0;
   params.initial_x.assign(m.lp.cols(), 0.0);
   params.initial_y.assign(m.lp.rows(), 0.0);
   for (int64_t j = 0; j < m.lp.cols(); ++j) {
@@ -553,6 +574,43 @@ void CarriedIterate::apply(const MatchingLp& m, SolverParams& params) const {
   const int64_t faces = m.lp.rows() - m.closedness_rows;  // one row per face, in face order
   if (static_cast<int64_t>(y_.size()) - closedness_rows_ == faces)
     for (int64_t i = 0; i < faces; ++i) params.initial_y[m.closedness_rows + i] = ratio * y_[closedness_rows_ + i];
+  if (ascend <= 0) return 0;
+
+  // Coordinate ascent on the rows the kept LP lacked (closedness rows of product edges it had
+  // none of: only new columns touch them). At 0 they leave most new columns' reduced costs below
+  // zero, and a warm start's first iterations then pull those columns up and wreck the optimum
+  // it was given.
+  std::vector<int64_t> fresh;
+  for (int64_t i = 0; i < m.closedness_rows; ++i)
+    if (!std::binary_search(row_edge_.begin(), row_edge_.end(), m.row_edge[i])) fresh.push_back(i);
+  if (fresh.empty()) return 0;
+  const LpProblem& lp = m.lp;
+  std::vector<double>& y = params.initial_y;
+  std::vector<char> touched(lp.cols(), 0);
+  for (int64_t i : fresh)
+    for (uint32_t k = lp.a.row_ptr[i]; k < lp.a.row_ptr[i + 1]; ++k) touched[col_of(lp.a.entry[k])] = 1;
+  std::vector<double> rc(lp.cols(), 0.0);  // in LP units, of the touched columns
+  for (int64_t j = 0; j < lp.cols(); ++j)
+    if (touched[j]) rc[j] = reduced_cost(lp, j, y) / lp.objective_scale;
+  std::vector<std::pair<double, bool>> entries;
+  for (int sweep = 0; sweep < ascend; ++sweep)
+    for (int64_t i : fresh) {
+      entries.clear();
+      for (uint32_t k = lp.a.row_ptr[i]; k < lp.a.row_ptr[i + 1]; ++k) {
+        const uint32_t e = lp.a.entry[k];
+        const bool negative = is_negative(e);
+        // Without row i: rc_j = c_j − Σ a_kj y_k, so adding a_ij y_i back.
+        entries.emplace_back(rc[col_of(e)] + (negative ? -y[i] : y[i]), negative);
+      }
+      const double v = best_row_dual(entries, y[i]);
+      if (v == y[i]) continue;
+      for (uint32_t k = lp.a.row_ptr[i]; k < lp.a.row_ptr[i + 1]; ++k) {
+        const uint32_t e = lp.a.entry[k];
+        rc[col_of(e)] -= is_negative(e) ? -(v - y[i]) : (v - y[i]);
+      }
+      y[i] = v;
+    }
+  return static_cast<int64_t>(fresh.size());
 }
 
 uint64_t CarriedIterate::key(const ProductTriangle& t) {
@@ -760,7 +818,15 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
       // cold count; rounding goes on from its iterate and its bound stays valid.
       const bool warm_resolve = price_warm && !carrying;
       if (warm_resolve) {
-        priced_from.apply(m, ro.lp);
+        const int64_t fresh = priced_from.apply(m, ro.lp, options_.price_dual_sweeps);
+        if (fresh > 0) {
+          SolverParams plain;
+          priced_from.apply(m, plain);
+          spdlog::info("level {}: duals of {} new rows by {} sweeps of coordinate ascent: the warm start's bound {:.6g} "
+                       "(at 0: {:.6g})",
+                       l + 1, fresh, options_.price_dual_sweeps, certified_lower_bound(m.lp, ro.lp.initial_y),
+                       certified_lower_bound(m.lp, plain.initial_y));
+        }
         ro.first_max_iterations = cold_iterations;
       }
       price_warm = false;

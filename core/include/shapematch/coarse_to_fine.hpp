@@ -33,8 +33,10 @@ public:
   void keep(const MatchingLp& m, const std::vector<double>& x, const std::vector<double>& y,
             double primal_weight = 0.0);
   // Fills params.initial_x / initial_y (and initial_primal_weight, where kept) for `m` (nothing
-  // where empty).
-  void apply(const MatchingLp& m, SolverParams& params) const;
+  // where empty). With `ascend`, the rows the kept LP lacks (they hold only columns it lacked)
+  // get duals that maximise the Lagrangian bound over them by that many sweeps of coordinate
+  // ascent, the other duals fixed, instead of 0. Returns how many rows that was.
+  int64_t apply(const MatchingLp& m, SolverParams& params, int ascend = 0) const;
 
   // The vertex pairs of a product triangle, hashed (its faces follow from them); a collision
   // only misplaces a warm-start value (or a carried fixing, which propagation then checks).
@@ -126,6 +128,9 @@ struct CoarseToFineOptions {
   // level 6 spent every local widening on propagation conflicts).
   int price_widenings = 2;
   double price_threshold = 1e-4;
+  // The re-solve after pricing starts the new rows' duals where this many sweeps of coordinate
+  // ascent on the Lagrangian bound put them (CarriedIterate::apply), not at 0. 0: off.
+  int price_dual_sweeps = 0;
   // More fine rings on Y at every ring (fine neighbourhood): a wider space from the start, paid
   // for in variables, against infeasible reduced LPs whose proof PDHG must find (slow at
   // 10 k faces).
