@@ -3,6 +3,7 @@
 #include "shapematch/matching.hpp"
 #include "shapematch/rounding.hpp"
 #include "shapematch/shapes.hpp"
+#include "solve_in_parts.hpp"
 #include "test_helpers.hpp"
 
 #include <doctest/doctest.h>
@@ -794,4 +795,54 @@ TEST_CASE("rounding: a part at its iteration cap goes on from its iterate before
   CHECK(now.rounds[1].status == LpStatus::IterationLimit);
   CHECK(now.rounds[1].fixed_to_one > 0);
   for (const RoundingRound& k : now.rounds) CHECK(!waits(k));
+}
+
+namespace {
+// A solver that always gives up, as Clp did on a part of a full-resolution rounding.
+class GivingUp final : public LpSolver {
+public:
+  std::string name() const override { return "giving-up"; }
+  LpResult solve(const LpProblem&, const SolverParams&) override {
+    ++calls;
+    LpResult r;
+    r.status = LpStatus::NumericalTrouble;
+    return r;
+  }
+  int calls = 0;
+};
+}  // namespace
+
+TEST_CASE("rounding: a part one solver gives up on goes to the other") {
+  const Mesh x = shapes::octahedron();
+  const Mesh y = test::deformed(x, [](const Eigen::Vector3d& p) { return Eigen::Vector3d(1.2 * p.x(), p.y(), 0.9 * p.z()); });
+  const MatchingLp m = build_matching_lp(x, compute_geometry(x), y, compute_geometry(y));
+  const LpResult exact = solve_lp(m.lp, "clp-dual");
+  REQUIRE(exact.status == LpStatus::Optimal);
+  SolverParams params;
+  params.tolerance = 1e-6;
+  GivingUp quitter;
+  const auto pdhg = make_solver("pdhg-cpu");
+  const auto clp = make_solver("clp-dual");
+  const int64_t n = m.lp.cols();
+  // The exact solver gives up on the (whole, small) LP: the first-order one solves it.
+  const detail::JoinedSolve a = detail::solve_in_parts(m.lp, params, *pdhg, &quitter, n + 1, params, false);
+  CHECK(quitter.calls == 1);
+  CHECK(a.r.status == LpStatus::Optimal);
+  CHECK(a.exact_parts == 0);
+  CHECK(a.r.objective == doctest::Approx(exact.objective).epsilon(1e-4));
+  // The first-order one gives up: the exact one takes a part up to 10× exact_below, not above.
+  const detail::JoinedSolve b = detail::solve_in_parts(m.lp, params, quitter, clp.get(), n / 10 + 1, params, false);
+  CHECK(quitter.calls == 2);
+  CHECK(b.r.status == LpStatus::Optimal);
+  CHECK(b.exact_parts == 1);
+  CHECK(b.r.objective == doctest::Approx(exact.objective).epsilon(1e-9));
+  const detail::JoinedSolve c = detail::solve_in_parts(m.lp, params, quitter, clp.get(), n / 20, params, false);
+  CHECK(quitter.calls == 3);
+  CHECK(c.r.status == LpStatus::NumericalTrouble);
+  // Both give up: so does the join.
+  GivingUp other;
+  const detail::JoinedSolve d = detail::solve_in_parts(m.lp, params, quitter, &other, n + 1, params, false);
+  CHECK(d.r.status == LpStatus::NumericalTrouble);
+  CHECK(other.calls == 1);
+  CHECK(quitter.calls == 4);
 }

@@ -1,4 +1,5 @@
 #include "shapematch/rounding.hpp"
+#include "solve_in_parts.hpp"
 
 #include "shapematch/errors.hpp"
 #include "shapematch/geometry.hpp"
@@ -269,32 +270,16 @@ std::vector<Part> split_into_parts(const LpProblem& lp) {
   return parts;
 }
 
-// A later round's LP solved part by part: parts with fewer than `exact_below` columns by the exact
-// solver, the others by `solver` from the warm start in `params` (given for the whole LP), and the
-// results joined. The joined status is Infeasible where a part is, the iteration limit where a
-// part stopped there; `proof` holds the duals of the parts that are infeasible, or (where none
-// is) that behave like it at their cap (`suspect`: certified bound far above the objective),
-// zero elsewhere, so that the blame stays with them.
-struct JoinedSolve {
-  LpResult r;
-  std::vector<double> proof;
-  bool suspect = false;
-  int64_t parts = 1, exact_parts = 0;
-  // Every row of the parts that are infeasible (or, where none is, suspect), in the LP's
-  // numbering: wider than the certificate's rows, for blaming a batch from a capped LP.
-  std::vector<int64_t> failed_rows;
-  // 1 for the columns of parts that stopped at their iteration (or time) limit; empty where none did.
-  std::vector<char> capped_cols;
-};
-
 bool looks_infeasible(const LpResult& r) {
   // Far above: those LPs' bounds were 3-60x their objectives; at 5 % above, feasible LPs that had
   // not converged by the cap (bound 5.34, objective 5.01) were undone round after round.
   return r.status == LpStatus::IterationLimit && r.lower_bound > r.objective + 0.5 * (1.0 + std::abs(r.objective));
 }
 
-JoinedSolve solve_in_parts(const LpProblem& lp, SolverParams params, LpSolver& solver, LpSolver* exact,
-                           int64_t exact_below, const SolverParams& exact_params, bool split) {
+}  // namespace
+
+JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpSolver& solver, LpSolver* exact,
+                                   int64_t exact_below, const SolverParams& exact_params, bool split) {
   JoinedSolve out;
   std::vector<Part> parts;
   if (split) parts = split_into_parts(lp);
@@ -325,16 +310,31 @@ JoinedSolve solve_in_parts(const LpProblem& lp, SolverParams params, LpSolver& s
     largest = std::max<int64_t>(largest, plp.cols());
     const bool use_exact = exact && plp.cols() < exact_below;
     SolverParams own;
-    if (!whole && !use_exact) {
+    if (!whole) {
       own = params;
       if (!warm_x.empty()) {
         for (int64_t j : part.cols) own.initial_x.push_back(warm_x[j]);
         for (int64_t i : part.rows) own.initial_y.push_back(warm_y[i]);
       }
     }
-    const SolverParams& p = use_exact ? exact_params : whole ? params : own;
+    const SolverParams& first_order = whole ? params : own;
+    const SolverParams& p = use_exact ? exact_params : first_order;
     exactly += use_exact;
-    const LpResult s = (use_exact ? *exact : solver).solve(plp, p);
+    LpResult s = (use_exact ? *exact : solver).solve(plp, p);
+    // One solver's numerical trouble on a part is the other's to try: measured, Clp gave up on a
+    // part of FAUST_r 043-063's finest rounding (round 19 of a 24-minute run), which ended it.
+    // (The exact solver only where a part is not far above its size: Clp on millions of columns
+    // takes hours.)
+    const bool failed =
+        s.status == LpStatus::NumericalTrouble || (s.status != LpStatus::Infeasible && s.x.size() != size_t(plp.cols()));
+    if (failed && (use_exact || (exact && plp.cols() <= 10 * std::max<int64_t>(exact_below, 1)))) {
+      spdlog::warn("rounding: {} failed on a part of {} variables ({}); trying {}", use_exact ? exact->name() : solver.name(),
+                   plp.cols(), to_string(s.status), use_exact ? solver.name() : exact->name());
+      const int64_t before = s.iterations;
+      s = (use_exact ? solver : *exact).solve(plp, use_exact ? first_order : exact_params);
+      s.iterations = std::max(s.iterations, before);
+      exactly += use_exact ? -1 : 1;
+    }
     r.iterations = std::max(r.iterations, s.iterations);
     if (s.status == LpStatus::NumericalTrouble) {
       r.status = s.status;
@@ -383,6 +383,8 @@ JoinedSolve solve_in_parts(const LpProblem& lp, SolverParams params, LpSolver& s
   }
   return out;
 }
+
+namespace {
 
 // Fixes the batch (largest first); a fixing that propagation proves infeasible is undone and
 // replaced by fixing fewer: with `greedy`, every candidate that does not clash with the larger
@@ -1159,7 +1161,7 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
       joined.r = solver->solve(red.lp, params);
       if (joined.r.status == LpStatus::Infeasible) joined.proof = joined.r.y;
     } else {
-      joined = solve_in_parts(red.lp, std::move(params), *solver, exact ? exact_solver.get() : nullptr,
+      joined = detail::solve_in_parts(red.lp, std::move(params), *solver, exact ? exact_solver.get() : nullptr,
                               options.exact_below, exact_params, options.split_parts);
     }
     const LpResult& r = joined.r;

@@ -1,0 +1,36 @@
+#pragma once
+// A later rounding round's LP, solved part by part (rounding.cpp); here for its tests.
+#include "shapematch/lp.hpp"
+
+#include <cstdint>
+#include <vector>
+
+namespace shapematch::detail {
+
+// A later round's LP solved part by part: parts with fewer than `exact_below` columns by the exact
+// solver, the others by `solver` from the warm start in `params` (given for the whole LP), and the
+// results joined. The joined status is Infeasible where a part is, the iteration limit where a
+// part stopped there; `proof` holds the duals of the parts that are infeasible, or (where none
+// is) that behave like it at their cap (`suspect`: certified bound far above the objective),
+// zero elsewhere, so that the blame stays with them. A part that one solver gives up on
+// (numerical trouble) goes to the other (`exact` up to 10 × exact_below columns); where both
+// fail, so does the join.
+struct JoinedSolve {
+  LpResult r;
+  std::vector<double> proof;
+  bool suspect = false;
+  int64_t parts = 1, exact_parts = 0;
+  // Every row of the parts that are infeasible (or, where none is, suspect), in the LP's
+  // numbering: wider than the certificate's rows, for blaming a batch from a capped LP.
+  std::vector<int64_t> failed_rows;
+  // 1 for the columns of parts that stopped at their iteration (or time) limit; empty where none did.
+  std::vector<char> capped_cols;
+};
+JoinedSolve solve_in_parts(const LpProblem& lp, SolverParams params, LpSolver& solver, LpSolver* exact,
+                           int64_t exact_below, const SolverParams& exact_params, bool split);
+
+}  // namespace shapematch::detail
+
+namespace shapematch {
+using detail::JoinedSolve;
+}
