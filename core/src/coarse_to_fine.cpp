@@ -555,8 +555,8 @@ double best_row_dual(const std::vector<std::pair<double, bool>>& entries, double
 }
 }  // namespace
 
-int64_t CarriedIterate::apply(const MatchingLp& m, SolverParams& params, int ascend) const {
-  if (empty()) return 0;
+void CarriedIterate::apply(const MatchingLp& m, SolverParams& params) const {
+  if (empty()) return;
   params.initial_x.assign(m.lp.cols(), 0.0);
   params.initial_y.assign(m.lp.rows(), 0.0);
   for (int64_t j = 0; j < m.lp.cols(); ++j) {
@@ -574,8 +574,10 @@ int64_t CarriedIterate::apply(const MatchingLp& m, SolverParams& params, int asc
   const int64_t faces = m.lp.rows() - m.closedness_rows;  // one row per face, in face order
   if (static_cast<int64_t>(y_.size()) - closedness_rows_ == faces)
     for (int64_t i = 0; i < faces; ++i) params.initial_y[m.closedness_rows + i] = ratio * y_[closedness_rows_ + i];
-  if (ascend <= 0) return 0;
+}
 
+int64_t CarriedIterate::ascend_new_rows(const MatchingLp& m, std::vector<double>& y, int sweeps) const {
+  if (empty() || sweeps <= 0 || y.size() != size_t(m.lp.rows())) return 0;
   // Coordinate ascent on the rows the kept LP lacked (closedness rows of product edges it had
   // none of: only new columns touch them). At 0 they leave most new columns' reduced costs below
   // zero, and a warm start's first iterations then pull those columns up and wreck the optimum
@@ -585,7 +587,6 @@ int64_t CarriedIterate::apply(const MatchingLp& m, SolverParams& params, int asc
     if (!std::binary_search(row_edge_.begin(), row_edge_.end(), m.row_edge[i])) fresh.push_back(i);
   if (fresh.empty()) return 0;
   const LpProblem& lp = m.lp;
-  std::vector<double>& y = params.initial_y;
   std::vector<char> touched(lp.cols(), 0);
   for (int64_t i : fresh)
     for (uint32_t k = lp.a.row_ptr[i]; k < lp.a.row_ptr[i + 1]; ++k) touched[col_of(lp.a.entry[k])] = 1;
@@ -593,7 +594,7 @@ int64_t CarriedIterate::apply(const MatchingLp& m, SolverParams& params, int asc
   for (int64_t j = 0; j < lp.cols(); ++j)
     if (touched[j]) rc[j] = reduced_cost(lp, j, y) / lp.objective_scale;
   std::vector<std::pair<double, bool>> entries;
-  for (int sweep = 0; sweep < ascend; ++sweep)
+  for (int sweep = 0; sweep < sweeps; ++sweep)
     for (int64_t i : fresh) {
       entries.clear();
       for (uint32_t k = lp.a.row_ptr[i]; k < lp.a.row_ptr[i + 1]; ++k) {
@@ -818,14 +819,13 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
       // cold count; rounding goes on from its iterate and its bound stays valid.
       const bool warm_resolve = price_warm && !carrying;
       if (warm_resolve) {
-        const int64_t fresh = priced_from.apply(m, ro.lp, options_.price_dual_sweeps);
-        if (fresh > 0) {
-          SolverParams plain;
-          priced_from.apply(m, plain);
+        priced_from.apply(m, ro.lp);
+        if (options_.price_dual_sweeps > 0) {
+          const double at_zero = certified_lower_bound(m.lp, ro.lp.initial_y);
+          const int64_t fresh = priced_from.ascend_new_rows(m, ro.lp.initial_y, options_.price_dual_sweeps);
           spdlog::info("level {}: duals of {} new rows by {} sweeps of coordinate ascent: the warm start's bound {:.6g} "
                        "(at 0: {:.6g})",
-                       l + 1, fresh, options_.price_dual_sweeps, certified_lower_bound(m.lp, ro.lp.initial_y),
-                       certified_lower_bound(m.lp, plain.initial_y));
+                       l + 1, fresh, options_.price_dual_sweeps, certified_lower_bound(m.lp, ro.lp.initial_y), at_zero);
         }
         ro.first_max_iterations = cold_iterations;
       }

@@ -309,18 +309,20 @@ JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpS
     const LpProblem& plp = whole ? lp : part.lp;
     largest = std::max<int64_t>(largest, plp.cols());
     const bool use_exact = exact && plp.cols() < exact_below;
+    // The first-order solver's parameters: `params` with the part's slice of the warm start (made
+    // only where that solver runs).
     SolverParams own;
-    if (!whole) {
+    auto first_order = [&]() -> const SolverParams& {
+      if (whole) return params;
       own = params;
       if (!warm_x.empty()) {
         for (int64_t j : part.cols) own.initial_x.push_back(warm_x[j]);
         for (int64_t i : part.rows) own.initial_y.push_back(warm_y[i]);
       }
-    }
-    const SolverParams& first_order = whole ? params : own;
-    const SolverParams& p = use_exact ? exact_params : first_order;
+      return own;
+    };
     exactly += use_exact;
-    LpResult s = (use_exact ? *exact : solver).solve(plp, p);
+    LpResult s = use_exact ? exact->solve(plp, exact_params) : solver.solve(plp, first_order());
     // One solver's numerical trouble on a part is the other's to try: measured, Clp gave up on a
     // part of FAUST_r 043-063's finest rounding (round 19 of a 24-minute run), which ended it.
     // (The exact solver only where a part is not far above its size: Clp on millions of columns
@@ -331,7 +333,7 @@ JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpS
       spdlog::warn("rounding: {} failed on a part of {} variables ({}); trying {}", use_exact ? exact->name() : solver.name(),
                    plp.cols(), to_string(s.status), use_exact ? solver.name() : exact->name());
       const int64_t before = s.iterations;
-      s = (use_exact ? solver : *exact).solve(plp, use_exact ? first_order : exact_params);
+      s = use_exact ? solver.solve(plp, first_order()) : exact->solve(plp, exact_params);
       s.iterations = std::max(s.iterations, before);
       exactly += use_exact ? -1 : 1;
     }

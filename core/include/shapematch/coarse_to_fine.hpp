@@ -33,10 +33,12 @@ public:
   void keep(const MatchingLp& m, const std::vector<double>& x, const std::vector<double>& y,
             double primal_weight = 0.0);
   // Fills params.initial_x / initial_y (and initial_primal_weight, where kept) for `m` (nothing
-  // where empty). With `ascend`, the rows the kept LP lacks (they hold only columns it lacked)
-  // get duals that maximise the Lagrangian bound over them by that many sweeps of coordinate
-  // ascent, the other duals fixed, instead of 0. Returns how many rows that was.
-  int64_t apply(const MatchingLp& m, SolverParams& params, int ascend = 0) const;
+  // where empty).
+  void apply(const MatchingLp& m, SolverParams& params) const;
+  // After apply: the rows of `m` the kept LP lacks (they hold only columns it lacked) get duals
+  // in `y` that maximise the Lagrangian bound over them by `sweeps` sweeps of coordinate ascent,
+  // the other duals fixed, instead of 0. Returns how many rows that was.
+  int64_t ascend_new_rows(const MatchingLp& m, std::vector<double>& y, int sweeps) const;
 
   // The vertex pairs of a product triangle, hashed (its faces follow from them); a collision
   // only misplaces a warm-start value (or a carried fixing, which propagation then checks).
