@@ -1,4 +1,5 @@
 #include "shapematch/energy.hpp"
+#include "shapematch/errors.hpp"
 #include "shapematch/shapes.hpp"
 #include "test_helpers.hpp"
 
@@ -149,4 +150,40 @@ TEST_CASE("energy: with the compressive membrane a stretch is charged once, as c
   // The reverse pair costs the same: the energy is symmetric in X and Y.
   const EnergyModel reverse(y, gy, x, gx, o);
   CHECK(reverse.membrane(t) == doctest::Approx(model.membrane(t)));
+}
+
+TEST_CASE("energy: the feature term is Σ (corner areas) ‖f_X − f_Y‖² over the three corners") {
+  const Mesh x = shapes::icosphere(1);
+  const Mesh y = test::deformed(x, [](const Eigen::Vector3d& p) { return Eigen::Vector3d(1.3 * p.x(), p.y(), p.z()); });
+  const Geometry gx = compute_geometry(x), gy = compute_geometry(y);
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-1, 1);
+  Eigen::MatrixXd fx(x.num_vertices(), 5), fy(y.num_vertices(), 5);
+  for (Eigen::Index i = 0; i < fx.size(); ++i) fx.data()[i] = u(rng);
+  for (Eigen::Index i = 0; i < fy.size(); ++i) fy.data()[i] = u(rng);
+  EnergyModel model(x, gx, y, gy);
+  CHECK(model.feature(identity_matching(x).front()) == 0.0);  // no features: no term
+  model.set_features(fx, fy);
+  auto area = [](const Mesh& m, const Geometry& g, int f, int v) {
+    if (f < 0) return 0.0;
+    for (int c = 0; c < 3; ++c)
+      if (m.faces[f][c] == v) return g.corner_area[f][c];
+    return -1.0;
+  };
+  const ProductSpace s = ProductSpace::full(x, y);
+  int degenerate = 0;
+  for (int64_t j = 0; j < s.size(); j += 13) {
+    const ProductTriangle t = s[j];
+    degenerate += t.fa < 0 || t.fb < 0;
+    double expected = 0.0;
+    for (int i = 0; i < 3; ++i)
+      expected += (area(x, gx, t.fa, t.a[i]) + area(y, gy, t.fb, t.b[i])) * (fx.row(t.a[i]) - fy.row(t.b[i])).squaredNorm();
+    CHECK(model.feature(t) == doctest::Approx(expected).epsilon(1e-14));
+  }
+  CHECK(degenerate > 0);
+  // Equal features on the identity: nothing to pay.
+  EnergyModel same(x, gx, x, gx);
+  same.set_features(fx, fx);
+  for (const auto& t : identity_matching(x)) CHECK(same.feature(t) == 0.0);
+  CHECK_THROWS_AS(same.set_features(fx, fy.leftCols(4)), InvalidInputError);
 }

@@ -71,6 +71,20 @@ TEST_CASE("mesh: edges are sorted and found by binary search") {
   CHECK(missing == 144);  // the original icosahedron vertices are no longer adjacent
 }
 
+TEST_CASE("mesh: edge lookup through each vertex's edges agrees with a search of all edges") {
+  Mesh m = shapes::icosphere(2);
+  REQUIRE(m.edge_begin.size() == size_t(m.num_vertices()) + 1);
+  CHECK(m.edge_begin.back() == m.num_edges());
+  std::vector<int> fast;
+  for (int u = -1; u <= m.num_vertices(); ++u)
+    for (int v = -1; v <= m.num_vertices(); ++v) fast.push_back(m.edge_index(u, v));
+  CHECK(std::count_if(fast.begin(), fast.end(), [](int e) { return e >= 0; }) == 2 * m.num_edges());
+  m.edge_begin.clear();  // `edges` filled by hand: the binary search
+  size_t k = 0;
+  for (int u = -1; u <= m.num_vertices(); ++u)
+    for (int v = -1; v <= m.num_vertices(); ++v) CHECK(m.edge_index(u, v) == fast[k++]);
+}
+
 TEST_CASE("mesh: genus from the Euler characteristic") {
   CHECK(validate_mesh(shapes::tetrahedron()) == 0);
   CHECK(validate_mesh(shapes::icosphere(3)) == 0);

@@ -232,6 +232,49 @@ TEST_CASE("thread pool: a chunk that throws is rethrown to the caller after ever
   }
 }
 
+TEST_CASE("parallel_sort: the same order as std::sort for any number of threads") {
+  std::mt19937_64 rng(3);
+  for (const int64_t n : {0, 1, 1000, 65536 * 3 + 17}) {
+    std::vector<int64_t> v(n);
+    for (auto& x : v) x = int64_t(rng() % 50000);  // many equal keys
+    std::vector<int64_t> expected = v;
+    std::sort(expected.begin(), expected.end());
+    for (const int threads : {1, 2, 3, 4}) {
+      CAPTURE(n);
+      CAPTURE(threads);
+      std::vector<int64_t> w = v;
+      detail::parallel_sort(w.data(), n, threads);
+      CHECK(w == expected);
+    }
+  }
+}
+
+TEST_CASE("scaled_norm: the same estimate for any number of threads") {
+  // Large enough for several blocks of the blocked vector sums and several chunks per loop.
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<double> u(0.2, 3.0);
+  const LpProblem p = random_lp(20000, 50000, 4, rng);
+  std::vector<double> r(p.rows()), d(p.cols());
+  for (auto& v : r) v = u(rng);
+  for (auto& v : d) v = u(rng);
+  const detail::NormEstimate one = detail::scaled_norm(p.a, p.at, r, d, 40, 1e-6, 1, 1.0, 1e300);
+  CHECK(one.steps == 40);
+  for (const int threads : {2, 3, 4}) {
+    const detail::NormEstimate e = detail::scaled_norm(p.a, p.at, r, d, 40, 1e-6, threads, 1.0, 1e300);
+    CAPTURE(threads);
+    CHECK(e.norm == one.norm);
+    CHECK(e.residual == one.residual);
+    CHECK(e.steps == one.steps);
+  }
+  // A lower bound: ‖Ã‖ ≥ ‖Ãx‖/‖x‖ for x = 1.
+  std::vector<double> ax(p.rows()), ones(p.cols());
+  for (int64_t j = 0; j < p.cols(); ++j) ones[j] = d[j];
+  spmv(p.a, ones.data(), ax.data());
+  double num = 0.0;
+  for (int64_t i = 0; i < p.rows(); ++i) num += r[i] * r[i] * ax[i] * ax[i];
+  CHECK(one.norm >= std::sqrt(num / double(p.cols())));
+}
+
 TEST_CASE("parallel_chunks: a chunk that throws is rethrown after every chunk ran") {
   for (const int threads : {1, 2, 4}) {
     for (const int bad : {0, threads - 1}) {

@@ -4,9 +4,12 @@
 #include "shapematch/errors.hpp"
 #include "shapematch/system.hpp"
 
+#include "parallel.hpp"
+
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <cmath>
 #include <exception>
 #include <limits>
 
@@ -94,10 +97,7 @@ struct Pricing {
 
 double reduced_cost(const LpProblem& lp, int64_t j, const std::vector<double>& y) {
   double s = 0.0;
-  for (uint32_t k = lp.at.row_ptr[j]; k < lp.at.row_ptr[j + 1]; ++k) {
-    const uint32_t e = lp.at.entry[k];
-    s += is_negative(e) ? -y[col_of(e)] : y[col_of(e)];
-  }
+  for (uint32_t k = lp.at.row_ptr[j]; k < lp.at.row_ptr[j + 1]; ++k) s += signed_value(lp.at.entry[k], y.data());
   return (lp.c[j] - s) * lp.objective_scale;
 }
 
@@ -106,9 +106,44 @@ std::vector<double> priced_against(const CarriedIterate& dual, const MatchingLp&
   SolverParams mapped;
   dual.apply(other, mapped);
   std::vector<double> rc(other.lp.cols());
-  for (int64_t j = 0; j < other.lp.cols(); ++j) rc[j] = reduced_cost(other.lp, j, mapped.initial_y);
+  detail::parallel_for(other.lp.cols(), 0, [&](int64_t j) { rc[j] = reduced_cost(other.lp, j, mapped.initial_y); });
   return rc;
 }
+
+// Membership of CarriedIterate keys (hashes already): open addressing, linear probing, the
+// table at most half full. A lookup costs a cache miss or two where a binary search over
+// millions of sorted keys cost some twenty dependent ones.
+class KeySet {
+public:
+  explicit KeySet(const std::vector<uint64_t>& keys) {
+    size_t capacity = 16;
+    while (capacity < 2 * keys.size()) capacity *= 2;
+    mask_ = capacity - 1;
+    slots_.assign(capacity, kEmpty);
+    for (uint64_t k : keys) {
+      if (k == kEmpty) {
+        has_empty_ = true;
+        continue;
+      }
+      size_t i = k & mask_;
+      while (slots_[i] != kEmpty && slots_[i] != k) i = (i + 1) & mask_;
+      slots_[i] = k;
+    }
+  }
+  bool contains(uint64_t k) const {
+    if (k == kEmpty) return has_empty_;
+    for (size_t i = k & mask_;; i = (i + 1) & mask_) {
+      if (slots_[i] == k) return true;
+      if (slots_[i] == kEmpty) return false;
+    }
+  }
+
+private:
+  static constexpr uint64_t kEmpty = 0;
+  std::vector<uint64_t> slots_;
+  size_t mask_ = 0;
+  bool has_empty_ = false;
+};
 
 // `wider`: the space one ring out (a superset of m's); `x`, `y`: m's first iterate.
 Pricing price_wider_space(const MatchingLp& m, std::vector<ProductTriangle> wider, const EnergyModel& model,
@@ -117,22 +152,29 @@ Pricing price_wider_space(const MatchingLp& m, std::vector<ProductTriangle> wide
   Pricing p;
   // The low tail over the kept columns the iterate leaves at 0, those propagation fixed included
   // (they make it: see above).
-  std::vector<double> kept;
-  for (int64_t j = 0; j < m.lp.cols(); ++j)
-    if (x[j] < 1e-6) kept.push_back(reduced_cost(m.lp, j, y));
+  std::vector<double> kept(m.lp.cols());
+  detail::parallel_for(m.lp.cols(), 0, [&](int64_t j) {
+    kept[j] = x[j] < 1e-6 ? reduced_cost(m.lp, j, y) : std::numeric_limits<double>::quiet_NaN();
+  });
+  std::erase_if(kept, [](double v) { return std::isnan(v); });
   if (!kept.empty()) {
     const size_t q = kept.size() / 10000;
     std::nth_element(kept.begin(), kept.begin() + q, kept.end());
     p.noise = std::min(0.0, kept[q]);
   }
   p.threshold = std::max(min_threshold, -p.noise);
-  std::vector<uint64_t> keys(m.lp.cols());
-  for (int64_t j = 0; j < m.lp.cols(); ++j) keys[j] = CarriedIterate::key(m.space[j]);
-  std::sort(keys.begin(), keys.end());
-  std::erase_if(wider, [&](const ProductTriangle& t) {
-    return std::binary_search(keys.begin(), keys.end(), CarriedIterate::key(t));
-  });
-  keys = {};
+  {
+    std::vector<uint64_t> keys(m.lp.cols());
+    detail::parallel_for(m.lp.cols(), 0, [&](int64_t j) { keys[j] = CarriedIterate::key(m.space[j]); });
+    const KeySet in_m(keys);
+    std::vector<char> drop(wider.size());
+    detail::parallel_for(int64_t(wider.size()), 0,
+                         [&](int64_t j) { drop[j] = in_m.contains(CarriedIterate::key(wider[j])); });
+    size_t out = 0;
+    for (size_t j = 0; j < wider.size(); ++j)
+      if (!drop[j]) wider[out++] = wider[j];
+    wider.resize(out);
+  }
   p.columns = static_cast<int64_t>(wider.size());
   CarriedIterate dual;
   dual.keep(m, {}, y);
@@ -559,18 +601,18 @@ void CarriedIterate::apply(const MatchingLp& m, SolverParams& params) const {
   if (empty()) return;
   params.initial_x.assign(m.lp.cols(), 0.0);
   params.initial_y.assign(m.lp.rows(), 0.0);
-  for (int64_t j = 0; j < m.lp.cols(); ++j) {
+  detail::parallel_for(m.lp.cols(), 0, [&](int64_t j) {
     const uint64_t k = key(m.space[j]);
     const auto it = std::lower_bound(x_.begin(), x_.end(), std::pair<uint64_t, double>{k, -1.0});
     if (it != x_.end() && it->first == k) params.initial_x[j] = it->second;
-  }
+  });
   const double ratio = scale_ / m.lp.objective_scale;  // y scales with the costs
   // ω balances the dual's steps against the primal's: it scales with y.
   if (primal_weight_ > 0.0) params.initial_primal_weight = ratio * primal_weight_;
-  for (int64_t i = 0; i < m.closedness_rows; ++i) {
+  detail::parallel_for(m.closedness_rows, 0, [&](int64_t i) {
     const auto it = std::lower_bound(row_edge_.begin(), row_edge_.end(), m.row_edge[i]);
     if (it != row_edge_.end() && *it == m.row_edge[i]) params.initial_y[i] = ratio * y_[it - row_edge_.begin()];
-  }
+  });
   const int64_t faces = m.lp.rows() - m.closedness_rows;  // one row per face, in face order
   if (static_cast<int64_t>(y_.size()) - closedness_rows_ == faces)
     for (int64_t i = 0; i < faces; ++i) params.initial_y[m.closedness_rows + i] = ratio * y_[closedness_rows_ + i];

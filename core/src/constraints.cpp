@@ -85,7 +85,7 @@ ConstraintSystem build_constraints(const ProductSpace& space) {
     for (int64_t r = 0; r < cs.closedness_rows; ++r) cs.row_edge[r] = r;
   } else {
     cs.row_edge = edge_id;
-    std::sort(cs.row_edge.begin(), cs.row_edge.end());
+    detail::parallel_sort(cs.row_edge.data(), static_cast<int64_t>(cs.row_edge.size()));
     cs.row_edge.erase(std::unique(cs.row_edge.begin(), cs.row_edge.end()), cs.row_edge.end());
     cs.closedness_rows = static_cast<int64_t>(cs.row_edge.size());
   }

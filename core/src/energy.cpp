@@ -112,7 +112,11 @@ double EnergyModel::feature(const ProductTriangle& p) const {
   for (int i = 0; i < 3; ++i) {
     const double ax = p.fa >= 0 ? gx_.corner_area[p.fa][corner_of(x_.faces[p.fa], p.a[i])] : 0.0;
     const double ay = p.fb >= 0 ? gy_.corner_area[p.fb][corner_of(y_.faces[p.fb], p.b[i])] : 0.0;
-    e += (ax + ay) * (fx_.row(p.a[i]) - fy_.row(p.b[i])).squaredNorm();
+    const double* u = fx_.data() + fx_.cols() * p.a[i];
+    const double* w = fy_.data() + fy_.cols() * p.b[i];
+    double d2 = 0.0;  // in index order, as Eigen's squaredNorm of a strided row added
+    for (Eigen::Index k = 0; k < fx_.cols(); ++k) d2 += (u[k] - w[k]) * (u[k] - w[k]);
+    e += (ax + ay) * d2;
   }
   return e;
 }

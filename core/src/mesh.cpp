@@ -472,6 +472,11 @@ int close_boundary_loops(Mesh& mesh) {
 
 int Mesh::edge_index(int u, int v) const {
   const std::array<int, 2> key = u < v ? std::array<int, 2>{u, v} : std::array<int, 2>{v, u};
+  if (key[0] >= 0 && size_t(key[0]) + 1 < edge_begin.size() && edge_begin.back() == num_edges()) {
+    for (int e = edge_begin[key[0]]; e < edge_begin[key[0] + 1]; ++e)
+      if (edges[e][1] == key[1]) return e;
+    return -1;
+  }
   const auto it = std::lower_bound(edges.begin(), edges.end(), key);
   return it != edges.end() && *it == key ? static_cast<int>(it - edges.begin()) : -1;
 }
@@ -486,6 +491,11 @@ void Mesh::build_edges() {
     }
   std::sort(edges.begin(), edges.end());
   edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+  edge_begin.assign(vertices.size() + 1, 0);
+  for (const auto& e : edges)
+    if (e[0] >= 0 && size_t(e[0]) < vertices.size()) ++edge_begin[e[0] + 1];
+  for (size_t u = 0; u < vertices.size(); ++u) edge_begin[u + 1] += edge_begin[u];
+  if (edge_begin.back() != num_edges()) edge_begin.clear();  // indices out of range: validation says so
 }
 
 int validate_mesh(const Mesh& mesh) {

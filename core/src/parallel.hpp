@@ -14,13 +14,14 @@ inline int hardware_threads() {
   return n == 0 ? 1 : static_cast<int>(n);
 }
 
-// Calls body(begin, end, chunk) for `threads` contiguous chunks of [0, n). If bodies throw, every
-// chunk still runs to its end and the first chunk's exception is rethrown here (an exception
-// escaping a std::thread would terminate the process).
+// Calls body(begin, end, chunk) for `threads` contiguous chunks of [0, n), each of about `grain`
+// items at least (a thread costs a spawn). If bodies throw, every chunk still runs to its end and
+// the first chunk's exception is rethrown here (an exception escaping a std::thread would
+// terminate the process).
 template <class Body>
-void parallel_chunks(int64_t n, int threads, Body&& body) {
+void parallel_chunks(int64_t n, int threads, Body&& body, int64_t grain = 4096) {
   if (threads <= 0) threads = hardware_threads();
-  threads = static_cast<int>(std::max<int64_t>(1, std::min<int64_t>(threads, n / 4096 + 1)));
+  threads = static_cast<int>(std::max<int64_t>(1, std::min<int64_t>(threads, n / std::max<int64_t>(1, grain) + 1)));
   if (threads == 1) {
     body(int64_t{0}, n, 0);
     return;
@@ -47,10 +48,31 @@ void parallel_chunks(int64_t n, int threads, Body&& body) {
 }
 
 template <class Body>
-void parallel_for(int64_t n, int threads, Body&& body) {
-  parallel_chunks(n, threads, [&](int64_t b, int64_t e, int) {
-    for (int64_t i = b; i < e; ++i) body(i);
-  });
+void parallel_for(int64_t n, int threads, Body&& body, int64_t grain = 4096) {
+  parallel_chunks(
+      n, threads,
+      [&](int64_t b, int64_t e, int) {
+        for (int64_t i = b; i < e; ++i) body(i);
+      },
+      grain);
+}
+
+// Sorts [first, first + n) like std::sort (for a total order: the same result): chunks sorted in
+// parallel, then merged pairwise, the merges of each round in parallel too.
+template <class T>
+void parallel_sort(T* first, int64_t n, int threads = 0) {
+  if (threads <= 0) threads = hardware_threads();
+  const int64_t chunks = std::max<int64_t>(1, std::min<int64_t>(threads, n / 65536));
+  std::vector<int64_t> cut(chunks + 1);
+  for (int64_t c = 0; c <= chunks; ++c) cut[c] = n * c / chunks;
+  parallel_for(chunks, threads, [&](int64_t c) { std::sort(first + cut[c], first + cut[c + 1]); }, 1);
+  for (int64_t width = 1; width < chunks; width *= 2) {
+    const int64_t merges = (chunks + 2 * width - 1) / (2 * width);
+    parallel_for(merges, threads, [&](int64_t k) {
+      const int64_t lo = 2 * width * k, mid = std::min(chunks, lo + width), hi = std::min(chunks, lo + 2 * width);
+      if (mid < hi) std::inplace_merge(first + cut[lo], first + cut[mid], first + cut[hi]);
+    }, 1);
+  }
 }
 
 }  // namespace shapematch::detail

@@ -14,13 +14,6 @@
 namespace shapematch::detail {
 namespace {
 
-// ±v[col] for one entry. The sign bit of the entry becomes the sign bit of the value: a branch
-// on it mispredicted about every other entry (signs change at 47 % of A's entries, 61 % of Aᵀ's).
-inline double signed_value(uint32_t e, const double* v) {
-  const uint64_t bits = std::bit_cast<uint64_t>(v[e & ~SignedCsr::kNegative]);
-  return std::bit_cast<double>(bits ^ (uint64_t(e & SignedCsr::kNegative) << 32));
-}
-
 // Σ ±v[col] over entries [begin, end), in entry order (the shaders add in the same order).
 inline double signed_gather(const uint32_t* entry, uint32_t begin, uint32_t end, const double* v) {
   double s = 0.0;

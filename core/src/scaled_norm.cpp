@@ -4,10 +4,33 @@
 
 #include <Eigen/Eigenvalues>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
 namespace shapematch::detail {
+
+namespace {
+
+// Vector sums in blocks of a fixed size, added in block order: the same value for any number of
+// threads (the partition into threads only decides who sums which blocks).
+constexpr int64_t kBlock = 8192;
+
+template <class Term>
+double blocked_sum(int64_t n, int threads, std::vector<double>& partial, Term&& term) {
+  const int64_t blocks = (n + kBlock - 1) / kBlock;
+  partial.assign(blocks, 0.0);
+  parallel_for(blocks, threads, [&](int64_t b) {
+    double s = 0.0;
+    for (int64_t j = b * kBlock, e = std::min(n, j + kBlock); j < e; ++j) s += term(j);
+    partial[b] = s;
+  }, 1);
+  double s = 0.0;
+  for (double p : partial) s += p;
+  return s;
+}
+
+}  // namespace
 
 NormEstimate scaled_norm(const SignedCsr& a, const SignedCsr& at, const std::vector<double>& r,
                          const std::vector<double>& d, int max_steps, double tolerance, int threads, double margin,
@@ -17,7 +40,7 @@ NormEstimate scaled_norm(const SignedCsr& a, const SignedCsr& at, const std::vec
   if (n == 0 || m == 0 || max_steps <= 0) return out;
   // v: the Lanczos vector, prev: the one before, w: ÃᵀÃv; dv = d∘v and ru = r∘(Ãv), so that
   // each product gathers one array per entry.
-  std::vector<double> v(n), prev(n, 0.0), w(n), dv(n), ru(m);
+  std::vector<double> v(n), prev(n, 0.0), w(n), dv(n), ru(m), partial;
   std::mt19937 rng(12345);
   std::uniform_real_distribution<double> uni(0.5, 1.5);
   double nv = 0.0;
@@ -32,29 +55,22 @@ NormEstimate scaled_norm(const SignedCsr& a, const SignedCsr& at, const std::vec
   for (int step = 0; step < max_steps; ++step) {
     parallel_for(m, threads, [&](int64_t i) {
       double s = 0.0;
-      for (uint32_t k = a.row_ptr[i]; k < a.row_ptr[i + 1]; ++k) {
-        const uint32_t e = a.entry[k];
-        s += is_negative(e) ? -dv[col_of(e)] : dv[col_of(e)];
-      }
+      for (uint32_t k = a.row_ptr[i]; k < a.row_ptr[i + 1]; ++k) s += signed_value(a.entry[k], dv.data());
       ru[i] = r[i] * (r[i] * s);
     });
-    parallel_for(n, threads, [&](int64_t j) {
+    // w = ÃᵀÃv and α = v·w in one pass.
+    const double al = blocked_sum(n, threads, partial, [&](int64_t j) {
       double s = 0.0;
-      for (uint32_t k = at.row_ptr[j]; k < at.row_ptr[j + 1]; ++k) {
-        const uint32_t e = at.entry[k];
-        s += is_negative(e) ? -ru[col_of(e)] : ru[col_of(e)];
-      }
+      for (uint32_t k = at.row_ptr[j]; k < at.row_ptr[j + 1]; ++k) s += signed_value(at.entry[k], ru.data());
       w[j] = d[j] * s;
+      return v[j] * w[j];
     });
     out.steps = step + 1;
-    double al = 0.0;
-    for (int64_t j = 0; j < n; ++j) al += v[j] * w[j];
     alpha.push_back(al);
-    double nw = 0.0;
-    for (int64_t j = 0; j < n; ++j) {
+    const double nw = blocked_sum(n, threads, partial, [&](int64_t j) {
       w[j] -= al * v[j] + b * prev[j];
-      nw += w[j] * w[j];
-    }
+      return w[j] * w[j];
+    });
     b = std::sqrt(nw);
     // The largest eigenvalue θ of the tridiagonal T (α on the diagonal, β below) and the last
     // component s of its eigenvector: ‖ÃᵀÃu − θu‖ = β|s| for the Ritz vector u.
@@ -69,7 +85,7 @@ NormEstimate scaled_norm(const SignedCsr& a, const SignedCsr& at, const std::vec
     if (margin * out.norm >= cap || out.residual <= tolerance || !(b > 1e-300)) break;
     beta.push_back(b);
     prev.swap(v);
-    for (int64_t j = 0; j < n; ++j) dv[j] = d[j] * (v[j] = w[j] / b);
+    parallel_for(n, threads, [&](int64_t j) { dv[j] = d[j] * (v[j] = w[j] / b); });
   }
   return out;
 }

@@ -17,12 +17,16 @@ struct Mesh {
   std::vector<Eigen::Vector3d> vertices;
   std::vector<std::array<int, 3>> faces;
   std::vector<std::array<int, 2>> edges;  // derived by build_edges()
+  // Derived by build_edges(): the edges (u, ·) are edges[edge_begin[u] … edge_begin[u + 1]), so
+  // that edge_index reads a vertex's few edges instead of searching all of them.
+  std::vector<int> edge_begin;
 
   int num_vertices() const { return static_cast<int>(vertices.size()); }
   int num_faces() const { return static_cast<int>(faces.size()); }
   int num_edges() const { return static_cast<int>(edges.size()); }
 
-  // Index of the undirected edge {u, v}, or -1 if there is none. O(log |E|).
+  // Index of the undirected edge {u, v}, or -1 if there is none: O(degree) after build_edges(),
+  // O(log |E|) where `edges` was filled otherwise.
   int edge_index(int u, int v) const;
   // Index of the directed edge u->v in [0, 2|E|), or -1.
   int directed_edge_index(int u, int v) const {
