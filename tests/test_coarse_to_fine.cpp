@@ -1,3 +1,4 @@
+#include "key_set.hpp"
 #include "shapematch/coarse_to_fine.hpp"
 #include "shapematch/errors.hpp"
 #include "shapematch/evaluation.hpp"
@@ -9,6 +10,7 @@
 
 #include <cmath>
 #include <map>
+#include <random>
 #include <set>
 
 using namespace shapematch;
@@ -670,4 +672,25 @@ TEST_CASE("coarse to fine: pricing a wider space against an exact dual says whet
   CHECK(c.objective < a.objective - 1e-6);
   CHECK(c.objective >= b.objective - 1e-6);
   CHECK(priced.lp.cols() < wide.lp.cols());
+}
+
+TEST_CASE("KeySet: exactly the keys it was given, 0 and colliding slots included") {
+  std::mt19937_64 rng(17);
+  std::vector<uint64_t> keys;
+  for (int i = 0; i < 5000; ++i) keys.push_back(rng());
+  for (uint64_t k = 0; k < 64; ++k) keys.push_back(k << 40);  // one slot for all: long probe runs
+  keys.push_back(keys[10]);                                     // a duplicate
+  const detail::KeySet set(keys);
+  for (uint64_t k : keys) CHECK(set.contains(k));
+  const std::set<uint64_t> given(keys.begin(), keys.end());
+  int absent = 0;
+  for (int i = 0; i < 20000; ++i) {
+    const uint64_t k = i < 64 ? (uint64_t(i) << 40) + 1 : rng();
+    if (given.count(k)) continue;
+    ++absent;
+    CHECK_FALSE(set.contains(k));
+  }
+  CHECK(absent > 19000);
+  CHECK_FALSE(detail::KeySet({1, 2, 3}).contains(0));
+  CHECK(detail::KeySet({}).contains(5) == false);
 }

@@ -258,7 +258,7 @@ TEST_CASE("scaled_norm: the same estimate for any number of threads") {
   for (auto& v : r) v = u(rng);
   for (auto& v : d) v = u(rng);
   const detail::NormEstimate one = detail::scaled_norm(p.a, p.at, r, d, 40, 1e-6, 1, 1.0, 1e300);
-  CHECK(one.steps == 40);
+  CHECK(one.steps > 10);
   for (const int threads : {2, 3, 4}) {
     const detail::NormEstimate e = detail::scaled_norm(p.a, p.at, r, d, 40, 1e-6, threads, 1.0, 1e300);
     CAPTURE(threads);

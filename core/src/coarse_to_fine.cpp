@@ -4,11 +4,13 @@
 #include "shapematch/errors.hpp"
 #include "shapematch/system.hpp"
 
+#include "key_set.hpp"
 #include "parallel.hpp"
 
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <exception>
 #include <limits>
@@ -110,41 +112,6 @@ std::vector<double> priced_against(const CarriedIterate& dual, const MatchingLp&
   return rc;
 }
 
-// Membership of CarriedIterate keys (hashes already): open addressing, linear probing, the
-// table at most half full. A lookup costs a cache miss or two where a binary search over
-// millions of sorted keys cost some twenty dependent ones.
-class KeySet {
-public:
-  explicit KeySet(const std::vector<uint64_t>& keys) {
-    size_t capacity = 16;
-    while (capacity < 2 * keys.size()) capacity *= 2;
-    mask_ = capacity - 1;
-    slots_.assign(capacity, kEmpty);
-    for (uint64_t k : keys) {
-      if (k == kEmpty) {
-        has_empty_ = true;
-        continue;
-      }
-      size_t i = k & mask_;
-      while (slots_[i] != kEmpty && slots_[i] != k) i = (i + 1) & mask_;
-      slots_[i] = k;
-    }
-  }
-  bool contains(uint64_t k) const {
-    if (k == kEmpty) return has_empty_;
-    for (size_t i = k & mask_;; i = (i + 1) & mask_) {
-      if (slots_[i] == k) return true;
-      if (slots_[i] == kEmpty) return false;
-    }
-  }
-
-private:
-  static constexpr uint64_t kEmpty = 0;
-  std::vector<uint64_t> slots_;
-  size_t mask_ = 0;
-  bool has_empty_ = false;
-};
-
 // `wider`: the space one ring out (a superset of m's); `x`, `y`: m's first iterate.
 Pricing price_wider_space(const MatchingLp& m, std::vector<ProductTriangle> wider, const EnergyModel& model,
                           bool scale_costs, const std::vector<double>& x, const std::vector<double>& y,
@@ -153,10 +120,11 @@ Pricing price_wider_space(const MatchingLp& m, std::vector<ProductTriangle> wide
   // The low tail over the kept columns the iterate leaves at 0, those propagation fixed included
   // (they make it: see above).
   std::vector<double> kept(m.lp.cols());
-  detail::parallel_for(m.lp.cols(), 0, [&](int64_t j) {
-    kept[j] = x[j] < 1e-6 ? reduced_cost(m.lp, j, y) : std::numeric_limits<double>::quiet_NaN();
-  });
-  std::erase_if(kept, [](double v) { return std::isnan(v); });
+  detail::parallel_for(m.lp.cols(), 0, [&](int64_t j) { kept[j] = reduced_cost(m.lp, j, y); });
+  size_t n_kept = 0;
+  for (int64_t j = 0; j < m.lp.cols(); ++j)
+    if (x[j] < 1e-6) kept[n_kept++] = kept[j];
+  kept.resize(n_kept);
   if (!kept.empty()) {
     const size_t q = kept.size() / 10000;
     std::nth_element(kept.begin(), kept.begin() + q, kept.end());
@@ -166,7 +134,7 @@ Pricing price_wider_space(const MatchingLp& m, std::vector<ProductTriangle> wide
   {
     std::vector<uint64_t> keys(m.lp.cols());
     detail::parallel_for(m.lp.cols(), 0, [&](int64_t j) { keys[j] = CarriedIterate::key(m.space[j]); });
-    const KeySet in_m(keys);
+    const detail::KeySet in_m(keys);
     std::vector<char> drop(wider.size());
     detail::parallel_for(int64_t(wider.size()), 0,
                          [&](int64_t j) { drop[j] = in_m.contains(CarriedIterate::key(wider[j])); });
@@ -245,11 +213,13 @@ int conflict_places(const MatchingLp& m, int max_places, int margin, ProofPlace&
     place.add(m, row);
     for (int f : faces_on(X, here.x, 1 + margin))
       for (int v : X.faces[f]) set_aside[v] = 1;
-    for (int64_t j = 0; j < m.space.size(); ++j) {
+    // Threads may mark the same row: atomically (each writes the same 1).
+    detail::parallel_for(m.space.size(), 0, [&](int64_t j) {
       const auto a = m.space[j].a;
       if (set_aside[a[0]] || set_aside[a[1]] || set_aside[a[2]])
-        for (uint32_t k = m.lp.at.row_ptr[j]; k < m.lp.at.row_ptr[j + 1]; ++k) skip[col_of(m.lp.at.entry[k])] = 1;
-    }
+        for (uint32_t k = m.lp.at.row_ptr[j]; k < m.lp.at.row_ptr[j + 1]; ++k)
+          std::atomic_ref<char>(skip[col_of(m.lp.at.entry[k])]).store(1, std::memory_order_relaxed);
+    });
   }
   if (places > 0) spdlog::debug("propagation: {} places of infeasibility", places);
   return places;

@@ -472,7 +472,8 @@ int close_boundary_loops(Mesh& mesh) {
 
 int Mesh::edge_index(int u, int v) const {
   const std::array<int, 2> key = u < v ? std::array<int, 2>{u, v} : std::array<int, 2>{v, u};
-  if (key[0] >= 0 && size_t(key[0]) + 1 < edge_begin.size() && edge_begin.back() == num_edges()) {
+  if (key[0] >= 0 && size_t(key[0]) + 1 < edge_begin.size() && edge_begin.size() == vertices.size() + 1 &&
+      edge_begin.back() == num_edges()) {
     for (int e = edge_begin[key[0]]; e < edge_begin[key[0] + 1]; ++e)
       if (edges[e][1] == key[1]) return e;
     return -1;

@@ -65,13 +65,14 @@ void parallel_sort(T* first, int64_t n, int threads = 0) {
   const int64_t chunks = std::max<int64_t>(1, std::min<int64_t>(threads, n / 65536));
   std::vector<int64_t> cut(chunks + 1);
   for (int64_t c = 0; c <= chunks; ++c) cut[c] = n * c / chunks;
-  parallel_for(chunks, threads, [&](int64_t c) { std::sort(first + cut[c], first + cut[c + 1]); }, 1);
+  // grain 2: a second thread only where there is a second chunk (or merge).
+  parallel_for(chunks, threads, [&](int64_t c) { std::sort(first + cut[c], first + cut[c + 1]); }, 2);
   for (int64_t width = 1; width < chunks; width *= 2) {
     const int64_t merges = (chunks + 2 * width - 1) / (2 * width);
     parallel_for(merges, threads, [&](int64_t k) {
       const int64_t lo = 2 * width * k, mid = std::min(chunks, lo + width), hi = std::min(chunks, lo + 2 * width);
       if (mid < hi) std::inplace_merge(first + cut[lo], first + cut[mid], first + cut[hi]);
-    }, 1);
+    }, 2);
   }
 }
 
