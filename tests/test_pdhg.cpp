@@ -249,6 +249,27 @@ TEST_CASE("parallel_sort: the same order as std::sort for any number of threads"
   }
 }
 
+TEST_CASE("parallel_rows: every row once, with rows of very different lengths") {
+  // Many short rows, then a few long ones (a matching LP's A), and the reverse.
+  for (const bool long_first : {false, true}) {
+    std::vector<uint32_t> row_ptr{0};
+    for (int i = 0; i < 60000; ++i) {
+      const bool is_long = long_first ? i < 40 : i >= 59960;
+      row_ptr.push_back(row_ptr.back() + (is_long ? 3000 : 3));
+    }
+    for (const int threads : {1, 2, 3, 4}) {
+      CAPTURE(long_first);
+      CAPTURE(threads);
+      std::vector<std::atomic<int>> seen(row_ptr.size() - 1);
+      detail::parallel_rows(row_ptr, threads, [&](int64_t i) { seen[i].fetch_add(1); });
+      int64_t wrong = 0;
+      for (auto& v : seen) wrong += v.load() != 1;
+      CHECK(wrong == 0);
+    }
+  }
+  detail::parallel_rows(std::vector<uint32_t>{0}, 2, [](int64_t) { FAIL("no rows to visit"); });
+}
+
 TEST_CASE("scaled_norm: the same estimate for any number of threads") {
   // Large enough for several blocks of the blocked vector sums and several chunks per loop.
   std::mt19937 rng(9);

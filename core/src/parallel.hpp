@@ -57,6 +57,36 @@ void parallel_for(int64_t n, int threads, Body&& body, int64_t grain = 4096) {
       grain);
 }
 
+// body(i) for every row i of a CSR matrix (row_ptr: its rows + 1 offsets), in chunks of about
+// equal entries plus rows: a matching LP's face rows, all at the end of A, hold as many entries
+// as its closedness rows, so equal row counts gave one thread twice the other's work.
+template <class Body>
+void parallel_rows(const std::vector<uint32_t>& row_ptr, int threads, Body&& body) {
+  const int64_t n = static_cast<int64_t>(row_ptr.size()) - 1;
+  if (n <= 0) return;
+  if (threads <= 0) threads = hardware_threads();
+  const int64_t total = int64_t(row_ptr[n]) + n;
+  threads = static_cast<int>(std::max<int64_t>(1, std::min<int64_t>(threads, total / 16384 + 1)));
+  std::vector<int64_t> cut(threads + 1, n);
+  cut[0] = 0;
+  for (int t = 1; t < threads; ++t) {  // the first row whose offset reaches t/threads of the total
+    const int64_t target = total * t / threads;
+    int64_t lo = cut[t - 1], hi = n;
+    while (lo < hi) {
+      const int64_t mid = lo + (hi - lo) / 2;
+      if (int64_t(row_ptr[mid]) + mid < target) lo = mid + 1; else hi = mid;
+    }
+    cut[t] = lo;
+  }
+  parallel_chunks(
+      threads, threads,
+      [&](int64_t b, int64_t e, int) {
+        for (int64_t c = b; c < e; ++c)
+          for (int64_t i = cut[c]; i < cut[c + 1]; ++i) body(i);
+      },
+      1);
+}
+
 // Sorts [first, first + n) like std::sort (for a total order: the same result): chunks sorted in
 // parallel, then merged pairwise, the merges of each round in parallel too.
 template <class T>

@@ -17,6 +17,17 @@
 namespace shapematch {
 namespace {
 
+// r_i /= √row_i and d_j /= √col_j where positive.
+void rescale(std::vector<double>& r, const std::vector<double>& row, std::vector<double>& d,
+             const std::vector<double>& col, int threads) {
+  detail::parallel_for(int64_t(r.size()), threads, [&](int64_t i) {
+    if (row[i] > 0) r[i] /= std::sqrt(row[i]);
+  });
+  detail::parallel_for(int64_t(d.size()), threads, [&](int64_t j) {
+    if (col[j] > 0) d[j] /= std::sqrt(col[j]);
+  });
+}
+
 // Ruiz equilibration then Pock–Chambolle (α = 1) scaling of A, kept as two diagonal vectors.
 // Rows and columns are independent, so the loops run in parallel with the same result.
 void compute_scaling(const LpProblem& p, int ruiz_iterations, int threads, std::vector<double>& r,
@@ -27,7 +38,7 @@ void compute_scaling(const LpProblem& p, int ruiz_iterations, int threads, std::
   std::vector<double> row(m), col(n);
   for (int it = 0; it < ruiz_iterations; ++it) {
     // |Ã_ij| = r_i d_j: infinity norms of rows and columns.
-    detail::parallel_for(m, threads, [&](int64_t i) {
+    detail::parallel_rows(p.a.row_ptr, threads, [&](int64_t i) {
       double mx = 0.0;
       for (uint32_t k = p.a.row_ptr[i]; k < p.a.row_ptr[i + 1]; ++k) mx = std::max(mx, d[col_of(p.a.entry[k])]);
       row[i] = r[i] * mx;
@@ -37,12 +48,9 @@ void compute_scaling(const LpProblem& p, int ruiz_iterations, int threads, std::
       for (uint32_t k = p.at.row_ptr[j]; k < p.at.row_ptr[j + 1]; ++k) mx = std::max(mx, r[col_of(p.at.entry[k])]);
       col[j] = d[j] * mx;
     });
-    for (int64_t i = 0; i < m; ++i)
-      if (row[i] > 0) r[i] /= std::sqrt(row[i]);
-    for (int64_t j = 0; j < n; ++j)
-      if (col[j] > 0) d[j] /= std::sqrt(col[j]);
+    rescale(r, row, d, col, threads);
   }
-  detail::parallel_for(m, threads, [&](int64_t i) {
+  detail::parallel_rows(p.a.row_ptr, threads, [&](int64_t i) {
     double s = 0.0;
     for (uint32_t k = p.a.row_ptr[i]; k < p.a.row_ptr[i + 1]; ++k) s += d[col_of(p.a.entry[k])];
     row[i] = r[i] * s;
@@ -52,10 +60,7 @@ void compute_scaling(const LpProblem& p, int ruiz_iterations, int threads, std::
     for (uint32_t k = p.at.row_ptr[j]; k < p.at.row_ptr[j + 1]; ++k) s += r[col_of(p.at.entry[k])];
     col[j] = d[j] * s;
   });
-  for (int64_t i = 0; i < m; ++i)
-    if (row[i] > 0) r[i] /= std::sqrt(row[i]);
-  for (int64_t j = 0; j < n; ++j)
-    if (col[j] > 0) d[j] /= std::sqrt(col[j]);
+  rescale(r, row, d, col, threads);
 }
 
 // A row whose achievable range over the box excludes b_i proves infeasibility at once

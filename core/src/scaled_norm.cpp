@@ -53,7 +53,7 @@ NormEstimate scaled_norm(const SignedCsr& a, const SignedCsr& at, const std::vec
   std::vector<double> alpha, beta;
   double b = 0.0;
   for (int step = 0; step < max_steps; ++step) {
-    parallel_for(m, threads, [&](int64_t i) {
+    parallel_rows(a.row_ptr, threads, [&](int64_t i) {
       double s = 0.0;
       for (uint32_t k = a.row_ptr[i]; k < a.row_ptr[i + 1]; ++k) s += signed_value(a.entry[k], dv.data());
       ru[i] = r[i] * (r[i] * s);
