@@ -120,7 +120,9 @@ Pricing price_wider_space(const MatchingLp& m, std::vector<ProductTriangle> wide
   // The low tail over the kept columns the iterate leaves at 0, those propagation fixed included
   // (they make it: see above).
   std::vector<double> kept(m.lp.cols());
-  detail::parallel_for(m.lp.cols(), 0, [&](int64_t j) { kept[j] = reduced_cost(m.lp, j, y); });
+  detail::parallel_for(m.lp.cols(), 0, [&](int64_t j) {
+    if (x[j] < 1e-6) kept[j] = reduced_cost(m.lp, j, y);
+  });
   size_t n_kept = 0;
   for (int64_t j = 0; j < m.lp.cols(); ++j)
     if (x[j] < 1e-6) kept[n_kept++] = kept[j];

@@ -39,7 +39,7 @@ public:
     s_.free_pos.assign(lp.rows(), 0);
     s_.free_neg.assign(lp.rows(), 0);
     // Rows are independent: counted in parallel (a fixer is built for every propagation pass,
-    // and at full resolution a pass over 50 M entries is where the time went).
+    // and reads every entry of A).
     detail::parallel_rows(lp.a.row_ptr, 0, [&](int64_t i) {
       s_.rhs[i] = std::llround(lp.b[i]);
       for (uint32_t k = lp.a.row_ptr[i]; k < lp.a.row_ptr[i + 1]; ++k)
