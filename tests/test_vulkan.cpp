@@ -112,22 +112,19 @@ TEST_CASE("Vulkan: contexts made one after another share the process's instance"
   }
   CHECK(vk::shared_instance() == instance);
 
-  // A forked child (bench lp solves in one) must not use the parent's instance: it makes its own.
+  // A child forked after Vulkan was initialised must refuse before any driver call (drivers do
+  // not support it, and on NVIDIA the attempt broke the parent's next device), and the parent
+  // must go on working.
   const pid_t pid = fork();
   REQUIRE(pid >= 0);
   if (pid == 0) {
-    int code = 0;
+    int code = 2;  // 2: the parent's instance came back, 3: some other exception
     try {
-      if (vk::shared_instance() == instance) {
-        code = 2;
-      } else {
-        vk::Context context;
-        const std::vector<uint32_t> words{7, 8, 9};
-        const vk::Buffer buffer = context.upload(std::span<const uint32_t>(words));
-        if (context.download<uint32_t>(buffer, words.size()) != words) code = 3;
-      }
+      vk::shared_instance();
+    } catch (const DeviceError&) {
+      code = 0;
     } catch (...) {
-      code = 4;
+      code = 3;
     }
     _exit(code);
   }
@@ -135,8 +132,11 @@ TEST_CASE("Vulkan: contexts made one after another share the process's instance"
   while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
   }
   REQUIRE(WIFEXITED(status));
-  CHECK(WEXITSTATUS(status) == 0);  // 2: the parent's instance, 3: wrong data, 4: an exception
+  CHECK(WEXITSTATUS(status) == 0);
   CHECK(vk::shared_instance() == instance);
+  vk::Context after;
+  const std::vector<uint32_t> words{4, 5, 6};
+  CHECK(after.download<uint32_t>(after.upload(std::span<const uint32_t>(words)), words.size()) == words);
 }
 
 TEST_CASE("Vulkan: dispatch grid stays within the workgroup count limits") {

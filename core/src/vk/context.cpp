@@ -103,19 +103,25 @@ Instance create_instance() {
 
 VkInstance shared_instance() {
   static std::mutex mutex;
-  static Instance instance;
+  // Never destroyed: on NVIDIA's driver (H100, 580.159) vkDestroyInstance from a static
+  // destructor at exit crashed every process that had used Vulkan (segfault after its output
+  // was written), since the driver's own state is torn down first. The OS reclaims it.
+  static VkInstance instance = VK_NULL_HANDLE;
   static pid_t owner = 0;
   const std::lock_guard<std::mutex> lock(mutex);
-  if (instance.get() && owner != getpid()) {
-    // A forked child inherits the handle but not the driver's threads and files behind it: it
-    // makes its own and leaves the parent's alone (destroying it here would be just as invalid).
-    instance.release();
+  if (instance != VK_NULL_HANDLE && owner != getpid()) {
+    // A forked child shares the parent's driver state (mappings, files) but not its threads.
+    // Drivers do not support Vulkan there: on NVIDIA a child that made its own instance got an
+    // error and left the parent's next vkCreateDevice failing with VK_ERROR_DEVICE_LOST. So the
+    // child refuses before any driver call; fork before the first Vulkan call instead.
+    throw DeviceError("Vulkan cannot be used in a process forked after Vulkan was initialised; "
+                      "fork before the first Vulkan call");
   }
-  if (!instance.get()) {
-    instance = create_instance();  // a failure throws and is tried again at the next call
+  if (instance == VK_NULL_HANDLE) {
+    instance = create_instance().release();  // a failure throws and is tried again at the next call
     owner = getpid();
   }
-  return instance.get();
+  return instance;
 }
 
 std::vector<PhysicalDevice> compute_devices(VkInstance instance) {

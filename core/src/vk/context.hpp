@@ -41,8 +41,9 @@ struct PhysicalDevice {
 // went wrong after repeated create/destroy cycles in one process: seen on an H100 (driver
 // 580.159), vkCreateInstance failed with VK_ERROR_INCOMPATIBLE_DRIVER after some dozens of
 // LP solves, each of which had made and destroyed its own instance; others report subgroup
-// builtins corrupted after ~11 cycles. Devices are still made per Context. A forked child gets
-// an instance of its own (bench lp solves in forked children).
+// builtins corrupted after ~11 cycles. Devices are still made per Context. It is never destroyed
+// (destroying it at exit crashed on NVIDIA). A process forked after the first call gets a
+// DeviceError here: bench lp forks its solver children before any Vulkan call.
 VkInstance shared_instance();
 std::vector<PhysicalDevice> compute_devices(VkInstance instance);
 // Index into devices: requested_index if valid, else (for < 0) discrete > integrated >
