@@ -61,6 +61,7 @@ struct MatchArgs {
   int price_widenings = CoarseToFineOptions{}.price_widenings;
   int lookahead_levels = CoarseToFineOptions{}.lookahead_levels;
   double price_threshold = CoarseToFineOptions{}.price_threshold;
+  double price_tolerance = CoarseToFineOptions{}.price_tolerance;
 };
 
 // auto: a GPU if there is one, else the native solver (lavapipe is for testing, not speed).
@@ -131,6 +132,7 @@ int run_match(const MatchArgs& args) {
   co.price_widenings = args.price_widenings;
   co.lookahead_levels = args.lookahead_levels;
   co.price_threshold = args.price_threshold;
+  co.price_tolerance = args.price_tolerance;
   co.matching = matching_options(args.pair, p);
   RoundingOptions& ro = co.rounding;
   ro.solver = solver_for(args);
@@ -335,7 +337,8 @@ int run_match(const MatchArgs& args) {
                               .set("stuck_carry", args.stuck_carry)
                               .set("stuck_stalled", args.stuck_stalled)
                               .set("price_widenings", args.price_widenings)
-                              .set("price_threshold", args.price_threshold));
+                              .set("price_threshold", args.price_threshold)
+                              .set("price_tolerance", args.price_tolerance));
     report.set("seconds", seconds);
     report.set("peak_rss_mb", peak_rss_mb());
     report.set("round_log", rounds);
@@ -520,6 +523,10 @@ Action add_match_command(CLI::App& app) {
                  "after a refined level's first LP, price the columns one ring out against its dual and widen the X "
                  "faces of those below zero, up to this many times per level, before rounding (0: off)")
       ->check(CLI::Range(0, 16))
+      ->capture_default_str();
+  app.add_option("--price-tolerance", a->price_tolerance,
+                 "price the wider space at this looser LP tolerance, then solve on (0: price the optimum)")
+      ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   app.add_option("--price-threshold", a->price_threshold,
                  "with --price-widenings: how far below zero (energy units) a column's reduced cost must be")

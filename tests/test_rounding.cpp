@@ -194,6 +194,52 @@ TEST_CASE("rounding: round 1 starts from a warm start over the whole LP and hand
   CHECK(warm.first_lp.lower_bound == doctest::Approx(cold.first_lp.lower_bound).epsilon(1e-2));
 }
 
+TEST_CASE("rounding: round 1 probed at a looser tolerance hands that iterate out, then goes on to its own") {
+  const MatchingLp& m = dolphins_60();
+  auto residual = [&](const std::vector<double>& x) {
+    std::vector<double> ax(m.lp.rows(), 0.0);
+    for (int64_t j = 0; j < m.lp.cols(); ++j)
+      for (uint32_t k = m.lp.at.row_ptr[j]; k < m.lp.at.row_ptr[j + 1]; ++k)
+        ax[col_of(m.lp.at.entry[k])] += (is_negative(m.lp.at.entry[k]) ? -1.0 : 1.0) * x[j];
+    double r = 0.0;
+    for (int64_t i = 0; i < m.lp.rows(); ++i) r = std::max(r, std::abs(ax[i] - m.lp.b[i]));
+    return r;
+  };
+  RoundingOptions o;
+  o.solver = "pdhg-cpu";
+  o.lp.tolerance = 1e-5;
+  const RoundingResult plain = round_to_graph_surface(m.space, m.lp, m.energy, o);
+  REQUIRE(plain.first_lp.status == LpStatus::Optimal);
+
+  std::vector<double> probe_x, final_x;
+  int probes = 0;
+  o.probe_tolerance = 1e-2;
+  o.probe = [&](const std::vector<double>& x, const std::vector<double>& y, double) {
+    CHECK(y.size() == size_t(m.lp.rows()));
+    probe_x = x;
+    ++probes;
+  };
+  o.first_iterate = [&](const std::vector<double>& x, const std::vector<double>&, double) { final_x = x; };
+  const RoundingResult probed = round_to_graph_surface(m.space, m.lp, m.energy, o);
+  CHECK(probes == 1);
+  REQUIRE(probe_x.size() == size_t(m.lp.cols()));
+  REQUIRE(final_x.size() == size_t(m.lp.cols()));
+  MESSAGE("max |Ax - b|: probe ", residual(probe_x), ", round 1 ", residual(final_x), "; round 1 iterations ",
+          probed.first_lp.iterations, " against ", plain.first_lp.iterations, " unprobed");
+  CHECK(residual(final_x) < 0.5 * residual(probe_x));  // it went on past the probe
+  CHECK(probed.first_lp.status == LpStatus::Optimal);
+  CHECK(probed.first_lp.lower_bound == doctest::Approx(plain.first_lp.lower_bound).epsilon(1e-3));
+  CHECK(satisfies_exactly(m.lp, probed.gamma));
+  CHECK(check_graph_surface(m.space, probed.gamma).covers_x);
+
+  // The probe may abandon the rounding; one not looser than the LP's own is never called.
+  struct Abandon {};
+  o.probe = [](const std::vector<double>&, const std::vector<double>&, double) { throw Abandon{}; };
+  CHECK_THROWS_AS(round_to_graph_surface(m.space, m.lp, m.energy, o), Abandon);
+  o.probe_tolerance = o.lp.tolerance;
+  CHECK_NOTHROW(round_to_graph_surface(m.space, m.lp, m.energy, o));
+}
+
 TEST_CASE("rounding: round 1 stops at its own cap, rounds from its iterate, and its bound stays below the optimum") {
   const MatchingLp& m = dolphins_60();
   RoundingOptions o;

@@ -1161,8 +1161,37 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
     }
     if (!after_fixing && options.first_max_iterations > 0)
       params.max_iterations = std::min(params.max_iterations, options.first_max_iterations);
+    // An iterate of red.lp over the whole LP: fixed variables at their values.
+    auto full_x = [&](const std::vector<double>& reduced) {
+      std::vector<double> x(lp.cols());
+      for (int64_t j = 0; j < lp.cols(); ++j) x[j] = fixer.state().value[j] == 1 ? 1.0 : 0.0;
+      for (size_t j = 0; j < red.cols.size(); ++j) x[red.cols[j]] = reduced[j];
+      return x;
+    };
     JoinedSolve joined;
-    if (!after_fixing) {
+    if (!after_fixing && options.probe && options.probe_tolerance > params.tolerance) {
+      SolverParams loose = params;
+      loose.tolerance = options.probe_tolerance;
+      LpResult p = solver->solve(red.lp, loose);
+      if (p.status == LpStatus::Optimal && p.x.size() == red.cols.size() && p.y.size() == red.rows.size()) {
+        std::vector<double> y(lp.rows(), 0.0);
+        for (size_t i = 0; i < red.rows.size(); ++i) y[red.rows[i]] = p.y[i];
+        options.probe(full_x(p.x), y, p.primal_weight);
+        params.initial_x = std::move(p.x);
+        params.initial_y = std::move(p.y);
+        if (std::isfinite(p.primal_weight) && p.primal_weight > 0.0) params.initial_primal_weight = p.primal_weight;
+        params.max_iterations = std::max<int64_t>(params.max_iterations - p.iterations, 1);
+        params.time_limit -= p.seconds;
+        const int64_t probed = p.iterations;
+        const double probe_seconds = p.seconds;
+        joined.r = solver->solve(red.lp, params);
+        joined.r.iterations += probed;
+        joined.r.seconds += probe_seconds;
+      } else {
+        joined.r = std::move(p);
+      }
+      if (joined.r.status == LpStatus::Infeasible) joined.proof = joined.r.y;
+    } else if (!after_fixing) {
       joined.r = solver->solve(red.lp, params);
       if (joined.r.status == LpStatus::Infeasible) joined.proof = joined.r.y;
     } else {
@@ -1171,9 +1200,7 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
     }
     const LpResult& r = joined.r;
     if (round == 1 && options.first_iterate && r.x.size() == red.cols.size()) {
-      std::vector<double> x(lp.cols()), y(lp.rows(), 0.0);
-      for (int64_t j = 0; j < lp.cols(); ++j) x[j] = fixer.state().value[j] == 1 ? 1.0 : 0.0;
-      for (size_t j = 0; j < red.cols.size(); ++j) x[red.cols[j]] = r.x[j];
+      std::vector<double> x = full_x(r.x), y(lp.rows(), 0.0);
       const bool diverged = r.status == LpStatus::Diverging;
       const std::vector<double>& dual = diverged ? r.last_y : r.y;
       double growth = 0.0;

@@ -130,6 +130,14 @@ struct RoundingOptions {
   // Not called after a proven infeasible LP (no iterate).
   // `primal_weight`: the solver's ω where it stopped (LpResult::primal_weight; NaN if none).
   std::function<void(const std::vector<double>& x, const std::vector<double>& y, double primal_weight)> first_iterate;
+  // Where probe_tolerance is above lp.tolerance and `probe` is set, round 1's LP is solved first
+  // to probe_tolerance and `probe` gets that iterate (over the whole LP, as first_iterate's) if it
+  // was optimal there; it may throw to abandon the rounding (coarse to fine prices a wider space
+  // with it). The solve then goes on from that iterate and its primal weight to lp.tolerance;
+  // round 1 reports both solves' iterations. A probe that ends otherwise (diverging, infeasible,
+  // at a limit) is round 1's result.
+  double probe_tolerance = 0.0;
+  std::function<void(const std::vector<double>& x, const std::vector<double>& y, double primal_weight)> probe;
 };
 
 struct RoundingRound {
