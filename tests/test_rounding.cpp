@@ -23,6 +23,17 @@ const MatchingLp& dolphins_60() {
   return m;
 }
 
+// max |A x − b| over the whole LP.
+double max_residual(const LpProblem& lp, const std::vector<double>& x) {
+  std::vector<double> ax(lp.rows(), 0.0);
+  for (int64_t j = 0; j < lp.cols(); ++j)
+    for (uint32_t k = lp.at.row_ptr[j]; k < lp.at.row_ptr[j + 1]; ++k)
+      ax[col_of(lp.at.entry[k])] += (is_negative(lp.at.entry[k]) ? -1.0 : 1.0) * x[j];
+  double r = 0.0;
+  for (int64_t i = 0; i < lp.rows(); ++i) r = std::max(r, std::abs(ax[i] - lp.b[i]));
+  return r;
+}
+
 }  // namespace
 
 TEST_CASE("rounding: a mesh against itself rounds to the identity with zero gap") {
@@ -176,14 +187,7 @@ TEST_CASE("rounding: round 1 starts from a warm start over the whole LP and hand
   CHECK(calls == 1);
   REQUIRE(x0.size() == size_t(m.lp.cols()));
   REQUIRE(y0.size() == size_t(m.lp.rows()));
-  // Over the whole LP: A x ≈ b (the fixed part included).
-  std::vector<double> ax(m.lp.rows(), 0.0);
-  for (int64_t j = 0; j < m.lp.cols(); ++j)
-    for (uint32_t k = m.lp.at.row_ptr[j]; k < m.lp.at.row_ptr[j + 1]; ++k)
-      ax[col_of(m.lp.at.entry[k])] += (is_negative(m.lp.at.entry[k]) ? -1.0 : 1.0) * x0[j];
-  double residual = 0.0;
-  for (int64_t i = 0; i < m.lp.rows(); ++i) residual = std::max(residual, std::abs(ax[i] - m.lp.b[i]));
-  CHECK(residual < 0.05);
+  CHECK(max_residual(m.lp, x0) < 0.05);  // over the whole LP, the fixed part included
   o.first_iterate = {};
   o.lp.initial_x = x0;
   o.lp.initial_y = y0;
@@ -196,15 +200,6 @@ TEST_CASE("rounding: round 1 starts from a warm start over the whole LP and hand
 
 TEST_CASE("rounding: round 1 probed at a looser tolerance hands that iterate out, then goes on to its own") {
   const MatchingLp& m = dolphins_60();
-  auto residual = [&](const std::vector<double>& x) {
-    std::vector<double> ax(m.lp.rows(), 0.0);
-    for (int64_t j = 0; j < m.lp.cols(); ++j)
-      for (uint32_t k = m.lp.at.row_ptr[j]; k < m.lp.at.row_ptr[j + 1]; ++k)
-        ax[col_of(m.lp.at.entry[k])] += (is_negative(m.lp.at.entry[k]) ? -1.0 : 1.0) * x[j];
-    double r = 0.0;
-    for (int64_t i = 0; i < m.lp.rows(); ++i) r = std::max(r, std::abs(ax[i] - m.lp.b[i]));
-    return r;
-  };
   RoundingOptions o;
   o.solver = "pdhg-cpu";
   o.lp.tolerance = 1e-5;
@@ -224,9 +219,10 @@ TEST_CASE("rounding: round 1 probed at a looser tolerance hands that iterate out
   CHECK(probes == 1);
   REQUIRE(probe_x.size() == size_t(m.lp.cols()));
   REQUIRE(final_x.size() == size_t(m.lp.cols()));
-  MESSAGE("max |Ax - b|: probe ", residual(probe_x), ", round 1 ", residual(final_x), "; round 1 iterations ",
+  MESSAGE("max |Ax - b|: probe ", max_residual(m.lp, probe_x), ", round 1 ", max_residual(m.lp, final_x),
+          "; round 1 iterations ",
           probed.first_lp.iterations, " against ", plain.first_lp.iterations, " unprobed");
-  CHECK(residual(final_x) < 0.5 * residual(probe_x));  // it went on past the probe
+  CHECK(max_residual(m.lp, final_x) < 0.5 * max_residual(m.lp, probe_x));  // it went on past the probe
   CHECK(probed.first_lp.status == LpStatus::Optimal);
   CHECK(probed.first_lp.lower_bound == doctest::Approx(plain.first_lp.lower_bound).epsilon(1e-3));
   CHECK(satisfies_exactly(m.lp, probed.gamma));
