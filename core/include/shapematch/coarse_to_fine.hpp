@@ -93,7 +93,9 @@ struct CoarseToFineOptions {
   // an LP (at full resolution a diverging first LP takes 55-215 s). 0: off. Measured at 1,
   // FAUST_r 026-029 at full resolution (with price_dual_sweeps 4): 2 524 of 9 998 faces started
   // widened at the finest level, which still diverged once; 814 s against 623 s, but energy 17.71
-  // against 24.67 and error 0.0213 against 0.0265 (one pair: not yet the default).
+  // against 24.67 and error 0.0213 against 0.0265 (one pair: not yet the default). Again without
+  // the sweeps (twentieth session, 2 cores): 15:41 against 9:21, energy 18.85, error 0.0214; on
+  // an H100 it took 016-026 (which the defaults never finished) to the end in 5.2 minutes.
   int inherit_widening = 0;
   // Fine rings of X faces around the proof that widen with it. Measured: 4 kept 021-029 at 1000
   // faces slightly closer to the global widening (error 0.065 against 0.070 at 0, 25 s against
