@@ -2,9 +2,13 @@
 #include "shapematch/shapes.hpp"
 #include "test_helpers.hpp"
 
+#include "sorted_index.hpp"
+
 #include <doctest/doctest.h>
 
 #include <algorithm>
+#include <limits>
+#include <random>
 #include <filesystem>
 #include <numeric>
 
@@ -130,3 +134,30 @@ TEST_CASE("constraints: a reduced space drops untouched closedness rows") {
   std::iota(cols.begin(), cols.end(), 0);
   CHECK(satisfies(cs, cols));
 }
+
+TEST_CASE("constraints: the sorted index ranks every key as lower_bound does") {
+  std::mt19937_64 rng(7);
+  for (const int64_t n : {0, 1, 2, 17, 1000, 100000}) {
+    for (const int64_t span : {int64_t(1), int64_t(3), int64_t(1) << 20, int64_t(1) << 40}) {
+      // Distinct keys with gaps of 1..span, 0 among them when n > 0, some clustered at the top.
+      std::vector<int64_t> keys;
+      int64_t k = 0;
+      for (int64_t i = 0; i < n; ++i) {
+        keys.push_back(k);
+        k += i > n - n / 8 ? 1 : 1 + int64_t(rng() % uint64_t(span));
+      }
+      const detail::SortedIndex index(keys);
+      const int64_t top = keys.empty() ? 0 : keys.back();
+      auto check = [&](int64_t q) {
+        const int64_t want = std::lower_bound(keys.begin(), keys.end(), q) - keys.begin();
+        if (index.rank(q) != want) FAIL_CHECK("n ", n, " span ", span, " key ", q, ": ", index.rank(q), " not ", want);
+      };
+      for (int64_t key : keys) check(key);
+      for (int i = 0; i < 2000; ++i) check(int64_t(rng() % uint64_t(top + 2)));
+      check(-1);
+      check(top + 1);
+      check(std::numeric_limits<int64_t>::max());
+    }
+  }
+}
+

@@ -2,6 +2,7 @@
 
 #include "parallel.hpp"
 #include "shapematch/errors.hpp"
+#include "sorted_index.hpp"
 
 #include <algorithm>
 
@@ -92,10 +93,8 @@ ConstraintSystem build_constraints(const ProductSpace& space) {
   const int64_t m = cs.closedness_rows + X.num_faces() + Y.num_faces();
   if (m >= (int64_t(1) << 31)) throw InvalidInputError("too many constraints: " + std::to_string(m));
   if (!space.is_full()) {
-    detail::parallel_for(3 * n, 0, [&](int64_t k) {
-      edge_row[k] = static_cast<uint32_t>(
-          std::lower_bound(cs.row_edge.begin(), cs.row_edge.end(), edge_id[k]) - cs.row_edge.begin());
-    });
+    const detail::SortedIndex index(cs.row_edge);
+    detail::parallel_for(3 * n, 0, [&](int64_t k) { edge_row[k] = static_cast<uint32_t>(index.rank(edge_id[k])); });
   } else {
     for (int64_t k = 0; k < 3 * n; ++k) edge_row[k] = static_cast<uint32_t>(edge_id[k]);
   }
