@@ -846,14 +846,18 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
       price_warm = false;
       const bool pricing = l > 0 && !carrying && priced < options_.price_widenings && options_.local_widening &&
                            local < options_.max_local_widenings;
+      // The iterate pricing reads (and a widening it calls for starts from).
+      auto keep_for_pricing = [&](const std::vector<double>& x, const std::vector<double>& y, double omega) {
+        first_x = x;
+        first_y = y;
+        first_omega = options_.carry_primal_weight ? omega : 0.0;
+      };
       // Price at a looser tolerance first (price_tolerance); the LP goes on to its own after.
       const bool probing = pricing && options_.price_tolerance > ro.lp.tolerance;
       if (probing) {
         ro.probe_tolerance = options_.price_tolerance;
         ro.probe = [&](const std::vector<double>& x, const std::vector<double>& y, double omega) {
-          first_x = x;
-          first_y = y;
-          first_omega = options_.carry_primal_weight ? omega : 0.0;
+          keep_for_pricing(x, y, omega);
           if (price_and_widen(m)) throw PricedWider{};
           first_x = {};
           first_y = {};
@@ -862,14 +866,10 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
       const bool may_carry = options_.stuck_after > 0.0 && options_.stuck_carry;
       if (l > 0 && (options_.warm_widening || may_carry || pricing) && !carrying)
         ro.first_iterate = [&](const std::vector<double>& x, const std::vector<double>& y, double omega) {
+          if (pricing && !probing) keep_for_pricing(x, y, omega);
           if (!options_.carry_primal_weight) omega = 0.0;
           if (options_.warm_widening) warm.keep(m, x, y, omega);
           if (may_carry) first.keep(m, x, y, omega);
-          if (pricing && !probing) {
-            first_x = x;
-            first_y = y;
-            first_omega = omega;
-          }
         };
       if (carrying) {
         std::sort(carried_ones.begin(), carried_ones.end());

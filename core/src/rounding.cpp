@@ -1169,30 +1169,29 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
       return x;
     };
     JoinedSolve joined;
-    if (!after_fixing && options.probe && options.probe_tolerance > params.tolerance) {
-      SolverParams loose = params;
-      loose.tolerance = options.probe_tolerance;
-      LpResult p = solver->solve(red.lp, loose);
-      if (p.status == LpStatus::Optimal && p.x.size() == red.cols.size() && p.y.size() == red.rows.size()) {
-        std::vector<double> y(lp.rows(), 0.0);
-        for (size_t i = 0; i < red.rows.size(); ++i) y[red.rows[i]] = p.y[i];
-        options.probe(full_x(p.x), y, p.primal_weight);
-        params.initial_x = std::move(p.x);
-        params.initial_y = std::move(p.y);
-        if (std::isfinite(p.primal_weight) && p.primal_weight > 0.0) params.initial_primal_weight = p.primal_weight;
-        params.max_iterations = std::max<int64_t>(params.max_iterations - p.iterations, 1);
-        params.time_limit -= p.seconds;
-        const int64_t probed = p.iterations;
-        const double probe_seconds = p.seconds;
-        joined.r = solver->solve(red.lp, params);
-        joined.r.iterations += probed;
-        joined.r.seconds += probe_seconds;
+    if (!after_fixing) {
+      if (options.probe && options.probe_tolerance > params.tolerance) {
+        SolverParams loose = params;
+        loose.tolerance = options.probe_tolerance;
+        LpResult p = solver->solve(red.lp, loose);
+        if (p.status == LpStatus::Optimal && p.x.size() == red.cols.size() && p.y.size() == red.rows.size()) {
+          std::vector<double> y(lp.rows(), 0.0);
+          for (size_t i = 0; i < red.rows.size(); ++i) y[red.rows[i]] = p.y[i];
+          options.probe(full_x(p.x), y, p.primal_weight);
+          params.initial_x = std::move(p.x);
+          params.initial_y = std::move(p.y);
+          if (std::isfinite(p.primal_weight) && p.primal_weight > 0.0) params.initial_primal_weight = p.primal_weight;
+          params.max_iterations = std::max<int64_t>(params.max_iterations - p.iterations, 1);
+          params.time_limit -= p.seconds;
+          joined.r = solver->solve(red.lp, params);
+          joined.r.iterations += p.iterations;
+          joined.r.seconds += p.seconds;
+        } else {
+          joined.r = std::move(p);
+        }
       } else {
-        joined.r = std::move(p);
+        joined.r = solver->solve(red.lp, params);
       }
-      if (joined.r.status == LpStatus::Infeasible) joined.proof = joined.r.y;
-    } else if (!after_fixing) {
-      joined.r = solver->solve(red.lp, params);
       if (joined.r.status == LpStatus::Infeasible) joined.proof = joined.r.y;
     } else {
       joined = detail::solve_in_parts(red.lp, std::move(params), *solver, exact ? exact_solver.get() : nullptr,

@@ -9,7 +9,8 @@ namespace shapematch::detail {
 
 // A table over the keys' high bits points into the sorted array, so a lookup searches a bucket
 // of about one key: a cache miss or two where a binary search over 100+ MB cost some twenty
-// dependent ones. rank(k) is std::lower_bound's position of k.
+// dependent ones. rank(k) is std::lower_bound's position of k. The array must outlive the index
+// and hold fewer than 2^32 keys (positions are 32-bit).
 class SortedIndex {
 public:
   explicit SortedIndex(const std::vector<int64_t>& sorted) : keys_(sorted) {
@@ -17,7 +18,7 @@ public:
     const uint64_t top = n > 0 ? static_cast<uint64_t>(std::max<int64_t>(sorted.back(), 0)) : 0;
     while ((top >> shift_) > static_cast<uint64_t>(std::max<int64_t>(n, 1))) ++shift_;
     const uint64_t buckets = (top >> shift_) + 1;
-    begin_.assign(buckets + 1, static_cast<uint32_t>(n));
+    begin_.resize(buckets + 1);
     // begin_[b]: the first position whose key's bucket is b or above.
     int64_t i = 0;
     for (uint64_t b = 0; b <= buckets; ++b) {
