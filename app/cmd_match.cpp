@@ -29,6 +29,8 @@ struct MatchArgs {
   std::string out = "shapematch-out";
   std::string backend = "auto";
   double threshold = 0.5;
+  std::vector<double> alternative_thresholds = RoundingOptions{}.alternative_thresholds;
+  int64_t alternatives_below = RoundingOptions{}.alternatives_below;
   int max_rounds = 50;
   double later_round_iterations = RoundingOptions{}.later_round_iterations;
   double fractional_batch = RoundingOptions{}.fractional_batch;
@@ -137,6 +139,8 @@ int run_match(const MatchArgs& args) {
   RoundingOptions& ro = co.rounding;
   ro.solver = solver_for(args);
   ro.threshold = args.threshold;
+  ro.alternative_thresholds = args.alternative_thresholds;
+  ro.alternatives_below = args.alternatives_below;
   ro.max_rounds = args.max_rounds;
   ro.later_round_iterations = args.later_round_iterations;
   ro.fractional_batch = args.fractional_batch;
@@ -300,6 +304,12 @@ int run_match(const MatchArgs& args) {
                               .set("lame_lambda", args.pair.lame.at(0))
                               .set("lame_mu", args.pair.lame.at(1))
                               .set("threshold", args.threshold)
+                              .set("alternative_thresholds", [&] {
+                                Json a = Json::array();
+                                for (double t : args.alternative_thresholds) a.push(Json(t));
+                                return a;
+                              }())
+                              .set("alternatives_below", args.alternatives_below)
                               .set("fractional_batch", args.fractional_batch)
                               .set("later_round_iterations", args.later_round_iterations)
                               .set("close_pockets", args.close_pockets)
@@ -367,6 +377,8 @@ int run_match(const MatchArgs& args) {
                       .set("lower_bound", l.lower_bound)
                       .set("energy", l.energy)
                       .set("gap", l.gap)
+                      .set("threshold", l.threshold)
+                      .set("roundings", l.roundings)
                       .set("second_start_energy", l.second_start_energy)
                       .set("second_start_kept", l.second_start_kept)
                       .set("lookahead_other_energy", l.lookahead_other_energy)
@@ -397,6 +409,31 @@ Action add_match_command(CLI::App& app) {
   app.add_option("--device", a->device, "Vulkan device index (see `shapematch devices`)");
   app.add_option("--threshold", a->threshold, "fix LP values above this to 1")
       ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str();
+  app.add_option_function<std::string>(
+         "--alt-thresholds",
+         [a](const std::string& list) {
+           a->alternative_thresholds.clear();
+           if (list == "none") return;
+           std::stringstream in(list);
+           for (std::string item; std::getline(in, item, ',');) {
+             std::size_t used = 0;
+             double t = -1.0;
+             try {
+               t = std::stod(item, &used);
+             } catch (const std::exception&) {
+             }
+             if (used != item.size() || !(t > 0.0 && t < 1.0))
+               throw CLI::ValidationError("--alt-thresholds", "need `none` or thresholds in (0, 1) separated by commas");
+             a->alternative_thresholds.push_back(t);
+           }
+         },
+         "where a level's LP has at most --alternatives-below variables, round it again from its first LP's "
+         "optimum with each of these thresholds (comma-separated) and keep the Γ of least energy; `none`: one "
+         "rounding (default 0.7)");
+  app.add_option("--alternatives-below", a->alternatives_below,
+                 "variables of a level's LP above which it is rounded once (--alt-thresholds)")
+      ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   app.add_flag("--close-pockets", a->close_pockets,
                "replace each pocket (an edge stretched over a whole star, a tear that A x = b admits) by the star collapsed onto one vertex: continuous, but costs energy");

@@ -349,6 +349,7 @@ TEST_CASE("coarse to fine: faces whose parent was widened start widened where as
   o.max_ring = 2;
   o.price_widenings = 0;
   o.second_start = false;
+  o.rounding.alternative_thresholds = {};  // the coarsest Γ these widenings were measured on
   int widenings[2][4] = {};
   for (const int inherit : {0, 1}) {
     CAPTURE(inherit);

@@ -236,6 +236,74 @@ TEST_CASE("rounding: round 1 probed at a looser tolerance hands that iterate out
   CHECK_NOTHROW(round_to_graph_surface(m.space, m.lp, m.energy, o));
 }
 
+TEST_CASE("rounding: alternative thresholds round again from round 1's optimum and keep the Γ of least energy") {
+  // A dolphin against a bumpy ball at 60 faces: a fractional LP (the dolphins' are integral) whose
+  // roundings alone by 0.3, 0.5 and 0.7 end at three energies (measured 16.61, 16.00, 16.26).
+  std::mt19937 rng(8);
+  std::uniform_real_distribution<double> u(-0.2, 0.2);
+  const Mesh x = decimate(shapes::dolphin(0, 0), 60);
+  const Mesh y = decimate(
+      test::deformed(shapes::icosphere(2), [&](const Eigen::Vector3d& p) { return Eigen::Vector3d(p * (1 + u(rng))); }), 60);
+  const MatchingLp m = build_matching_lp(x, compute_geometry(x), y, compute_geometry(y));
+  RoundingOptions o;
+  o.solver = "pdhg-cpu";
+  o.lp.tolerance = 1e-3;
+  o.alternative_thresholds = {};
+  std::map<double, double> alone;
+  for (double t : {0.3, 0.5, 0.7}) {
+    o.threshold = t;
+    const RoundingResult r = round_to_graph_surface(m.space, m.lp, m.energy, o);
+    REQUIRE(r.tried.size() == 1);
+    CHECK(r.tried[0].first == t);
+    CHECK(r.threshold == t);
+    alone[t] = r.energy;
+  }
+  MESSAGE("energies alone: 0.3 ", alone[0.3], ", 0.5 ", alone[0.5], ", 0.7 ", alone[0.7]);
+  CHECK(alone[0.3] != alone[0.5]);  // else this pair shows nothing
+
+  o.threshold = 0.3;
+  o.alternative_thresholds = {0.5, 0.3, 0.7};  // 0.3 again is not run twice
+  int progress_calls = 0, first_iterates = 0;
+  o.first_iterate = [&](const std::vector<double>&, const std::vector<double>&, double) { ++first_iterates; };
+  const RoundingResult best =
+      round_to_graph_surface(m.space, m.lp, m.energy, o, [&](const RoundingRound&) { ++progress_calls; });
+  REQUIRE(best.tried.size() == 3);
+  CHECK(best.tried[0] == std::pair<double, double>{0.3, alone[0.3]});  // the one asked for first, as alone
+  double lowest = best.tried[0].second, at = 0.3;
+  for (const auto& [t, e] : best.tried) {
+    CHECK(std::isfinite(e));
+    if (e < lowest) lowest = e, at = t;
+  }
+  MESSAGE("with alternatives: 0.5 ", best.tried[1].second, ", 0.7 ", best.tried[2].second);
+  CHECK(best.energy == lowest);
+  CHECK(best.threshold == at);
+  CHECK(satisfies_exactly(m.lp, best.gamma));
+  const GraphSurfaceCheck g = check_graph_surface(m.space, best.gamma);
+  CHECK(g.covers_x);
+  CHECK(g.orientation);
+  double sum = 0.0;
+  for (int64_t j : best.gamma) sum += m.energy[j];
+  CHECK(sum == doctest::Approx(best.energy).epsilon(1e-12));
+  // Only the rounding asked for reports progress and hands out round 1's iterate; the bound is its
+  // round 1's (or better).
+  CHECK(first_iterates == 1);
+  o.alternative_thresholds = {};
+  o.first_iterate = {};
+  const RoundingResult plain = round_to_graph_surface(m.space, m.lp, m.energy, o);
+  CHECK(progress_calls == int(plain.rounds.size()));
+  CHECK(best.lower_bound >= plain.lower_bound);
+  CHECK(best.lower_bound <= best.energy + 1e-9);
+  // Here an alternative wins; it restarts at the optimum, so its round 1 only confirms it.
+  CHECK(best.threshold != 0.3);
+  CHECK(best.energy < alone[0.3]);
+  CHECK(best.rounds.front().iterations * 4 < plain.first_lp.iterations);
+
+  // Above alternatives_below, one rounding.
+  o.alternative_thresholds = {0.5, 0.7};
+  o.alternatives_below = m.lp.cols() - 1;
+  CHECK(round_to_graph_surface(m.space, m.lp, m.energy, o).tried.size() == 1);
+}
+
 TEST_CASE("rounding: round 1 stops at its own cap, rounds from its iterate, and its bound stays below the optimum") {
   const MatchingLp& m = dolphins_60();
   RoundingOptions o;

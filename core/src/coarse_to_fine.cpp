@@ -395,6 +395,8 @@ void accept(const MatchingLp& m, const RoundingResult& rr, LevelReport& rep, std
   rep.lower_bound = rr.lower_bound;
   rep.energy = rr.energy;
   rep.gap = rr.gap;
+  rep.threshold = rr.threshold;
+  rep.roundings = std::max<int>(1, rr.tried.size());
   gamma.clear();
   for (int64_t j : rr.gamma) gamma.push_back(m.space[j]);
 }

@@ -854,11 +854,20 @@ bool satisfies_exactly(const LpProblem& lp, const std::vector<int64_t>& gamma) {
   return true;
 }
 
-RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem& lp, const std::vector<double>& energy,
-                                      const RoundingOptions& options,
-                                      const std::function<void(const RoundingRound&)>& progress) {
-  if (static_cast<int64_t>(energy.size()) != lp.cols() || space.size() != lp.cols())
-    throw InvalidInputError("rounding: the space, the LP and the energies disagree in size");
+namespace {
+// Round 1's optimum over the whole LP, for the alternative roundings to start from.
+struct FirstOptimum {
+  std::vector<double> x, y;
+  double primal_weight = 0.0;
+  double seconds = 0.0;
+  int64_t iterations = 0;
+};
+
+// One rounding with options.threshold (round_to_graph_surface's alternatives aside); keeps round
+// 1's optimum in `keep` where it is given and round 1 ended optimal.
+RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const std::vector<double>& energy,
+                          const RoundingOptions& options, const std::function<void(const RoundingRound&)>& progress,
+                          FirstOptimum* keep) {
   auto solver = make_solver(options.solver);
   std::unique_ptr<LpSolver> exact_solver;  // for the small last rounds (exact_below)
   RoundingResult result;
@@ -1198,6 +1207,15 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
                               options.exact_below, exact_params, options.split_parts);
     }
     const LpResult& r = joined.r;
+    if (round == 1 && keep && r.status == LpStatus::Optimal && r.x.size() == red.cols.size() &&
+        r.y.size() == red.rows.size()) {
+      keep->x = full_x(r.x);
+      keep->y.assign(lp.rows(), 0.0);
+      for (size_t i = 0; i < red.rows.size(); ++i) keep->y[red.rows[i]] = r.y[i];
+      keep->primal_weight = std::isfinite(r.primal_weight) ? r.primal_weight : 0.0;
+      keep->seconds = clock.seconds();
+      keep->iterations = r.iterations;
+    }
     if (round == 1 && options.first_iterate && r.x.size() == red.cols.size()) {
       std::vector<double> x = full_x(r.x), y(lp.rows(), 0.0);
       const bool diverged = r.status == LpStatus::Diverging;
@@ -1389,7 +1407,58 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
   else if (options.start_dual.size() == size_t(lp.rows())) result.lower_bound = certified_lower_bound(lp, options.start_dual);
   else result.lower_bound = -std::numeric_limits<double>::infinity();
   result.gap = relative_gap(result.energy, result.lower_bound);
+  result.threshold = options.threshold;
   return result;
+}
+}  // namespace
+
+RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem& lp, const std::vector<double>& energy,
+                                      const RoundingOptions& options,
+                                      const std::function<void(const RoundingRound&)>& progress) {
+  if (static_cast<int64_t>(energy.size()) != lp.cols() || space.size() != lp.cols())
+    throw InvalidInputError("rounding: the space, the LP and the energies disagree in size");
+  const bool alternatives =
+      !options.alternative_thresholds.empty() && options.start_ones.empty() && lp.cols() <= options.alternatives_below;
+  FirstOptimum first;
+  RoundingResult best = round_once(space, lp, energy, options, progress, alternatives ? &first : nullptr);
+  best.tried.push_back({options.threshold, best.energy});
+  if (first.x.empty()) return best;  // no alternatives, or round 1 not optimal (nothing to restart from)
+  for (double t : options.alternative_thresholds) {
+    if (std::any_of(best.tried.begin(), best.tried.end(), [&](const auto& p) { return p.first == t; })) continue;
+    RoundingOptions alt = options;
+    alt.threshold = t;
+    alt.alternative_thresholds.clear();
+    alt.first_iterate = {};
+    alt.probe = {};
+    alt.probe_tolerance = 0.0;
+    alt.first_max_iterations = 0;
+    alt.lp.initial_x = first.x;  // round 1 starts at its optimum: it only confirms it
+    alt.lp.initial_y = first.y;
+    alt.lp.initial_primal_weight = first.primal_weight;
+    alt.reference_seconds = first.seconds;  // the later rounds' caps and the stuck rule as the first's
+    alt.reference_iterations = first.iterations;
+    Stopwatch clock;
+    try {
+      RoundingResult r = round_once(space, lp, energy, alt, {}, nullptr);
+      const bool lower = r.energy < best.energy;
+      spdlog::info("rounding: threshold {} gives energy {:.6g} in {} rounds ({:.2f} s) against {:.6g} with {}{}", t,
+                   r.energy, r.rounds.size(), clock.seconds(), best.energy, best.threshold,
+                   lower ? ": its Γ goes on" : "");
+      best.tried.push_back({t, r.energy});
+      if (lower) {
+        // The bound stays the first LP's (both solves certify the same LP; the better one counts).
+        r.lower_bound = std::max(r.lower_bound, best.lower_bound);
+        r.first_lp = std::move(best.first_lp);
+        r.gap = relative_gap(r.energy, r.lower_bound);
+        r.tried = std::move(best.tried);
+        best = std::move(r);
+      }
+    } catch (const SolverError& e) {  // that rounding found no Γ (or its LP gave up): the others stand
+      spdlog::info("rounding: threshold {} found no Γ ({}, {:.2f} s)", t, e.what(), clock.seconds());
+      best.tried.push_back({t, std::numeric_limits<double>::quiet_NaN()});
+    }
+  }
+  return best;
 }
 
 double relative_gap(double energy, double bound) {

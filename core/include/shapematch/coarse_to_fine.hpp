@@ -222,6 +222,8 @@ struct LevelReport {
   int64_t iterations = 0;      // LP iterations over all rounds of the accepted ring (seconds
                                // include an infeasible attempt's, which ends within a few dozen)
   double lower_bound = 0.0, energy = 0.0, gap = 0.0;
+  double threshold = 0.5;      // the rounding threshold whose Γ was kept (RoundingOptions::alternative_thresholds)
+  int roundings = 1;           // roundings run from the accepted LP (1 + the alternatives tried)
   double seconds = 0.0;
   double peak_rss_mb = 0.0;
   // The second start (level 1 only): its energy, NaN where it did not run or found no Γ, and

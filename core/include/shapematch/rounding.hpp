@@ -138,6 +138,16 @@ struct RoundingOptions {
   // at a limit) is round 1's result.
   double probe_tolerance = 0.0;
   std::function<void(const std::vector<double>& x, const std::vector<double>& y, double primal_weight)> probe;
+  // Where the LP has at most alternatives_below columns, the rounding runs again from round 1's
+  // iterate with each of these thresholds (round 1 then only confirms that optimum), and the Γ of
+  // least energy is returned, with the threshold that found it. Fixing by a threshold is greedy,
+  // and which variables cross it first decides where a coarse level lands: on FAUST_r 020-024 at
+  // 200 faces, 0.5 ended at 2.851 and 0.7 at 2.741 (LP bound 2.628), and two full-resolution runs
+  // that differed at their 200-face level by 2.906 against 2.958 ended at 15.1 against 19.9
+  // (docs/results.md). An alternative that fails (no Γ, stuck, an LP that gives up) is dropped.
+  // Not with start_ones. Empty: one rounding.
+  std::vector<double> alternative_thresholds = {0.7};
+  int64_t alternatives_below = 1'500'000;
 };
 
 struct RoundingRound {
@@ -166,7 +176,9 @@ struct RoundingResult {
   double lower_bound = 0.0;    // certified bound of the first LP
   double gap = 0.0;            // (energy − bound) / |bound|
   LpResult first_lp;           // the relaxation before any fixing (with start_ones: after those)
-  std::vector<RoundingRound> rounds;
+  std::vector<RoundingRound> rounds;  // of the rounding that found Γ
+  double threshold = 0.5;      // the threshold that found Γ (RoundingOptions::alternative_thresholds)
+  std::vector<std::pair<double, double>> tried;  // (threshold, energy) of every rounding run; NaN: no Γ
 };
 
 // Rounding gave up where the LPs after its fixings kept failing (RoundingOptions::stuck_after):
