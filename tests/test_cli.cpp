@@ -124,6 +124,8 @@ TEST_CASE("cli: match writes a verified, complete output directory, or nothing")
   CHECK(fs::exists(out / "y.ply"));
   CHECK(report.find("\"close_pockets\": false") != std::string::npos);  // off by default
   CHECK(json_number(report, "pockets_closed") == 0);
+  // One level of 30 faces: rounded with 0.5, and again with the default alternative 0.7.
+  CHECK(json_number(report, "roundings") == 2);
 
   // --close-pockets reaches the rounding and the report (no pocket at 30 faces; the repair
   // itself is tested in test_rounding).
@@ -136,6 +138,19 @@ TEST_CASE("cli: match writes a verified, complete output directory, or nothing")
   CHECK(json_number(with, "pockets_closed") >= 0);
   CHECK(with.find("\"verified\": true") != std::string::npos);
   fs::remove_all(closed);
+
+  // --alt-thresholds none rounds once; a threshold outside (0, 1) is a usage error naming the option.
+  const fs::path once = out.string() + "_once";
+  r = run("match --faces 30 --backend cpu --alt-thresholds none -o " + once.string());
+  REQUIRE(r.code == 0);
+  std::ifstream fo(once / "report.json");
+  const std::string single((std::istreambuf_iterator<char>(fo)), {});
+  CHECK(json_number(single, "roundings") == 1);
+  fs::remove_all(once);
+  r = run("match --faces 30 --backend cpu --alt-thresholds 0.7,1.5 -o " + once.string());
+  CHECK(r.code != 0);
+  CHECK(r.err.find("--alt-thresholds") != std::string::npos);
+  CHECK_FALSE(fs::exists(once));
 
   // A failing run leaves the previous output untouched and no temporary directory behind.
   const fs::path bad = write_temp("open2.off", "OFF\n4 3 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n");
