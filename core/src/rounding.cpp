@@ -1207,16 +1207,8 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
                               options.exact_below, exact_params, options.split_parts);
     }
     const LpResult& r = joined.r;
-    if (round == 1 && keep && r.status == LpStatus::Optimal && r.x.size() == red.cols.size() &&
-        r.y.size() == red.rows.size()) {
-      keep->x = full_x(r.x);
-      keep->y.assign(lp.rows(), 0.0);
-      for (size_t i = 0; i < red.rows.size(); ++i) keep->y[red.rows[i]] = r.y[i];
-      keep->primal_weight = std::isfinite(r.primal_weight) ? r.primal_weight : 0.0;
-      keep->seconds = clock.seconds();
-      keep->iterations = r.iterations;
-    }
-    if (round == 1 && options.first_iterate && r.x.size() == red.cols.size()) {
+    // Round 1's iterate over the whole LP, for first_iterate and (an optimum) for the alternatives.
+    if (round == 1 && (options.first_iterate || keep) && r.x.size() == red.cols.size()) {
       std::vector<double> x = full_x(r.x), y(lp.rows(), 0.0);
       const bool diverged = r.status == LpStatus::Diverging;
       const std::vector<double>& dual = diverged ? r.last_y : r.y;
@@ -1226,7 +1218,14 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
       if (dual.size() == red.rows.size())
         for (size_t i = 0; i < red.rows.size(); ++i)
           if (!diverged || i >= r.y.size() || std::abs(r.y[i]) <= 0.01 * growth) y[red.rows[i]] = dual[i];
-      options.first_iterate(x, y, r.primal_weight);
+      if (keep && r.status == LpStatus::Optimal && r.y.size() == red.rows.size()) {
+        keep->x = x;
+        keep->y = y;
+        keep->primal_weight = std::isfinite(r.primal_weight) ? r.primal_weight : 0.0;
+        keep->seconds = clock.seconds();
+        keep->iterations = r.iterations;
+      }
+      if (options.first_iterate) options.first_iterate(x, y, r.primal_weight);
     }
     RoundingRound info;
     info.round = round;
