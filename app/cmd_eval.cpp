@@ -13,9 +13,11 @@
 
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <optional>
 #include <random>
+#include <sstream>
 
 namespace fs = std::filesystem;
 
@@ -62,6 +64,26 @@ std::vector<int> input_ids(const fs::path& dir, const std::string& side, int mat
     seen[ids[v]] = 1;
   }
   return ids;
+}
+
+// A coarser level's vertex map (match writes levels/level_K.txt): `x y` per line, input vertices
+// of X and Y, 0-based; φ over the input vertices of X, -1 where that level has no vertex.
+std::vector<int> read_level_map(const fs::path& path, int x_input, int y_input) {
+  std::ifstream in(path);
+  if (!in) throw IoError(path.string() + ": cannot open");
+  std::vector<int> phi(x_input, -1);
+  std::string line;
+  for (int number = 1; std::getline(in, line); ++number) {
+    std::istringstream fields(line);
+    long long x = -1, y = -1;
+    std::string rest;
+    if (!(fields >> x >> y) || (fields >> rest) || x < 0 || x >= x_input || y < 0 || y >= y_input || phi[x] >= 0)
+      throw InvalidInputError(fmt::format("{}: line {}: expected two 0-based input vertices (X < {}, Y < {}), each X "
+                                          "vertex once",
+                                          path.string(), number, x_input, y_input));
+    phi[x] = static_cast<int>(y);
+  }
+  return phi;
 }
 
 // Runs tools/plot_pck.py with Debian's Python (which has matplotlib); a missing matplotlib is a
@@ -147,6 +169,18 @@ int run_eval(const EvalArgs& args) {
   if (!args.gt_y_sym.empty())
     symmetric = geodesic_errors(y_full, phi, read_vts_ground_truth(args.gt_x, args.gt_y_sym, x_input, y_input), options);
   const OrientationFlips flips = count_orientation_flips(xm, ym, map);
+  // The coarser levels' maps, scored the same way on the points each level kept.
+  Json levels = Json::array();
+  for (int k = 1; fs::exists(dir / "levels" / fmt::format("level_{}.txt", k)); ++k) {
+    const fs::path path = dir / "levels" / fmt::format("level_{}.txt", k);
+    const GeodesicErrors e = geodesic_errors(y_full, read_level_map(path, x_input, y_input), truth, options);
+    levels.push(Json::object()
+                    .set("level", k)
+                    .set("points", e.points)
+                    .set("mean_geodesic_error", e.mean)
+                    .set("median_geodesic_error", e.median));
+    spdlog::info("level {}: mean geodesic error {:.4f} (median {:.4f}) over {} points", k, e.mean, e.median, e.points);
+  }
   // The point map (written by match since it has one): the same scores for points, whose
   // corners are vertices of the matched Y, i.e. input vertices of Y.
   const fs::path points_path = dir / "map_x_to_y_points.txt";
@@ -201,6 +235,7 @@ int run_eval(const EvalArgs& args) {
       .set("orientation_flips", flips.flips)
       .set("degenerate_faces", flips.degenerate)
       .set("geodesic_solves", errors.geodesic_solves)
+      .set("levels", levels)
       .set("seconds", total.seconds());
   if (point_errors) {
     Json pm = Json::object()

@@ -16,6 +16,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <numeric>
 #include <random>
 #include <sstream>
 
@@ -230,6 +231,23 @@ int run_match(const MatchArgs& args) {
     write_file_atomic((tmp / "map_y_to_x_points.txt").string(), point_map_text(points.y_to_x));
     write_file_atomic((tmp / "x_vertex_ids.txt").string(), lines(p.x_ids));
     write_file_atomic((tmp / "y_vertex_ids.txt").string(), lines(p.y_ids));
+    // Every coarser level's vertex map, in input vertices: where eval can see an error arise.
+    if (c2f.levels.size() > 1) {
+      fs::create_directories(tmp / "levels");
+      for (const LevelReport& level : c2f.levels) {
+        if (level.level + 1 >= matcher.x_levels().size()) continue;  // the finest is map_x_to_y.txt
+        const MeshLevel& lx = matcher.x_levels().levels[level.level];
+        const MeshLevel& ly = matcher.y_levels().levels[level.level];
+        const ProductSpace space = ProductSpace::from_list(lx.mesh, ly.mesh, level.gamma);
+        std::vector<int64_t> all(level.gamma.size());
+        std::iota(all.begin(), all.end(), int64_t{0});
+        const VertexMaps vm = vertex_maps(space, all);
+        std::string text;
+        for (int v = 0; v < lx.mesh.num_vertices(); ++v)
+          text += fmt::format("{} {}\n", p.x_ids[lx.input_vertex[v]], p.y_ids[ly.input_vertex[vm.x_to_y[v]]]);
+        write_file_atomic((tmp / "levels" / fmt::format("level_{}.txt", level.level + 1)).string(), text);
+      }
+    }
     std::ostringstream gs;
     for (int64_t j : rr.gamma) {
       const ProductTriangle t = m.space[j];

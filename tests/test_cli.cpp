@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <string>
 #include <sys/wait.h>
 #include <vector>
@@ -160,6 +161,52 @@ TEST_CASE("cli: match writes a verified, complete output directory, or nothing")
   for (const auto& entry : fs::directory_iterator(out.parent_path()))
     CHECK(entry.path().filename().string().rfind("shapematch_cli_match.tmp", 0) != 0);
   fs::remove_all(out);
+}
+
+// Every coarser level's map is written in input vertices and scored by eval: a shape matched
+// with itself through two levels is the identity at both (exactly 0 only if the level's
+// vertices are translated to input vertices correctly), and a corrupted level file is one line.
+TEST_CASE("cli: match writes each coarser level's map and eval scores it") {
+  shapematch::test::TempDir tmp;
+  const std::string dolphin = std::string(SHAPEMATCH_ASSETS_DIR) + "/dolphin_straight.off";
+  const fs::path out = tmp.path / "self";
+  Run r = run("match " + dolphin + " " + dolphin + " --faces 400 --levels 2 --backend cpu -o " + out.string());
+  REQUIRE_MESSAGE(r.code == 0, r.err);
+  REQUIRE(fs::exists(out / "levels" / "level_1.txt"));
+  CHECK_FALSE(fs::exists(out / "levels" / "level_2.txt"));  // the finest is map_x_to_y.txt
+  std::ifstream lf(out / "levels" / "level_1.txt");
+  int lines = 0, x = -1, y = -1;
+  for (std::string line; std::getline(lf, line); ++lines) {
+    std::istringstream(line) >> x >> y;
+    CHECK(x == y);
+  }
+  CHECK(lines > 40);   // about 52 vertices at 100 faces
+  CHECK(lines < 100);
+  r = run("eval " + out.string() + " --gt identity");
+  REQUIRE_MESSAGE(r.code == 0, r.err);
+  const size_t at = r.out.find("\"levels\"");
+  REQUIRE(at != std::string::npos);
+  const std::string levels = r.out.substr(at);
+  CHECK(json_number(levels, "level") == 1);
+  CHECK(json_number(levels, "points") == lines);
+  CHECK(json_number(levels, "mean_geodesic_error") == 0.0);
+
+  // Two poses: the coarse level's error is measured on its own points, not the finest's.
+  const std::string swimming = std::string(SHAPEMATCH_ASSETS_DIR) + "/dolphin_swimming.off";
+  const fs::path pair = tmp.path / "pair";
+  r = run("match " + dolphin + " " + swimming + " --faces 400 --levels 2 --backend cpu -o " + pair.string());
+  REQUIRE_MESSAGE(r.code == 0, r.err);
+  r = run("eval " + pair.string() + " --gt identity");
+  REQUIRE_MESSAGE(r.code == 0, r.err);
+  const std::string pl = r.out.substr(r.out.find("\"levels\""));
+  CHECK(json_number(pl, "points") == lines);
+  CHECK(json_number(pl, "mean_geodesic_error") > 0.0);
+  CHECK(json_number(pl, "mean_geodesic_error") < 0.3);  // not a swapped match
+
+  std::ofstream(out / "levels" / "level_1.txt", std::ios::app) << "3 7 9\n";
+  r = run("eval " + out.string() + " --gt identity");
+  CHECK(r.code != 0);
+  CHECK(r.err.find("level_1.txt: line") != std::string::npos);
 }
 
 // The README's main command, checked for what its picture should show: the bundled dolphins

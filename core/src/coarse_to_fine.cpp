@@ -399,6 +399,7 @@ void accept(const MatchingLp& m, const RoundingResult& rr, LevelReport& rep, std
   rep.roundings = std::max<int>(1, rr.tried.size());
   gamma.clear();
   for (int64_t j : rr.gamma) gamma.push_back(m.space[j]);
+  rep.gamma = gamma;
 }
 
 }  // namespace

@@ -235,6 +235,9 @@ struct LevelReport {
   // chain of higher energy at the second level won.
   double lookahead_other_energy = std::numeric_limits<double>::quiet_NaN();
   bool lookahead_switched = false;
+  // The level's Γ, the one that went on (on the level's meshes, x_levels()/y_levels()): match
+  // writes a vertex map per level from it, so that eval can say at which level an error arose.
+  std::vector<ProductTriangle> gamma;
 };
 
 struct CoarseToFineResult {
