@@ -14,6 +14,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <numeric>
@@ -47,6 +48,8 @@ struct MatchArgs {
   int device = -1;
   HierarchyOptions hierarchy;
   int ring = 1, max_ring = 3;
+  int coarse_ring = CoarseToFineOptions{}.coarse_ring;
+  int coarse_ring_faces = CoarseToFineOptions{}.coarse_ring_faces;
   std::string neighbourhood = "fine";
   std::string widen = "local";
   int widen_margin = CoarseToFineOptions{}.widen_margin;
@@ -118,7 +121,9 @@ int run_match(const MatchArgs& args) {
                  co.hierarchy.coarsest_faces);
   co.ring = args.ring;
   co.neighbourhood = args.neighbourhood == "fine" ? Neighbourhood::Fine : Neighbourhood::Coarse;
-  co.max_ring = std::max(args.max_ring, args.ring);
+  co.coarse_ring = args.coarse_ring;
+  co.coarse_ring_faces = args.coarse_ring_faces;
+  co.max_ring = std::max({args.max_ring, args.ring, args.coarse_ring_faces > 0 ? args.coarse_ring : 0});
   co.local_widening = args.widen == "local";
   co.coarse_tolerance = args.coarse_tolerance;
   co.widen_margin = args.widen_margin;
@@ -350,6 +355,8 @@ int run_match(const MatchArgs& args) {
                               .set("surface_parents", args.hierarchy.surface_parents)
                               .set("level_ratio", args.hierarchy.ratio)
                               .set("ring", args.ring)
+                              .set("coarse_ring", args.coarse_ring)
+                              .set("coarse_ring_faces", args.coarse_ring_faces)
                               .set("neighbourhood", args.neighbourhood)
                               .set("widen", args.widen)
                               .set("widen_margin", args.widen_margin)
@@ -517,6 +524,14 @@ Action add_match_command(CLI::App& app) {
       ->capture_default_str();
   app.add_option("--ring", a->ring, "neighbourhood rings of the reduced product space (eq. 17)")
       ->check(CLI::Range(0, 8))
+      ->capture_default_str();
+  app.add_option("--coarse-ring", a->coarse_ring,
+                 "the ring at the levels below the finest with at most --coarse-ring-faces faces")
+      ->check(CLI::Range(0, 8))
+      ->capture_default_str();
+  app.add_option("--coarse-ring-faces", a->coarse_ring_faces,
+                 "levels below the finest with at most this many faces start at --coarse-ring (0: --ring everywhere)")
+      ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   app.add_option("--neighbourhood", a->neighbourhood,
                  "where rings count: coarse (eq. 17 on the coarse level) or fine (on Y's fine level)")

@@ -170,7 +170,7 @@ TEST_CASE("cli: match writes each coarser level's map and eval scores it") {
   shapematch::test::TempDir tmp;
   const std::string dolphin = std::string(SHAPEMATCH_ASSETS_DIR) + "/dolphin_straight.off";
   const fs::path out = tmp.path / "self";
-  Run r = run("match " + dolphin + " " + dolphin + " --faces 400 --levels 2 --backend cpu -o " + out.string());
+  Run r = run("match " + dolphin + " " + dolphin + " --faces 300 --levels 2 --backend cpu -o " + out.string());
   REQUIRE_MESSAGE(r.code == 0, r.err);
   REQUIRE(fs::exists(out / "levels" / "level_1.txt"));
   CHECK_FALSE(fs::exists(out / "levels" / "level_2.txt"));  // the finest is map_x_to_y.txt
@@ -194,7 +194,7 @@ TEST_CASE("cli: match writes each coarser level's map and eval scores it") {
   // Two poses: the coarse level's error is measured on its own points, not the finest's.
   const std::string swimming = std::string(SHAPEMATCH_ASSETS_DIR) + "/dolphin_swimming.off";
   const fs::path pair = tmp.path / "pair";
-  r = run("match " + dolphin + " " + swimming + " --faces 400 --levels 2 --backend cpu -o " + pair.string());
+  r = run("match " + dolphin + " " + swimming + " --faces 300 --levels 2 --backend cpu -o " + pair.string());
   REQUIRE_MESSAGE(r.code == 0, r.err);
   r = run("eval " + pair.string() + " --gt identity");
   REQUIRE_MESSAGE(r.code == 0, r.err);

@@ -11,6 +11,7 @@
 #include <cmath>
 #include <map>
 #include <random>
+#include <memory>
 #include <set>
 
 using namespace shapematch;
@@ -350,6 +351,7 @@ TEST_CASE("coarse to fine: faces whose parent was widened start widened where as
   o.price_widenings = 0;
   o.second_start = false;
   o.rounding.alternative_thresholds = {};  // the coarsest Γ these widenings were measured on
+  o.coarse_ring_faces = 0;                 // ring 0 at every level, as measured
   int widenings[2][4] = {};
   for (const int inherit : {0, 1}) {
     CAPTURE(inherit);
@@ -495,6 +497,41 @@ TEST_CASE("coarse to fine: the tolerance below the finest level is its own, loos
   CHECK(id > ic);
   CHECK(id == ia);  // 1e-4 below the finest, as in `tight`
   CHECK(d.levels[0].iterations == a.levels[0].iterations);
+}
+
+TEST_CASE("coarse to fine: the small levels below the finest start at their own ring, the finest at --ring") {
+  CoarseToFineOptions o;
+  o.hierarchy.levels = 3;
+  o.hierarchy.coarsest_faces = 16;
+  o.rounding.solver = "pdhg-cpu";
+  o.coarse_ring_faces = 1000000;  // every level below the finest, whatever its size
+  CoarseToFineResult r[2];
+  std::vector<std::unique_ptr<CoarseToFineMatcher>> keep;  // the results refer to their meshes
+  for (int k : {1, 2}) {
+    o.coarse_ring = k;
+    keep.push_back(std::make_unique<CoarseToFineMatcher>(finger_matcher(o)));
+    r[k - 1] = keep.back()->run();
+    REQUIRE(r[k - 1].levels.size() == 3);
+    CHECK(r[k - 1].levels[1].ring >= k);
+    CHECK(check_graph_surface(r[k - 1].finest.space, r[k - 1].rounding.gamma).ok());
+  }
+  // Both refine the same coarsest Γ (the full space's): the middle level's space at ring 2 holds
+  // the one at ring 1, so its LP is no higher (bounds within the coarse tolerance of the optimum).
+  CHECK(r[0].levels[0].energy == doctest::Approx(r[1].levels[0].energy).epsilon(1e-12));
+  CHECK(r[1].levels[1].variables > r[0].levels[1].variables);
+  CHECK(r[1].levels[1].lower_bound <= r[0].levels[1].lower_bound + 1e-2 * std::abs(r[0].levels[1].lower_bound));
+  CHECK(r[1].levels[1].lower_bound <= r[0].levels[1].energy + 1e-9);
+  // The finest level starts at --ring either way.
+  CHECK(r[0].levels[2].ring == o.ring);
+  CHECK(r[1].levels[2].ring == o.ring);
+  // Above the size limit a level keeps --ring.
+  o.coarse_ring_faces = 10;
+  const CoarseToFineMatcher none = finger_matcher(o);
+  CHECK(none.run().levels[1].ring == o.ring);
+  // A coarse ring beyond max_ring is refused.
+  o.coarse_ring_faces = 1000;
+  o.coarse_ring = o.max_ring + 1;
+  CHECK_THROWS_AS(finger_matcher(o), InvalidInputError);
 }
 
 TEST_CASE("coarse to fine: the second start solves the second level twice and keeps the lower energy") {

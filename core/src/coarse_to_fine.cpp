@@ -408,6 +408,8 @@ CoarseToFineMatcher::CoarseToFineMatcher(const Mesh& x, const Mesh& y, CoarseToF
     : options_(std::move(options)) {
   if (options_.ring < 0 || options_.max_ring < options_.ring)
     throw InvalidInputError("coarse to fine: need 0 ≤ --ring ≤ max ring");
+  if (options_.coarse_ring_faces > 0 && (options_.coarse_ring < 0 || options_.max_ring < options_.coarse_ring))
+    throw InvalidInputError("coarse to fine: need 0 ≤ --coarse-ring ≤ max ring");
   // Both shapes get the same number of levels (the larger shape's count), each its own face counts.
   HierarchyOptions ho = options_.hierarchy;
   if (ho.levels == 0)
@@ -647,6 +649,11 @@ std::vector<double> reduced_costs(const MatchingLp& m, const std::vector<double>
   return priced_against(dual, other);
 }
 
+int CoarseToFineMatcher::ring_at(int l) const {
+  const bool coarse = l + 1 < hx_.size() && hx_.levels[l].mesh.num_faces() <= options_.coarse_ring_faces;
+  return coarse ? options_.coarse_ring : options_.ring;
+}
+
 RoundingOptions CoarseToFineMatcher::rounding_for(int l) const {
   RoundingOptions ro = options_.rounding;
   if (l + 1 < hx_.size() && options_.coarse_tolerance > 0.0) ro.lp.tolerance = options_.coarse_tolerance;
@@ -658,13 +665,14 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
                                         const Progress& progress, std::vector<int>& widened) const {
   const MeshLevel& lx = hx_.levels[l];
   const MeshLevel& ly = hy_.levels[l];
+  const int base_ring = ring_at(l);
   std::vector<int> extra;  // local widening: more fine rings per fine X face
   if (l > 0 && options_.inherit_widening > 0 && options_.local_widening &&
       widened.size() == size_t(hx_.levels[l - 1].mesh.num_faces())) {
     extra.assign(lx.mesh.num_faces(), 0);
     for (int f = 0; f < lx.mesh.num_faces(); ++f) {
       const int e = std::min({widened[lx.parent_face[f]], options_.inherit_widening,
-                              std::max(0, options_.max_ring - options_.ring)});
+                              std::max(0, options_.max_ring - base_ring)});
       if (e > 0) extra[f] = e, ++rep.inherited_faces;
     }
     if (rep.inherited_faces > 0)
@@ -673,7 +681,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
   }
   std::vector<int> last_widened;
   int local = 0;
-  int ring = options_.ring;
+  int ring = base_ring;
   bool trust_divergence = true;
   bool regional_done = false;
   bool around_done = false;

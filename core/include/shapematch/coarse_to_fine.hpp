@@ -58,6 +58,17 @@ struct CoarseToFineOptions {
   Neighbourhood neighbourhood = Neighbourhood::Fine;  // measured: as accurate, 2.5-15x faster
   int ring = 1;      // N(f) = faces within this many rings of f's vertices (eq. 17)
   int max_ring = 3;  // widen up to this when a reduced LP is infeasible
+  // The ring at the levels below the finest with at most coarse_ring_faces faces (on X; 0: `ring`
+  // everywhere). There ring 1 held the chain in the tube around a coarser Γ that was wrong in
+  // places; ring 2 lets those levels move away from it at a few seconds each. Measured, FAUST_r
+  // 020-021 at full resolution: with ring 1, X's left arm went wrong at the 532-face level
+  // (level maps: its points 0.16 off there, 0.21 at the end) and the run ended at energy 21.75,
+  // error 0.0377; with ring 2 at the 200- to 3 760-face levels, energy 13.12, error 0.0194, in
+  // 18 minutes against 9 (ring 2 only up to 1 414 faces: level 4 as good, 5.36 against 6.18, but
+  // the finest level's LP at 15.3 and its rounding thrashing; stopped after 21 minutes).
+  // docs/results.md, twenty-second session.
+  int coarse_ring = 2;
+  int coarse_ring_faces = 4000;
   // First widen only near the proof of infeasibility (the places where propagation finds a
   // contradiction, or a Farkas certificate's rows), up to this many times per level, before
   // widening everywhere. Measured, FAUST_r 021-029 at 1000 faces (3 levels from 100, bending
@@ -262,6 +273,8 @@ public:
 private:
   // Level l's rounding options: the coarse tolerance below the finest level.
   RoundingOptions rounding_for(int l) const;
+  // Level l's ring before any widening: coarse_ring at the small levels below the finest.
+  int ring_at(int l) const;
   // Level l from the coarser level's Γ (the full space at l = 0), widening where it is
   // infeasible; throws InfeasibleError when the largest ring is. Replaces `gamma` with level l's.
   // `widened`: on entry the coarser level's extra rings per X face (inherit_widening; empty:
