@@ -60,7 +60,7 @@ struct CoarseToFineOptions {
   int max_ring = 3;  // widen up to this when a reduced LP is infeasible
   // The ring at the levels below the finest with at most coarse_ring_faces faces (on X; 0: `ring`
   // everywhere). There ring 1 held the chain in the tube around a coarser Γ that was wrong in
-  // places; ring 2 lets those levels move away from it at a few seconds each. Measured, FAUST_r
+  // places; ring 2 lets those levels move away from it, at 2-3x their LP sizes. Measured, FAUST_r
   // 020-021 at full resolution: with ring 1, X's left arm went wrong at the 532-face level
   // (level maps: its points 0.16 off there, 0.21 at the end) and the run ended at energy 21.75,
   // error 0.0377; with ring 2 at the 200- to 3 760-face levels, energy 13.12, error 0.0194, in
