@@ -13,11 +13,9 @@
 
 #include <cstdlib>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
 #include <optional>
 #include <random>
-#include <sstream>
 
 namespace fs = std::filesystem;
 
@@ -66,22 +64,13 @@ std::vector<int> input_ids(const fs::path& dir, const std::string& side, int mat
   return ids;
 }
 
-// A coarser level's vertex map (match writes levels/level_K.txt): `x y` per line, input vertices
-// of X and Y, 0-based; φ over the input vertices of X, -1 where that level has no vertex.
+// A coarser level's vertex map (match writes levels/level_K.txt): `x y` per line, 0-based input
+// vertices of X and Y; φ over the input vertices of X, -1 where that level has no vertex.
 std::vector<int> read_level_map(const fs::path& path, int x_input, int y_input) {
-  std::ifstream in(path);
-  if (!in) throw IoError(path.string() + ": cannot open");
   std::vector<int> phi(x_input, -1);
-  std::string line;
-  for (int number = 1; std::getline(in, line); ++number) {
-    std::istringstream fields(line);
-    long long x = -1, y = -1;
-    std::string rest;
-    if (!(fields >> x >> y) || (fields >> rest) || x < 0 || x >= x_input || y < 0 || y >= y_input || phi[x] >= 0)
-      throw InvalidInputError(fmt::format("{}: line {}: expected two 0-based input vertices (X < {}, Y < {}), each X "
-                                          "vertex once",
-                                          path.string(), number, x_input, y_input));
-    phi[x] = static_cast<int>(y);
+  for (const auto& [x, y] : read_vertex_pairs(path.string(), false, x_input, y_input)) {
+    if (phi[x] >= 0) throw InvalidInputError(fmt::format("{}: X vertex {} is listed twice", path.string(), x));
+    phi[x] = y;
   }
   return phi;
 }
@@ -171,8 +160,9 @@ int run_eval(const EvalArgs& args) {
   const OrientationFlips flips = count_orientation_flips(xm, ym, map);
   // The coarser levels' maps, scored the same way on the points each level kept.
   Json levels = Json::array();
-  for (int k = 1; fs::exists(dir / "levels" / fmt::format("level_{}.txt", k)); ++k) {
+  for (int k = 1;; ++k) {
     const fs::path path = dir / "levels" / fmt::format("level_{}.txt", k);
+    if (!fs::exists(path)) break;
     const GeodesicErrors e = geodesic_errors(y_full, read_level_map(path, x_input, y_input), truth, options);
     levels.push(Json::object()
                     .set("level", k)

@@ -102,10 +102,15 @@ GroundTruth read_vts_ground_truth(const std::string& x_path, const std::string& 
   return gt;
 }
 
-GroundTruth read_map_ground_truth(const std::string& path, int x_vertices, int y_vertices) {
+GroundTruth read_vertex_pairs(const std::string& path, bool one_based, int x_vertices, int y_vertices) {
   GroundTruth gt;
-  for (const auto& row : read_rows(path, 2, 1, {x_vertices, y_vertices})) gt.push_back({row[0], row[1]});
+  for (const auto& row : read_rows(path, 2, one_based ? 1 : 0, {x_vertices, y_vertices}))
+    gt.push_back({row[0], row[1]});
   return gt;
+}
+
+GroundTruth read_map_ground_truth(const std::string& path, int x_vertices, int y_vertices) {
+  return read_vertex_pairs(path, true, x_vertices, y_vertices);
 }
 
 std::vector<std::array<double, 2>> pck_curve(const std::vector<double>& errors, double max, double step) {

@@ -27,6 +27,8 @@ GroundTruth read_vts_ground_truth(const std::string& x_path, const std::string& 
 // Two 1-based columns per line, "x_vertex y_vertex": column 1 is a vertex of X, column 2 of Y.
 // TOPKIDS kidXX_ref.txt maps kidXX → kid00, so X = kidXX and Y = kid00.
 GroundTruth read_map_ground_truth(const std::string& path, int x_vertices, int y_vertices);
+// The same two columns with either base (match's levels/level_K.txt are 0-based).
+GroundTruth read_vertex_pairs(const std::string& path, bool one_based, int x_vertices, int y_vertices);
 
 // One vertex index per line (map_x_to_y.txt, x_vertex_ids.txt; `.vts` with one_based), each in
 // [0, num_vertices) after subtracting the base; returned 0-based. Throws IoError or
