@@ -396,7 +396,9 @@ int run_bench_lp(BenchLpArgs args) {
       row.nonzeros = m.lp.nonzeros();
       row.solver = solver;
       row.run = solve_repeated(m.lp, solver, params, args.repeat);
-      if (pdhg) row.bytes_per_iteration = pdhg_bytes_per_iteration(m.lp);
+      if (pdhg)
+        row.bytes_per_iteration =
+            solver == "pdhg-cpu-f32" ? pdhg_bytes_per_iteration_f32(m.lp) : pdhg_bytes_per_iteration(m.lp);
       if (row.run.status == "error")
         spdlog::warn("  {}: failed: {}", solver, row.run.device);
       else

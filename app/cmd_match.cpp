@@ -73,6 +73,7 @@ struct MatchArgs {
 // auto: a GPU if there is one, else the native solver (lavapipe is for testing, not speed).
 std::string solver_for(const MatchArgs& a) {
   if (a.backend == "cpu") return "pdhg-cpu";
+  if (a.backend == "cpu-f32") return "pdhg-cpu-f32";
   if (a.backend == "vulkan") return "pdhg-vulkan";
   if (a.backend == "clp") return "clp-dual";
   try {
@@ -429,7 +430,7 @@ Action add_match_command(CLI::App& app) {
   add_pair_options(app, a->pair);
   app.add_option("-o,--out", a->out, "output directory")->capture_default_str();
   app.add_option("--backend", a->backend, "LP backend")
-      ->check(CLI::IsMember({"auto", "vulkan", "cpu", "clp"}))
+      ->check(CLI::IsMember({"auto", "vulkan", "cpu", "cpu-f32", "clp"}))
       ->capture_default_str();
   app.add_option("--device", a->device, "Vulkan device index (see `shapematch devices`)");
   app.add_option("--threshold", a->threshold, "fix LP values above this to 1")

@@ -153,6 +153,19 @@ TEST_CASE("cli: match writes a verified, complete output directory, or nothing")
   CHECK(r.err.find("--alt-thresholds") != std::string::npos);
   CHECK_FALSE(fs::exists(once));
 
+  // --backend cpu-f32 reaches the solver (the report names it) and lands on the fp64 run's Γ, or
+  // one of the same energy within the LP tolerance.
+  const fs::path f32 = out.string() + "_f32";
+  r = run("match --faces 30 --backend cpu-f32 -o " + f32.string());
+  REQUIRE(r.code == 0);
+  std::ifstream ff(f32 / "report.json");
+  const std::string narrow((std::istreambuf_iterator<char>(ff)), {});
+  CHECK(narrow.find("\"pdhg-cpu-f32\"") != std::string::npos);
+  CHECK(narrow.find("\"verified\": true") != std::string::npos);
+  CHECK(std::abs(json_number(narrow, "energy") - json_number(report, "energy")) <=
+        1e-3 * std::abs(json_number(report, "energy")));
+  fs::remove_all(f32);
+
   // A failing run leaves the previous output untouched and no temporary directory behind.
   const fs::path bad = write_temp("open2.off", "OFF\n4 3 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n");
   r = run("match " + bad.string() + " " + bad.string() + " -o " + out.string());

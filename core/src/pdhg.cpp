@@ -141,8 +141,9 @@ LpResult PdhgSolver::solve(const LpProblem& problem, const SolverParams& params)
   if (!params.initial_y.empty())
     for (int64_t i = 0; i < m; ++i) y0[i] = params.initial_y[i] / r[i];
 
-  auto backend = backend_ == PdhgBackendKind::Cpu ? detail::make_cpu_backend(params.threads)
-                                                  : detail::make_vulkan_backend(params.device);
+  auto backend = backend_ == PdhgBackendKind::Cpu      ? detail::make_cpu_backend(params.threads)
+                 : backend_ == PdhgBackendKind::CpuF32 ? detail::make_cpu_f32_backend(params.threads)
+                                                       : detail::make_vulkan_backend(params.device);
   result.device = backend->device();
   backend->load(lp, x0, y0);
   result.setup_seconds = clock.seconds();
@@ -277,6 +278,13 @@ double pdhg_bytes_per_iteration(const LpProblem& problem) {
   const double n = double(problem.cols()), m = double(problem.rows()), nnz = double(problem.nonzeros());
   const double primal = 4.0 * (n + 1) + (4.0 + 8.0) * nnz + 8.0 * 4 * n + 8.0 * 2 * n;
   const double dual = 4.0 * (m + 1) + (4.0 + 8.0) * nnz + 8.0 * 4 * m + 8.0 * 2 * m;
+  return primal + dual;
+}
+
+double pdhg_bytes_per_iteration_f32(const LpProblem& problem) {
+  const double n = double(problem.cols()), m = double(problem.rows()), nnz = double(problem.nonzeros());
+  const double primal = 4.0 * (n + 1) + (4.0 + 4.0) * nnz + 4.0 * 4 * n + 4.0 * 2 * n;
+  const double dual = 4.0 * (m + 1) + (4.0 + 4.0) * nnz + 4.0 * 3 * m + 4.0 * 2 * m;
   return primal + dual;
 }
 

@@ -74,6 +74,7 @@ public:
 };
 
 std::unique_ptr<PdhgBackend> make_cpu_backend(int threads);
+std::unique_ptr<PdhgBackend> make_cpu_f32_backend(int threads);  // fp32 vectors, dual relative to its anchor
 std::unique_ptr<PdhgBackend> make_vulkan_backend(int device_index);
 
 }  // namespace shapematch::detail

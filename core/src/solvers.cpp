@@ -4,10 +4,11 @@
 
 namespace shapematch {
 
-std::vector<std::string> solver_names() { return {"pdhg-cpu", "pdhg-vulkan", "clp-dual", "clp-barrier"}; }
+std::vector<std::string> solver_names() { return {"pdhg-cpu", "pdhg-cpu-f32", "pdhg-vulkan", "clp-dual", "clp-barrier"}; }
 
 std::unique_ptr<LpSolver> make_solver(const std::string& name) {
   if (name == "pdhg-cpu") return std::make_unique<PdhgSolver>(PdhgBackendKind::Cpu);
+  if (name == "pdhg-cpu-f32") return std::make_unique<PdhgSolver>(PdhgBackendKind::CpuF32);
   if (name == "pdhg-vulkan") return std::make_unique<PdhgSolver>(PdhgBackendKind::Vulkan);
   if (name == "clp-dual") return std::make_unique<ClpSolver>(ClpSolver::Method::DualSimplex);
   if (name == "clp-barrier") return std::make_unique<ClpSolver>(ClpSolver::Method::Barrier);

@@ -23,12 +23,17 @@ struct PdhgOptions {
   double initial_primal_weight = 1.0;
 };
 
-enum class PdhgBackendKind { Cpu, Vulkan };
+// CpuF32: the native kernels with fp32 vectors and the dual kept relative to its anchor
+// (pdhg_cpu.cpp): fewer bytes per iteration, the same stopping rules; results differ in the last
+// digits from Cpu, which is the Vulkan shaders' bit-for-bit oracle.
+enum class PdhgBackendKind { Cpu, CpuF32, Vulkan };
 
 class PdhgSolver final : public LpSolver {
 public:
   explicit PdhgSolver(PdhgBackendKind backend, PdhgOptions options = {}) : backend_(backend), options_(options) {}
-  std::string name() const override { return backend_ == PdhgBackendKind::Cpu ? "pdhg-cpu" : "pdhg-vulkan"; }
+  std::string name() const override {
+    return backend_ == PdhgBackendKind::Cpu ? "pdhg-cpu" : backend_ == PdhgBackendKind::CpuF32 ? "pdhg-cpu-f32" : "pdhg-vulkan";
+  }
   LpResult solve(const LpProblem& problem, const SolverParams& params) override;
 
 private:
@@ -42,5 +47,8 @@ private:
 // x, xr (8 bytes each); the dual kernel does the same over A with b, r, y, y⁰ and writes y, yr.
 // Dividing it by a measured streaming bandwidth gives the time bound of one iteration.
 double pdhg_bytes_per_iteration(const LpProblem& problem);
+// The same for PdhgBackendKind::CpuF32: gathers of 4 bytes; per column g⁰, d, x, x⁰ read and x,
+// xr written; per row b, r, δ read and δ, r·δ written (4 bytes each).
+double pdhg_bytes_per_iteration_f32(const LpProblem& problem);
 
 }  // namespace shapematch

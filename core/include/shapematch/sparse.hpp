@@ -25,6 +25,10 @@ inline double signed_value(uint32_t e, const double* v) {
   const double x = v[col_of(e)];
   return std::bit_cast<double>(std::bit_cast<uint64_t>(x) ^ (uint64_t(e & SignedCsr::kNegative) << 32));
 }
+// The same for a float vector: the entry's sign bit is already where a float's is.
+inline float signed_value(uint32_t e, const float* v) {
+  return std::bit_cast<float>(std::bit_cast<uint32_t>(v[col_of(e)]) ^ (e & SignedCsr::kNegative));
+}
 
 // Aᵀ in the same format; within each row the columns come out in increasing order.
 SignedCsr transpose(const SignedCsr& a);
