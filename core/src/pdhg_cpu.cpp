@@ -116,18 +116,95 @@ std::vector<int64_t> split_by_cost(const SignedCsr& m, int parts) {
 // over, few enough that claiming them costs nothing measurable.
 constexpr int kChunksPerThread = 16;
 
-class CpuBackend final : public PdhgBackend {
+// What both native backends share: the thread pool, per-thread partial sums, the cost splits of
+// the iteration loops and the evaluation at (x̂, ŷ), which is fp64 in both.
+class NativeBackend : public PdhgBackend {
+protected:
+  explicit NativeBackend(int threads) : pool_(threads) {}
+
+  void prepare(const ScaledLp& lp) {
+    lp_ = &lp;
+    n_ = lp.a->cols;
+    m_ = lp.a->rows;
+    partial_.assign(pool_.size() * 8, 0.0);
+    col_split_ = split_by_cost(*lp.at, pool_.size() * kChunksPerThread);
+    row_split_ = split_by_cost(*lp.a, pool_.size() * kChunksPerThread);
+  }
+
+  double sum(int slot) const {
+    double s = 0.0;
+    for (int t = 0; t < pool_.size(); ++t) s += partial_[8 * t + slot];
+    return s;
+  }
+
+  // kernel(begin, end) over chunks of about equal cost; the last iteration of a batch splits rows
+  // evenly, one share per thread into partial_[8t], so that the statistics (and the host's restart
+  // decisions on them) do not depend on the cost split.
+  template <class Kernel>
+  void run_split(bool last, const std::vector<int64_t>& split, int64_t count, Kernel&& kernel) {
+    const int T = pool_.size();
+    if (last)
+      pool_.run(T, [&](int t) { partial_[8 * t] = kernel(count * t / T, count * (t + 1) / T); });
+    else
+      pool_.run(int(split.size()) - 1, [&](int c) { kernel(split[c], split[c + 1]); });
+  }
+
+  // Residual, objective and bound at x̂ = xhat(j), ŷ = yhat(i) (scaled) in original units.
+  template <class XHat, class YHat>
+  void evaluate_at(XHat&& xhat, YHat&& yhat, BatchStats& stats) {
+    const SignedCsr& a = *lp_->a;
+    const SignedCsr& at = *lp_->at;
+    const double* d = lp_->col_scale.data();
+    const double* r = lp_->row_scale.data();
+    const int T = pool_.size();
+    scratch_x_.resize(n_);
+    scratch_y_.resize(m_);
+    pool_.run(T, [&](int t) {
+      for (int64_t j = n_ * t / T, e = n_ * (t + 1) / T; j < e; ++j) scratch_x_[j] = d[j] * xhat(j);
+      for (int64_t i = m_ * t / T, e = m_ * (t + 1) / T; i < e; ++i) scratch_y_[i] = r[i] * yhat(i);
+    });
+    pool_.run(T, [&](int t) {
+      double res = 0.0, by = 0.0;
+      for (int64_t i = m_ * t / T, e = m_ * (t + 1) / T; i < e; ++i) {
+        const double ri = a_row_sum(a.entry.data(), a.row_ptr[i], a.row_ptr[i + 1], scratch_x_.data()) - lp_->b[i] / r[i];
+        res += ri * ri;
+        by += double(lp_->b[i]) * yhat(i);
+      }
+      double cx = 0.0, neg = 0.0;
+      for (int64_t j = n_ * t / T, e = n_ * (t + 1) / T; j < e; ++j) {
+        cx += double(lp_->c[j]) * xhat(j);
+        const double rc = double(lp_->c[j]) / d[j] - double(signed_gather(at, j, scratch_y_.data()));
+        neg += std::min(0.0, rc);
+      }
+      partial_[8 * t] = res;
+      partial_[8 * t + 1] = by;
+      partial_[8 * t + 2] = cx;
+      partial_[8 * t + 3] = neg;
+    });
+    stats.residual2 = sum(0);
+    stats.by = sum(1);
+    stats.cx = sum(2);
+    stats.reduced_neg = sum(3);
+  }
+
+  ThreadPool pool_;
+  const ScaledLp* lp_ = nullptr;
+  int64_t n_ = 0, m_ = 0;
+  std::vector<double> scratch_x_, scratch_y_;
+  std::vector<int64_t> col_split_, row_split_;  // chunks of Aᵀ's and A's rows of about equal cost
+  std::vector<double> partial_;  // 8 slots per thread, apart enough to avoid false sharing of hot slots
+};
+
+class CpuBackend final : public NativeBackend {
 public:
-  explicit CpuBackend(int threads) : pool_(threads) {}
+  explicit CpuBackend(int threads) : NativeBackend(threads) {}
 
   std::string device() const override {
     return "cpu (" + std::to_string(pool_.size()) + " threads)";
   }
 
   void load(const ScaledLp& lp, const std::vector<double>& x, const std::vector<double>& y) override {
-    lp_ = &lp;
-    n_ = lp.a->cols;
-    m_ = lp.a->rows;
+    prepare(lp);
     x_ = x;
     x0_ = x;
     xhat_ = x;  // read() before any iteration returns the start
@@ -137,9 +214,6 @@ public:
     yhat_ = y;
     yr_.resize(m_);
     for (int64_t i = 0; i < m_; ++i) yr_[i] = lp.row_scale[i] * y_[i];
-    partial_.assign(pool_.size() * 8, 0.0);
-    col_split_ = split_by_cost(*lp.at, pool_.size() * kChunksPerThread);
-    row_split_ = split_by_cost(*lp.a, pool_.size() * kChunksPerThread);
   }
 
   BatchStats iterate(int count, int64_t k0, const Step& step) override {
@@ -185,20 +259,11 @@ public:
   }
 
 private:
-  double sum(int slot) const {
-    double s = 0.0;
-    for (int t = 0; t < pool_.size(); ++t) s += partial_[8 * t + slot];
-    return s;
-  }
-
-  // The last iteration of a batch splits rows evenly, as the reductions always did, so that the
-  // statistics (and the host's restart decisions on them) do not depend on the cost split.
   void primal(const Step& step, double w, bool last) {
-    const int T = pool_.size();
     if (last)
-      pool_.run(T, [&](int t) { partial_[8 * t] = primal_rows<true>(step, w, n_ * t / T, n_ * (t + 1) / T); });
+      run_split(true, col_split_, n_, [&](int64_t b, int64_t e) { return primal_rows<true>(step, w, b, e); });
     else
-      pool_.run(int(col_split_.size()) - 1, [&](int c) { primal_rows<false>(step, w, col_split_[c], col_split_[c + 1]); });
+      run_split(false, col_split_, n_, [&](int64_t b, int64_t e) { return primal_rows<false>(step, w, b, e); });
   }
 
   template <bool Last>
@@ -230,11 +295,10 @@ private:
   }
 
   void dual(const Step& step, double w, bool last) {
-    const int T = pool_.size();
     if (last)
-      pool_.run(T, [&](int t) { partial_[8 * t] = dual_rows<true>(step, w, m_ * t / T, m_ * (t + 1) / T); });
+      run_split(true, row_split_, m_, [&](int64_t b, int64_t e) { return dual_rows<true>(step, w, b, e); });
     else
-      pool_.run(int(row_split_.size()) - 1, [&](int c) { dual_rows<false>(step, w, row_split_[c], row_split_[c + 1]); });
+      run_split(false, row_split_, m_, [&](int64_t b, int64_t e) { return dual_rows<false>(step, w, b, e); });
   }
 
   template <bool Last>
@@ -264,49 +328,11 @@ private:
     return dy2;
   }
 
-  // Residual, objective and bound at (x̂, ŷ) in original units; reuses xr_/yr_-sized scratch.
   void evaluate(BatchStats& stats) {
-    const SignedCsr& a = *lp_->a;
-    const SignedCsr& at = *lp_->at;
-    const double* d = lp_->col_scale.data();
-    const double* r = lp_->row_scale.data();
-    const int T = pool_.size();
-    scratch_x_.resize(n_);
-    scratch_y_.resize(m_);
-    pool_.run(T, [&](int t) {
-      for (int64_t j = n_ * t / T, e = n_ * (t + 1) / T; j < e; ++j) scratch_x_[j] = d[j] * xhat_[j];
-      for (int64_t i = m_ * t / T, e = m_ * (t + 1) / T; i < e; ++i) scratch_y_[i] = r[i] * yhat_[i];
-    });
-    pool_.run(T, [&](int t) {
-      double res = 0.0, by = 0.0;
-      for (int64_t i = m_ * t / T, e = m_ * (t + 1) / T; i < e; ++i) {
-        const double ri = a_row_sum(a.entry.data(), a.row_ptr[i], a.row_ptr[i + 1], scratch_x_.data()) - lp_->b[i] / r[i];
-        res += ri * ri;
-        by += double(lp_->b[i]) * yhat_[i];
-      }
-      double cx = 0.0, neg = 0.0;
-      for (int64_t j = n_ * t / T, e = n_ * (t + 1) / T; j < e; ++j) {
-        cx += double(lp_->c[j]) * xhat_[j];
-        const double rc = double(lp_->c[j]) / d[j] - double(signed_gather(at, j, scratch_y_.data()));
-        neg += std::min(0.0, rc);
-      }
-      partial_[8 * t] = res;
-      partial_[8 * t + 1] = by;
-      partial_[8 * t + 2] = cx;
-      partial_[8 * t + 3] = neg;
-    });
-    stats.residual2 = sum(0);
-    stats.by = sum(1);
-    stats.cx = sum(2);
-    stats.reduced_neg = sum(3);
+    evaluate_at([&](int64_t j) { return xhat_[j]; }, [&](int64_t i) { return yhat_[i]; }, stats);
   }
 
-  ThreadPool pool_;
-  const ScaledLp* lp_ = nullptr;
-  int64_t n_ = 0, m_ = 0;
-  std::vector<double> x_, x0_, xhat_, xr_, y_, y0_, yhat_, yr_, scratch_x_, scratch_y_;
-  std::vector<int64_t> col_split_, row_split_;  // chunks of Aᵀ's and A's rows of about equal cost
-  std::vector<double> partial_;  // 8 slots per thread, apart enough to avoid false sharing of hot slots
+  std::vector<double> x_, x0_, xhat_, xr_, y_, y0_, yhat_, yr_;
 };
 
 // The native backend with single-precision vectors: about 40 % fewer bytes per iteration (see
@@ -317,16 +343,14 @@ private:
 // cancellation) minus d_j Σ ±r_i δ_i. The Halpern anchor of δ is 0, so y⁰ is not read per
 // iteration either. Sums and every statistic are fp64. Not bit-compatible with the shaders: the
 // fp64 CPU backend stays their oracle.
-class CpuF32Backend final : public PdhgBackend {
+class CpuF32Backend final : public NativeBackend {
 public:
-  explicit CpuF32Backend(int threads) : pool_(threads) {}
+  explicit CpuF32Backend(int threads) : NativeBackend(threads) {}
 
   std::string device() const override { return "cpu fp32 (" + std::to_string(pool_.size()) + " threads)"; }
 
   void load(const ScaledLp& lp, const std::vector<double>& x, const std::vector<double>& y) override {
-    lp_ = &lp;
-    n_ = lp.a->cols;
-    m_ = lp.a->rows;
+    prepare(lp);
     d_.assign(lp.col_scale.begin(), lp.col_scale.end());
     b_.assign(lp.b.begin(), lp.b.end());
     r_.assign(lp.row_scale.begin(), lp.row_scale.end());
@@ -339,9 +363,6 @@ public:
     dhat_.assign(m_, 0.0f);
     dr_.assign(m_, 0.0f);
     g0_.resize(n_);
-    partial_.assign(pool_.size() * 8, 0.0);
-    col_split_ = split_by_cost(*lp.at, pool_.size() * kChunksPerThread);
-    row_split_ = split_by_cost(*lp.a, pool_.size() * kChunksPerThread);
     anchor_reduced_cost();
   }
 
@@ -395,23 +416,6 @@ public:
   }
 
 private:
-  double sum(int slot) const {
-    double s = 0.0;
-    for (int t = 0; t < pool_.size(); ++t) s += partial_[8 * t + slot];
-    return s;
-  }
-
-  // As CpuBackend: cost-balanced chunks, and even thread shares on a batch's last iteration (its
-  // reductions land in partial_[8t]).
-  template <class Kernel>
-  void run_split(bool last, const std::vector<int64_t>& split, int64_t count, Kernel&& kernel) {
-    const int T = pool_.size();
-    if (last)
-      pool_.run(T, [&](int t) { partial_[8 * t] = kernel(count * t / T, count * (t + 1) / T); });
-    else
-      pool_.run(int(split.size()) - 1, [&](int c) { kernel(split[c], split[c + 1]); });
-  }
-
   // g⁰ = c̃ − D_c Ãᵀ… at the anchor, in fp64 (the cancellation happens here, once per restart).
   void anchor_reduced_cost() {
     scratch_y_.resize(m_);
@@ -480,51 +484,15 @@ private:
     return dy2;
   }
 
-  // As CpuBackend::evaluate, at x̂ and ŷ = y⁰ + δ̂, in fp64.
+  // At x̂ and ŷ = y⁰ + δ̂, in fp64.
   void evaluate(BatchStats& stats) {
-    const SignedCsr& a = *lp_->a;
-    const SignedCsr& at = *lp_->at;
-    const double* d = lp_->col_scale.data();
-    const double* r = lp_->row_scale.data();
-    const int T = pool_.size();
-    scratch_x_.resize(n_);
-    scratch_y_.resize(m_);
-    pool_.run(T, [&](int t) {
-      for (int64_t j = n_ * t / T, e = n_ * (t + 1) / T; j < e; ++j) scratch_x_[j] = d[j] * double(xhat_[j]);
-      for (int64_t i = m_ * t / T, e = m_ * (t + 1) / T; i < e; ++i) scratch_y_[i] = r[i] * (y0_[i] + double(dhat_[i]));
-    });
-    pool_.run(T, [&](int t) {
-      double res = 0.0, by = 0.0;
-      for (int64_t i = m_ * t / T, e = m_ * (t + 1) / T; i < e; ++i) {
-        const double ri = a_row_sum(a.entry.data(), a.row_ptr[i], a.row_ptr[i + 1], scratch_x_.data()) - lp_->b[i] / r[i];
-        res += ri * ri;
-        by += lp_->b[i] * (y0_[i] + double(dhat_[i]));
-      }
-      double cx = 0.0, neg = 0.0;
-      for (int64_t j = n_ * t / T, e = n_ * (t + 1) / T; j < e; ++j) {
-        cx += lp_->c[j] * double(xhat_[j]);
-        neg += std::min(0.0, lp_->c[j] / d[j] - signed_gather(at, j, scratch_y_.data()));
-      }
-      partial_[8 * t] = res;
-      partial_[8 * t + 1] = by;
-      partial_[8 * t + 2] = cx;
-      partial_[8 * t + 3] = neg;
-    });
-    stats.residual2 = sum(0);
-    stats.by = sum(1);
-    stats.cx = sum(2);
-    stats.reduced_neg = sum(3);
+    evaluate_at([&](int64_t j) { return double(xhat_[j]); }, [&](int64_t i) { return y0_[i] + double(dhat_[i]); },
+                stats);
   }
 
-  ThreadPool pool_;
-  const ScaledLp* lp_ = nullptr;
-  int64_t n_ = 0, m_ = 0;
   std::vector<float> g0_, d_, x_, x0_, xhat_, xr_;  // columns
   std::vector<float> b_, r_, delta_, dhat_, dr_;    // rows: δ, δ̂ = ŷ − y⁰, r·δ
   std::vector<double> y0_;                          // the dual anchor
-  std::vector<double> scratch_x_, scratch_y_;
-  std::vector<int64_t> col_split_, row_split_;
-  std::vector<double> partial_;
 };
 
 }  // namespace
