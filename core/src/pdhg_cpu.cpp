@@ -339,8 +339,8 @@ private:
 // pdhg_bytes_per_iteration_f32). Plain fp32 iterates stall because c − Aᵀy cancels large duals
 // (docs/architecture.md, "Precision"), so the dual is kept as y = y⁰ + δ: the anchor y⁰ in fp64,
 // the move δ since the last restart in fp32, and the primal kernel reads the anchor's reduced
-// cost g⁰ = c̃ − D_c Ãᵀ… (computed in fp64 at every restart, stored in fp32 after the
-// cancellation) minus d_j Σ ±r_i δ_i. The Halpern anchor of δ is 0, so y⁰ is not read per
+// cost g⁰_j = c̃_j − d_j Σ_i ±r_i y⁰_i (computed in fp64 at every restart, stored in fp32 after
+// the cancellation) minus d_j Σ_i ±r_i δ_i. The Halpern anchor of δ is 0, so y⁰ is not read per
 // iteration either. Sums and every statistic are fp64. Not bit-compatible with the shaders: the
 // fp64 CPU backend stays their oracle.
 class CpuF32Backend final : public NativeBackend {
@@ -416,7 +416,7 @@ public:
   }
 
 private:
-  // g⁰ = c̃ − D_c Ãᵀ… at the anchor, in fp64 (the cancellation happens here, once per restart).
+  // g⁰_j = c̃_j − d_j Σ_i ±r_i y⁰_i, in fp64 (the cancellation happens here, once per restart).
   void anchor_reduced_cost() {
     scratch_y_.resize(m_);
     const int T = pool_.size();
