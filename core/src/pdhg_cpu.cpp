@@ -6,6 +6,7 @@
 #include <array>
 #include <bit>
 #include <cmath>
+#include <type_traits>
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
@@ -140,13 +141,14 @@ protected:
   // kernel(begin, end) over chunks of about equal cost; the last iteration of a batch splits rows
   // evenly, one share per thread into partial_[8t], so that the statistics (and the host's restart
   // decisions on them) do not depend on the cost split.
+  // kernel(std::bool_constant<last>, begin, end).
   template <class Kernel>
   void run_split(bool last, const std::vector<int64_t>& split, int64_t count, Kernel&& kernel) {
     const int T = pool_.size();
     if (last)
-      pool_.run(T, [&](int t) { partial_[8 * t] = kernel(count * t / T, count * (t + 1) / T); });
+      pool_.run(T, [&](int t) { partial_[8 * t] = kernel(std::true_type{}, count * t / T, count * (t + 1) / T); });
     else
-      pool_.run(int(split.size()) - 1, [&](int c) { kernel(split[c], split[c + 1]); });
+      pool_.run(int(split.size()) - 1, [&](int c) { kernel(std::false_type{}, split[c], split[c + 1]); });
   }
 
   // Residual, objective and bound at x̂ = xhat(j), ŷ = yhat(i) (scaled) in original units.
@@ -260,10 +262,7 @@ public:
 
 private:
   void primal(const Step& step, double w, bool last) {
-    if (last)
-      run_split(true, col_split_, n_, [&](int64_t b, int64_t e) { return primal_rows<true>(step, w, b, e); });
-    else
-      run_split(false, col_split_, n_, [&](int64_t b, int64_t e) { return primal_rows<false>(step, w, b, e); });
+    run_split(last, col_split_, n_, [&](auto l, int64_t b, int64_t e) { return primal_rows<l()>(step, w, b, e); });
   }
 
   template <bool Last>
@@ -295,10 +294,7 @@ private:
   }
 
   void dual(const Step& step, double w, bool last) {
-    if (last)
-      run_split(true, row_split_, m_, [&](int64_t b, int64_t e) { return dual_rows<true>(step, w, b, e); });
-    else
-      run_split(false, row_split_, m_, [&](int64_t b, int64_t e) { return dual_rows<false>(step, w, b, e); });
+    run_split(last, row_split_, m_, [&](auto l, int64_t b, int64_t e) { return dual_rows<l()>(step, w, b, e); });
   }
 
   template <bool Last>
@@ -372,15 +368,10 @@ public:
       const bool last = it + 1 == count;
       const double kk = static_cast<double>(k0 + it);
       const double w = (kk + 1.0) / (kk + 2.0);
-      if (last) {
-        run_split(true, col_split_, n_, [&](int64_t b, int64_t e) { return primal_rows<true>(step, w, b, e); });
-        stats.dx2 = sum(0);
-        run_split(true, row_split_, m_, [&](int64_t b, int64_t e) { return dual_rows<true>(step, w, b, e); });
-        stats.dy2 = sum(0);
-      } else {
-        run_split(false, col_split_, n_, [&](int64_t b, int64_t e) { return primal_rows<false>(step, w, b, e); });
-        run_split(false, row_split_, m_, [&](int64_t b, int64_t e) { return dual_rows<false>(step, w, b, e); });
-      }
+      run_split(last, col_split_, n_, [&](auto l, int64_t b, int64_t e) { return primal_rows<l()>(step, w, b, e); });
+      if (last) stats.dx2 = sum(0);
+      run_split(last, row_split_, m_, [&](auto l, int64_t b, int64_t e) { return dual_rows<l()>(step, w, b, e); });
+      if (last) stats.dy2 = sum(0);
     }
     evaluate(stats);
     return stats;
