@@ -407,36 +407,6 @@ TEST_CASE("rounding: propagation names the row of a contradiction, and skipped r
   }
 }
 
-TEST_CASE("rounding: propagation's proof holds the rows that forced the contradiction, nearest first") {
-  // Row 0: x0 + x1 = 1 needs a 1, but row 1 (x1 = 0) zeroes x1, row 3 (x2 = 0) zeroes x2 and row 2
-  // (x0 − x2 = 0) then x0. Row 4 (x3 + x4 = 1) has nothing to do with it.
-  const LpProblem chain = test::dense_lp({{1, 1, 0, 0, 0},
-                                          {0, 1, 0, 0, 0},
-                                          {1, 0, -1, 0, 0},
-                                          {0, 0, 1, 0, 0},
-                                          {0, 0, 0, 1, 1}},
-                                         {1, 0, 0, 0, 1}, {0, 0, 0, 0, 0});
-  const std::vector<int64_t> proof = propagation_proof(chain);
-  REQUIRE(!proof.empty());
-  CHECK(proof.front() == propagation_conflict(chain));
-  std::vector<int64_t> sorted = proof;
-  std::sort(sorted.begin(), sorted.end());
-  CHECK(sorted == std::vector<int64_t>{0, 1, 2, 3});
-  // Capped: the contradiction's row comes first.
-  const std::vector<int64_t> one = propagation_proof(chain, {}, 1);
-  REQUIRE(one.size() == 1);
-  CHECK(one[0] == proof.front());
-  // Without row 3, x2 and x0 stay free: no contradiction, no proof.
-  CHECK(propagation_proof(chain, {0, 0, 0, 1, 0}).empty());
-  // x0 = 1 and x1 = 1, each by its own row, against x0 + x1 = 1: the proof names all three.
-  const LpProblem clash = test::dense_lp({{1, 1}, {1, 0}, {0, 1}, {1, -1}}, {1, 1, 1, 0}, {0, 0});
-  const std::vector<int64_t> both = propagation_proof(clash, {0, 0, 0, 1});
-  std::vector<int64_t> b = both;
-  std::sort(b.begin(), b.end());
-  CHECK(b == std::vector<int64_t>{0, 1, 2});
-  CHECK(propagation_proof(test::dense_lp({{1, 1, 0}, {0, 1, 1}}, {1, 1}, {0, 0, 0})).empty());
-}
-
 TEST_CASE("rounding: a batch full of clashing candidates still ends in an exact graph surface, halved or greedy") {
   // Threshold 0: every variable the LP touches is a candidate, so fixings clash with larger ones
   // and must be taken back exactly (propagation included). Measured: fixing every candidate that

@@ -30,9 +30,7 @@ void sort_unique(std::vector<int>& v) {
 struct ProofPlace {
   std::vector<char> x, y;  // per vertex
   explicit ProofPlace(const MatchingLp& m) : x(m.space.x().num_vertices(), 0), y(m.space.y().num_vertices(), 0) {}
-  // The row's own face (a π row) and, with `columns` (always for a closedness row), the vertices
-  // of every variable in it.
-  void add(const MatchingLp& m, int64_t row, bool columns = true) {
+  void add(const MatchingLp& m, int64_t row) {
     if (row < 0 || row >= m.lp.rows()) return;
     const int64_t face = row - m.closedness_rows;
     const int fx = m.space.x().num_faces();
@@ -40,7 +38,6 @@ struct ProofPlace {
       for (int v : m.space.x().faces[face]) x[v] = 1;
     else if (face >= fx)
       for (int v : m.space.y().faces[face - fx]) y[v] = 1;
-    if (!columns && face >= 0) return;
     for (uint32_t k = m.lp.a.row_ptr[row]; k < m.lp.a.row_ptr[row + 1]; ++k) {
       const ProductTriangle t = m.space[col_of(m.lp.a.entry[k])];
       for (int v : t.a) x[v] = 1;
@@ -195,48 +192,27 @@ constexpr int kMaxRingBeyond = 3;
 constexpr int kMaxMarginBoost = 3;
 // The last local widening of a level: every X face this many rings around the earlier ones.
 constexpr int kRegionRings = 8;
-// Rows of a propagation proof that locate it (nearest the contradiction first). Measured, FAUST_r
-// 065-069 at full resolution: with the contradiction's row alone, one Y face's row (639
-// variables, all zeroed by propagation) came back after 27 widenings around its preimages.
-constexpr int64_t kProofRows = 256;
-
-// A row's identity across rebuilds of a level's space: its product edge, or its face.
-uint64_t row_key(const MatchingLp& m, int64_t row) {
-  const int64_t face = row - m.closedness_rows;
-  if (face < 0) return static_cast<uint64_t>(m.row_edge[row]) << 2;
-  const int fx = m.space.x().num_faces();
-  return face < fx ? (static_cast<uint64_t>(face) << 2) | 1 : (static_cast<uint64_t>(face - fx) << 2) | 2;
-}
 
 // Every place where unit propagation proves a reduced LP infeasible: after each contradiction
 // the rows of every variable over the X faces near it are set aside, so that the next pass finds
 // the next independent one (at most `max_places`). Adds them all to `place`; returns how many.
-// A place is its contradiction's row; where that row already failed at an earlier attempt of the
-// level (`seen`, by row_key), widening there did not help, and the place is the whole proof.
-int conflict_places(const MatchingLp& m, int max_places, int margin, ProofPlace& place, std::vector<uint64_t>& seen) {
+int conflict_places(const MatchingLp& m, int max_places, int margin, ProofPlace& place) {
   const Mesh& X = m.space.x();
   std::vector<char> skip(m.lp.rows(), 0), set_aside(X.num_vertices(), 0);
   int places = 0;
   for (; places < max_places; ++places) {
-    const std::vector<int64_t> proof = propagation_proof(m.lp, skip, kProofRows);
-    if (proof.empty()) break;
-    const int64_t row = proof.front();
+    const int64_t row = propagation_conflict(m.lp, skip);
+    if (row < 0) break;
     skip[row] = 1;
     const int64_t face = row - m.closedness_rows;
-    const uint64_t key = row_key(m, row);
-    const bool again = std::find(seen.begin(), seen.end(), key) != seen.end();
-    if (!again) seen.push_back(key);
-    spdlog::debug("propagation: conflict in row {} ({}), {} variables, proof of {} rows{}", row,
+    spdlog::debug("propagation: conflict in row {} ({}), {} variables", row,
                   face < 0                 ? std::string("closedness")
                   : face < X.num_faces()   ? "X face " + std::to_string(face)
                                            : "Y face " + std::to_string(face - X.num_faces()),
-                  m.lp.a.row_ptr[row + 1] - m.lp.a.row_ptr[row], proof.size(), again ? " (again: widening along it)" : "");
+                  m.lp.a.row_ptr[row + 1] - m.lp.a.row_ptr[row]);
     ProofPlace here(m);
-    for (size_t q = 0; q < (again ? proof.size() : 1); ++q) {
-      // Beyond the contradiction's own row only where the proof passes: a π row's own face.
-      here.add(m, proof[q], q == 0);
-      place.add(m, proof[q], q == 0);
-    }
+    here.add(m, row);
+    place.add(m, row);
     for (int f : faces_on(X, here.x, 1 + margin))
       for (int v : X.faces[f]) set_aside[v] = 1;
     // Threads may mark the same row: atomically (each writes the same 1).
@@ -731,7 +707,6 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
   // (max_propagation_widenings): they cost a rebuild, not an LP.
   int propagated = 0;
   bool propagating = false;
-  std::vector<uint64_t> conflicts_seen;  // row_key of every propagation contradiction so far
   // One more fine ring on these faces (up to `cap` rings); false if none could grow. `last`: the
   // level's regional widening, which comes after max_local_widenings.
   auto widen_locally = [&](const std::vector<int>& faces, const char* why, int cap, bool last = false) {
@@ -841,8 +816,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
       ProofPlace place(m);
       propagating = true;
       const bool widened =
-          conflict_places(m, kMaxConflictPlaces, options_.widen_margin, place, conflicts_seen) > 0 &&
-          widen_at(m, place, "infeasible");
+          conflict_places(m, kMaxConflictPlaces, options_.widen_margin, place) > 0 && widen_at(m, place, "infeasible");
       propagating = false;
       if (widened) continue;
       if (options_.widen_around > 0 && !around_done && local + propagated > 0) {

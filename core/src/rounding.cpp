@@ -83,36 +83,6 @@ public:
   }
   // The row at which the last failed propagation found a contradiction.
   int64_t failed_row() const { return failed_row_; }
-  // Where that row found a variable already fixed the other way: the variable (else -1).
-  int64_t failed_col() const { return failed_col_; }
-
-  // From now on, record for each variable propagation fixes the row that forced it (conflict
-  // analysis; 4 bytes per variable).
-  void track_reasons() { reason_.assign(lp_.cols(), -1); }
-  // The rows of the last contradiction's proof, nearest first: the failed row, then the rows that
-  // forced the fixed variables in it, and theirs, up to `max_rows` (needs track_reasons). Each
-  // comes with the fixed variables through which it was reached.
-  std::vector<int64_t> proof_rows(int64_t max_rows) const {
-    std::vector<int64_t> rows;
-    if (failed_row_ < 0 || reason_.empty()) return rows;
-    std::vector<char> seen(lp_.rows(), 0);
-    auto visit = [&](int64_t i) {
-      if (i >= 0 && !seen[i] && static_cast<int64_t>(rows.size()) < max_rows) {
-        seen[i] = 1;
-        rows.push_back(i);
-      }
-    };
-    visit(failed_row_);
-    if (failed_col_ >= 0) visit(reason_[failed_col_]);
-    for (size_t q = 0; q < rows.size(); ++q) {
-      const int64_t i = rows[q];
-      for (uint32_t k = lp_.a.row_ptr[i]; k < lp_.a.row_ptr[i + 1]; ++k) {
-        const int64_t j = col_of(lp_.a.entry[k]);
-        if (s_.value[j] >= 0) visit(reason_[j]);
-      }
-    }
-    return rows;
-  }
 
   // Fixes the variables and propagates; false if that proves the system infeasible.
   bool fix(const std::vector<std::pair<int64_t, int>>& assignments) {
@@ -135,14 +105,9 @@ public:
   }
 
 private:
-  bool assign(int64_t j, int v, std::deque<int64_t>& queue, int64_t reason = -1) {
-    if (s_.value[j] >= 0) {
-      if (s_.value[j] == v) return true;
-      failed_col_ = j;
-      return false;
-    }
+  bool assign(int64_t j, int v, std::deque<int64_t>& queue) {
+    if (s_.value[j] >= 0) return s_.value[j] == v;
     s_.value[j] = static_cast<int8_t>(v);
-    if (!reason_.empty()) reason_[j] = static_cast<int32_t>(reason);
     trail_.push_back(static_cast<uint32_t>(j));  // < 2^31 columns (build_constraints checks)
     ++(v ? s_.ones : s_.zeros);
     for (uint32_t k = lp_.at.row_ptr[j]; k < lp_.at.row_ptr[j + 1]; ++k) {
@@ -170,7 +135,6 @@ private:
       if (skip_ && (*skip_)[i]) continue;
       if (r > pos || r < -neg) {
         failed_row_ = i;
-        failed_col_ = -1;
         return false;
       }
       if (pos + neg == 0 || (r != pos && r != -neg)) continue;
@@ -181,7 +145,7 @@ private:
         const int64_t j = col_of(e);
         if (s_.value[j] >= 0) continue;
         const int v = (is_negative(e) != plus_is_one) ? 1 : 0;
-        if (!assign(j, v, queue, i)) {
+        if (!assign(j, v, queue)) {
           failed_row_ = i;
           return false;
         }
@@ -193,8 +157,6 @@ private:
   const LpProblem& lp_;
   FixState s_;
   int64_t failed_row_ = -1;
-  int64_t failed_col_ = -1;
-  std::vector<int32_t> reason_;  // per variable: the row that forced it (-1: fixed by a caller)
   std::vector<uint32_t> trail_;  // assigned variables, in order
   const std::vector<char>* skip_ = nullptr;
 };
@@ -745,15 +707,6 @@ int64_t propagation_conflict(const LpProblem& lp, const std::vector<char>& skip)
     throw InvalidInputError("propagation: need one skip flag per row");
   Fixer fixer(lp);
   return fixer.propagate_all(skip.empty() ? nullptr : &skip) ? -1 : fixer.failed_row();
-}
-
-std::vector<int64_t> propagation_proof(const LpProblem& lp, const std::vector<char>& skip, int64_t max_rows) {
-  if (!skip.empty() && static_cast<int64_t>(skip.size()) != lp.rows())
-    throw InvalidInputError("propagation: need one skip flag per row");
-  Fixer fixer(lp);
-  fixer.track_reasons();
-  if (fixer.propagate_all(skip.empty() ? nullptr : &skip)) return {};
-  return fixer.proof_rows(std::max<int64_t>(1, max_rows));
 }
 
 std::vector<int64_t> close_pockets(const ProductSpace& space, const std::vector<int64_t>& gamma, int64_t* closed) {

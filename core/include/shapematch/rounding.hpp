@@ -209,13 +209,6 @@ double relative_gap(double energy, double bound);
 // Unit propagation of A x = b over binary x with nothing fixed, leaving out the rows marked in
 // `skip` (empty: none): the row where it finds a contradiction, or -1 if it finds none.
 int64_t propagation_conflict(const LpProblem& lp, const std::vector<char>& skip = {});
-// The same with its proof: the row of the contradiction first, then, nearest first, the rows
-// whose propagation fixed the variables that made it (and theirs), up to `max_rows`; empty if
-// there is no contradiction. Where a reduced LP is too narrow, the contradiction's row often
-// lies far from the rows that emptied it (a Y face whose every preimage propagation zeroed at
-// the tube's edge): widening at its row alone does not remove it.
-std::vector<int64_t> propagation_proof(const LpProblem& lp, const std::vector<char>& skip = {},
-                                       int64_t max_rows = 256);
 
 // A pocket: an edge u-w of X stretched over the whole star of a connected set K of vertices of
 // Y, u paired with exactly K and w with the star's rim (product triangles (u, w, w) x (k, b1, b2)
