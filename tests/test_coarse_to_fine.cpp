@@ -561,21 +561,25 @@ TEST_CASE("coarse to fine: the second start solves the second level twice and ke
 }
 
 TEST_CASE("coarse to fine: lookahead refines both Γ of the second level and keeps the lower energy further up") {
+  // Two dolphins, whose chains still differ at the second level (on the finger pair both found
+  // the same Γ there and went on as one).
+  const Mesh dx = decimate(shapes::dolphin(20, 0), 80), dy = decimate(shapes::dolphin(-20, 40), 90);
+  auto dolphin_matcher = [&](const CoarseToFineOptions& options) { return CoarseToFineMatcher(dx, dy, options); };
   CoarseToFineOptions o;
   o.hierarchy.coarsest_faces = 12;
   o.hierarchy.second_faces = 24;
   o.hierarchy.ratio = 1.6;
   o.rounding.solver = "pdhg-cpu";
   o.lookahead_levels = 0;
-  const CoarseToFineMatcher plain_matcher = finger_matcher(o);  // decided at the second level
+  const CoarseToFineMatcher plain_matcher = dolphin_matcher(o);  // decided at the second level
   REQUIRE(plain_matcher.x_levels().size() == 5);
   const CoarseToFineResult plain = plain_matcher.run();
   o.second_start = false;
-  const CoarseToFineMatcher refined_matcher = finger_matcher(o);  // the refined chain alone
+  const CoarseToFineMatcher refined_matcher = dolphin_matcher(o);  // the refined chain alone
   const CoarseToFineResult refined = refined_matcher.run();
   o.second_start = true;
   o.lookahead_levels = 2;
-  const CoarseToFineMatcher matcher = finger_matcher(o);
+  const CoarseToFineMatcher matcher = dolphin_matcher(o);
   const CoarseToFineResult r = matcher.run();
   REQUIRE(r.levels.size() == 5);
   CHECK(check_graph_surface(r.finest.space, r.rounding.gamma).ok());
@@ -600,6 +604,34 @@ TEST_CASE("coarse to fine: lookahead refines both Γ of the second level and kee
   CHECK(r.levels[1].second_start_kept == (plain.levels[1].second_start_kept != d.lookahead_switched));
   if (!d.lookahead_switched)
     for (int l : {1, 2}) CHECK(r.levels[l].energy == doctest::Approx(plain.levels[l].energy).epsilon(1e-12));
+}
+
+TEST_CASE("coarse to fine: two lookahead chains that reach the same Γ go on as one, with the same result") {
+  // A shape against itself: the second start and the refined chain both find the identity at the
+  // second level, so lookahead has nothing to compare there or above.
+  CoarseToFineOptions o;
+  o.hierarchy.coarsest_faces = 12;
+  o.hierarchy.second_faces = 24;
+  o.hierarchy.ratio = 1.6;
+  o.rounding.solver = "pdhg-cpu";
+  const Mesh finger = decimate(shapes::bent_finger(30, 8, 8), 80);
+  o.lookahead_levels = 0;
+  const CoarseToFineMatcher plain_matcher(finger, finger, o);
+  const CoarseToFineResult plain = plain_matcher.run();
+  o.lookahead_levels = 2;
+  const CoarseToFineMatcher matcher(finger, finger, o);
+  const CoarseToFineResult r = matcher.run();
+  REQUIRE(r.levels.size() == plain.levels.size());
+  REQUIRE(r.levels.size() >= 4);
+  // Merged where they met: at the second level, the other chain's energy recorded there only.
+  CHECK(r.levels[1].lookahead_other_energy == r.levels[1].energy);
+  for (size_t l = 0; l < r.levels.size(); ++l) {
+    if (l != 1) CHECK(std::isnan(r.levels[l].lookahead_other_energy));
+    CHECK(!r.levels[l].lookahead_switched);
+    CHECK(r.levels[l].energy == doctest::Approx(plain.levels[l].energy).epsilon(1e-12));
+    CHECK(r.levels[l].variables == plain.levels[l].variables);
+  }
+  CHECK(check_graph_surface(r.finest.space, r.rounding.gamma).ok());
 }
 
 TEST_CASE("coarse to fine: a stuck rounding widens around its failed parts and goes on from its fixings") {

@@ -387,6 +387,19 @@ std::vector<ProductTriangle> reduced_product_space(const MeshLevel& fine_x, cons
 
 namespace {
 
+// The same product triangles, in any order.
+bool same_surface(const std::vector<ProductTriangle>& g, const std::vector<ProductTriangle>& h) {
+  if (g.size() != h.size()) return false;
+  auto sorted = [](const std::vector<ProductTriangle>& v) {
+    std::vector<std::pair<std::array<int, 3>, std::array<int, 3>>> k;
+    k.reserve(v.size());
+    for (const ProductTriangle& t : v) k.emplace_back(t.a, t.b);
+    std::sort(k.begin(), k.end());
+    return k;
+  };
+  return sorted(g) == sorted(h);
+}
+
 // A level's rounding result becomes its report's numbers and the Γ the next level refines.
 void accept(const MatchingLp& m, const RoundingResult& rr, LevelReport& rep, std::vector<ProductTriangle>& gamma) {
   rep.rounds = static_cast<int>(rr.rounds.size());
@@ -517,6 +530,16 @@ CoarseToFineResult CoarseToFineMatcher::run(const Progress& progress) const {
     for (Chain& c : chains) {
       c.pending.back().seconds = seconds;
       c.pending.back().peak_rss_mb = rss;
+    }
+    // Two chains that reached the same Γ would repeat each other's every LP from here on (FAUST_r
+    // 065-069 at full resolution: the same 1 414-face level solved twice, 95 s of 191): the
+    // leading one goes on alone, as the decision would keep it on a tie.
+    if (chains.size() > 1 && l < decide_at && same_surface(chains[0].gamma, chains[1].gamma) &&
+        (options_.inherit_widening == 0 || chains[0].widened == chains[1].widened)) {
+      chains[0].pending.back().lookahead_other_energy = chains[1].pending.back().energy;
+      spdlog::info("level {}: both chains reached the same Γ (energy {:.6g}): one goes on", l + 1,
+                   chains[0].pending.back().energy);
+      chains.pop_back();
     }
     if (chains.size() > 1 && l >= decide_at) {
       const size_t best = chains[1].pending.back().energy < chains[0].pending.back().energy ? 1 : 0;
