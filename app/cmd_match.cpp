@@ -57,6 +57,7 @@ struct MatchArgs {
   int y_margin = CoarseToFineOptions{}.y_margin;
   int max_local_widenings = CoarseToFineOptions{}.max_local_widenings;
   int max_propagation_widenings = CoarseToFineOptions{}.max_propagation_widenings;
+  int recurring_margin = CoarseToFineOptions{}.recurring_margin;
   bool warm_widening = CoarseToFineOptions{}.warm_widening;
   bool carry_primal_weight = CoarseToFineOptions{}.carry_primal_weight;
   int inherit_widening = CoarseToFineOptions{}.inherit_widening;
@@ -132,6 +133,7 @@ int run_match(const MatchArgs& args) {
   co.y_margin = args.y_margin;
   co.max_local_widenings = args.max_local_widenings;
   co.max_propagation_widenings = args.max_propagation_widenings;
+  co.recurring_margin = args.recurring_margin;
   co.warm_widening = args.warm_widening;
   co.carry_primal_weight = args.carry_primal_weight;
   co.inherit_widening = args.inherit_widening;
@@ -365,6 +367,7 @@ int run_match(const MatchArgs& args) {
                               .set("y_margin", args.y_margin)
                               .set("max_local_widenings", args.max_local_widenings)
                               .set("max_propagation_widenings", args.max_propagation_widenings)
+                              .set("recurring_margin", args.recurring_margin)
                               .set("warm_widening", args.warm_widening)
                               .set("carry_primal_weight", args.carry_primal_weight)
                               .set("inherit_widening", args.inherit_widening)
@@ -395,6 +398,7 @@ int run_match(const MatchArgs& args) {
                       .set("stuck_widenings", l.stuck_widenings)
                       .set("price_widenings", l.price_widenings)
                       .set("propagation_widenings", l.propagation_widenings)
+                      .set("recurring_widenings", l.recurring_widenings)
                       .set("inherited_faces", l.inherited_faces)
                       .set("carried_fixings", l.carried_fixings)
                       .set("iterations_bound", l.iterations_bound)
@@ -567,6 +571,11 @@ Action add_match_command(CLI::App& app) {
   app.add_option("--max-propagation-widenings", a->max_propagation_widenings,
                  "local widenings per level where unit propagation found the contradiction (before any LP)")
       ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  app.add_option("--recurring-margin", a->recurring_margin,
+                 "where propagation's contradiction comes back in the same π row, the k-th time widen X faces "
+                 "within 1 + this·k rings of it to the largest ring at once (0: off)")
+      ->check(CLI::Range(0, 64))
       ->capture_default_str();
   app.add_option("--widen-margin", a->widen_margin, "fine rings of faces around the proof that widen with it")
       ->check(CLI::Range(0, 64))

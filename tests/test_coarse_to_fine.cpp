@@ -1,4 +1,5 @@
 #include "key_set.hpp"
+#include "recurring_conflicts.hpp"
 #include "shapematch/coarse_to_fine.hpp"
 #include "shapematch/errors.hpp"
 #include "shapematch/evaluation.hpp"
@@ -328,6 +329,16 @@ TEST_CASE("coarse to fine: an infeasible reduced LP is widened near the proof, n
     variables[local ? 0 : 1] = l.variables;
   }
   CHECK(variables[0] < variables[1]);
+  {
+    // No contradiction comes back here: widening wider where one does changes nothing.
+    o.local_widening = true;
+    o.recurring_margin = 0;
+    const CoarseToFineMatcher off = finger_matcher(o);
+    const CoarseToFineResult r = off.run();
+    CHECK(r.levels.back().recurring_widenings == 0);
+    CHECK(r.levels.back().variables == variables[0]);
+    o.recurring_margin = CoarseToFineOptions{}.recurring_margin;
+  }
   // Propagation's widenings have a budget of their own: the same without any of the other kind.
   o.local_widening = true;
   o.max_local_widenings = 0;
@@ -763,4 +774,17 @@ TEST_CASE("KeySet: exactly the keys it was given, 0 and colliding slots included
   CHECK(absent > 19000);
   CHECK_FALSE(detail::KeySet({1, 2, 3}).contains(0));
   CHECK(detail::KeySet({}).contains(5) == false);
+}
+
+TEST_CASE("coarse to fine: a contradiction counts as back only in the π row of the same face") {
+  detail::RecurringConflicts r;
+  std::vector<int64_t> back;
+  CHECK(r.record({7, 3}, back) == 0);
+  CHECK(back.empty());
+  CHECK(r.record({3, 3, 9}, back) == 1);  // 3 again (once, though listed twice); 9 new
+  CHECK(back == std::vector<int64_t>{3});
+  CHECK(r.record({9, 3}, back) == 2);  // 3 a third time, 9 a second
+  CHECK(back == std::vector<int64_t>{3, 9});
+  CHECK(r.record({}, back) == 0);
+  CHECK(back.empty());
 }

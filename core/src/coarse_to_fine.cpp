@@ -6,6 +6,7 @@
 
 #include "key_set.hpp"
 #include "parallel.hpp"
+#include "recurring_conflicts.hpp"
 
 #include <spdlog/spdlog.h>
 
@@ -195,8 +196,10 @@ constexpr int kRegionRings = 8;
 
 // Every place where unit propagation proves a reduced LP infeasible: after each contradiction
 // the rows of every variable over the X faces near it are set aside, so that the next pass finds
-// the next independent one (at most `max_places`). Adds them all to `place`; returns how many.
-int conflict_places(const MatchingLp& m, int max_places, int margin, ProofPlace& place) {
+// the next independent one (at most `max_places`). Adds them all to `place`, and the faces of the
+// π rows among them (row − closedness rows: X faces, then Y faces) to `pi_faces`; returns how many.
+int conflict_places(const MatchingLp& m, int max_places, int margin, ProofPlace& place,
+                    std::vector<int64_t>& pi_faces) {
   const Mesh& X = m.space.x();
   std::vector<char> skip(m.lp.rows(), 0), set_aside(X.num_vertices(), 0);
   int places = 0;
@@ -210,6 +213,7 @@ int conflict_places(const MatchingLp& m, int max_places, int margin, ProofPlace&
                   : face < X.num_faces()   ? "X face " + std::to_string(face)
                                            : "Y face " + std::to_string(face - X.num_faces()),
                   m.lp.a.row_ptr[row + 1] - m.lp.a.row_ptr[row]);
+    if (face >= 0) pi_faces.push_back(face);
     ProofPlace here(m);
     here.add(m, row);
     place.add(m, row);
@@ -730,9 +734,12 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
   // (max_propagation_widenings): they cost a rebuild, not an LP.
   int propagated = 0;
   bool propagating = false;
+  detail::RecurringConflicts recurring;  // π rows where propagation failed, by face
   // One more fine ring on these faces (up to `cap` rings); false if none could grow. `last`: the
   // level's regional widening, which comes after max_local_widenings.
-  auto widen_locally = [&](const std::vector<int>& faces, const char* why, int cap, bool last = false) {
+  // `to_cap`: straight to `cap` rings, not one more.
+  auto widen_locally = [&](const std::vector<int>& faces, const char* why, int cap, bool last = false,
+                           bool to_cap = false) {
     if (!options_.local_widening) return false;
     if (propagating ? propagated >= options_.max_propagation_widenings
                     : local >= options_.max_local_widenings && !last)
@@ -741,7 +748,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
     int64_t widened = 0;
     for (int f : faces)
       if (ring + extra[f] < cap) {
-        ++extra[f];
+        extra[f] = to_cap ? cap - ring : extra[f] + 1;
         ++widened;
       }
     if (widened == 0) return false;
@@ -837,9 +844,28 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
     // Propagation alone proves most reduced LPs infeasible, and says where: widen there first.
     if (l > 0 && options_.local_widening) {
       ProofPlace place(m);
+      std::vector<int64_t> pi_faces;
       propagating = true;
-      const bool widened =
-          conflict_places(m, kMaxConflictPlaces, options_.widen_margin, place) > 0 && widen_at(m, place, "infeasible");
+      const bool found = conflict_places(m, kMaxConflictPlaces, options_.widen_margin, place, pi_faces) > 0;
+      // π rows whose contradiction came back after a widening there: wider around them, to the cap.
+      bool widened = false;
+      if (found && options_.recurring_margin > 0) {
+        std::vector<int64_t> back;
+        const int returns = recurring.record(pi_faces, back);
+        ProofPlace again(m);
+        for (int64_t f : back) again.add(m, m.closedness_rows + f);
+        const int margin = options_.widen_margin + options_.recurring_margin * returns;
+        widened = returns > 0 && widen_locally(faces_to_widen(m, again, margin, true),
+                                               "infeasible (a contradiction came back)",
+                                               options_.max_ring + kMaxRingBeyond, false, true);
+        if (widened) {
+          ++rep.recurring_widenings;
+          spdlog::info("level {}: the same π row's contradiction came back ({} times): widened {} rings around it "
+                       "to ring {}",
+                       l + 1, returns, 1 + margin, options_.max_ring + kMaxRingBeyond);
+        }
+      }
+      if (found && !widened) widened = widen_at(m, place, "infeasible");
       propagating = false;
       if (widened) continue;
       if (options_.widen_around > 0 && !around_done && local + propagated > 0) {

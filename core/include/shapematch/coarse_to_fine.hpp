@@ -84,6 +84,13 @@ struct CoarseToFineOptions {
   // up max_local_widenings, and the ring then widened everywhere (4.9 M → 9.0 M and 10.1 M
   // variables; 508 s with a gap of 7.4 %, and over 600 s).
   int max_propagation_widenings = 64;
+  // Where propagation's contradiction comes back in the π row of the same face after a widening
+  // there, the widening missed it: the k-th return widens every X face within
+  // 1 + recurring_margin·(k − 1) fine rings of the proof (and those that map next to its Y side)
+  // at once to max_ring + 3, instead of one ring at a time. 0: off. Measured, FAUST_r 065-069 at
+  // full resolution: 27 of level 6's 52 propagation widenings were Y face 6 939's π row (639
+  // variables every time), in 4-step series per place (docs/results.md, twenty-fifth session).
+  int recurring_margin = 2;
   // Start the first LP of a widened space from the previous attempt's iterate (its dual reset
   // where it diverged), by variable and row identity. Off: measured at full resolution (FAUST_r
   // 020-024) after a diverging attempt, the widened LP took 3 008 iterations warm against 2 048
@@ -226,6 +233,7 @@ struct LevelReport {
   int stuck_widenings = 0;     // of the local widenings, those where rounding was stuck (stuck_after)
   int price_widenings = 0;     // of the local widenings, those where pricing found columns below zero
   int propagation_widenings = 0;  // of the local widenings, those where propagation found the contradiction
+  int recurring_widenings = 0;    // of those, where it came back in the same π row (recurring_margin)
   int64_t inherited_faces = 0; // fine X faces that started with extra rings (inherit_widening)
   int64_t carried_fixings = 0; // fixings to 1 the last of those went on from
   int64_t iterations_bound = 0;  // of the LP solved again for the bound after one
