@@ -86,7 +86,7 @@ struct CoarseToFineOptions {
   int max_propagation_widenings = 64;
   // Where propagation's contradiction comes back in the π row of the same face after a widening
   // there, the widening missed it: the k-th return widens every X face within
-  // 1 + recurring_margin·(k − 1) fine rings of the proof (and those that map next to its Y side)
+  // 1 + recurring_margin·k fine rings of the proof (and those that map next to its Y side)
   // at once to max_ring + 3, instead of one ring at a time. 0: off. Measured, FAUST_r 065-069 at
   // full resolution: 27 of level 6's 52 propagation widenings were Y face 6 939's π row (639
   // variables every time), in 4-step series per place (docs/results.md, twenty-fifth session).
