@@ -849,15 +849,14 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
       const bool found = conflict_places(m, kMaxConflictPlaces, options_.widen_margin, place, pi_faces) > 0;
       // π rows whose contradiction came back after a widening there: wider around them, to the cap.
       bool widened = false;
-      if (found && options_.recurring_margin > 0) {
-        std::vector<int64_t> back;
-        const int returns = recurring.record(pi_faces, back);
+      std::vector<int64_t> back;
+      const int returns = found && options_.recurring_margin > 0 ? recurring.record(pi_faces, back) : 0;
+      if (returns > 0) {
         ProofPlace again(m);
         for (int64_t f : back) again.add(m, m.closedness_rows + f);
         const int margin = options_.widen_margin + options_.recurring_margin * returns;
-        widened = returns > 0 && widen_locally(faces_to_widen(m, again, margin, true),
-                                               "infeasible (a contradiction came back)",
-                                               options_.max_ring + kMaxRingBeyond, false, true);
+        widened = widen_locally(faces_to_widen(m, again, margin, true), "infeasible (a contradiction came back)",
+                                options_.max_ring + kMaxRingBeyond, false, true);
         if (widened) {
           ++rep.recurring_widenings;
           spdlog::info("level {}: the same π row's contradiction came back ({} times): widened {} rings around it "
