@@ -58,6 +58,8 @@ struct MatchArgs {
   int max_local_widenings = CoarseToFineOptions{}.max_local_widenings;
   int max_propagation_widenings = CoarseToFineOptions{}.max_propagation_widenings;
   int recurring_margin = CoarseToFineOptions{}.recurring_margin;
+  bool watch_resolve = false;
+  double second_start_budget = CoarseToFineOptions{}.second_start_budget;
   bool warm_widening = CoarseToFineOptions{}.warm_widening;
   bool carry_primal_weight = CoarseToFineOptions{}.carry_primal_weight;
   int inherit_widening = CoarseToFineOptions{}.inherit_widening;
@@ -134,6 +136,8 @@ int run_match(const MatchArgs& args) {
   co.max_local_widenings = args.max_local_widenings;
   co.max_propagation_widenings = args.max_propagation_widenings;
   co.recurring_margin = args.recurring_margin;
+  co.watch_resolve = args.watch_resolve;
+  co.second_start_budget = args.second_start_budget;
   co.warm_widening = args.warm_widening;
   co.carry_primal_weight = args.carry_primal_weight;
   co.inherit_widening = args.inherit_widening;
@@ -368,6 +372,8 @@ int run_match(const MatchArgs& args) {
                               .set("max_local_widenings", args.max_local_widenings)
                               .set("max_propagation_widenings", args.max_propagation_widenings)
                               .set("recurring_margin", args.recurring_margin)
+                              .set("watch_resolve", args.watch_resolve)
+                              .set("second_start_budget", args.second_start_budget)
                               .set("warm_widening", args.warm_widening)
                               .set("carry_primal_weight", args.carry_primal_weight)
                               .set("inherit_widening", args.inherit_widening)
@@ -577,6 +583,14 @@ Action add_match_command(CLI::App& app) {
                  "within 1 + this·k rings of it to the largest ring at once (0: off)")
       ->check(CLI::Range(0, 64))
       ->capture_default_str();
+  app.add_option("--second-start-budget", a->second_start_budget,
+                 "beside a refined Γ, the second start's rounding gives up once its rounds after the first did this "
+                 "many times its first LP's work (iterations × variables), the alternative thresholds still trying (0: no budget)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  app.add_flag("--watch-resolve", a->watch_resolve,
+               "let the divergence watch stop the re-solve after pricing too (off: it starts at the optimum of a "
+               "space it contains and stops at the cold first LP's iterations)");
   app.add_option("--widen-margin", a->widen_margin, "fine rings of faces around the proof that widen with it")
       ->check(CLI::Range(0, 64))
       ->capture_default_str();

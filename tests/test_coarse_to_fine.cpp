@@ -1,3 +1,4 @@
+#include "divergence_rule.hpp"
 #include "key_set.hpp"
 #include "recurring_conflicts.hpp"
 #include "shapematch/coarse_to_fine.hpp"
@@ -787,4 +788,27 @@ TEST_CASE("coarse to fine: a contradiction counts as back only in the π row of 
   CHECK(back == std::vector<int64_t>{3, 9});
   CHECK(r.record({}, back) == 0);
   CHECK(back.empty());
+}
+
+TEST_CASE("coarse to fine: the divergence watch stops first LPs with widenings left, not the re-solve after pricing") {
+  using detail::FirstLpState;
+  using detail::watch_divergence;
+  const FirstLpState first{.refined = true, .widenings_left = true, .trusted = true};
+  CHECK(watch_divergence(first));
+  FirstLpState s = first;
+  s.refined = false;  // the coarsest level is the full space: nothing to widen
+  CHECK_FALSE(watch_divergence(s));
+  s = first;
+  s.widenings_left = false;  // the last attempts wait for a proof
+  CHECK_FALSE(watch_divergence(s));
+  s = first;
+  s.trusted = false;  // a suspicion came to nothing at this level
+  CHECK_FALSE(watch_divergence(s));
+  s = first;
+  s.warm_resolve = true;  // its space contains one whose LP ended optimal
+  CHECK_FALSE(watch_divergence(s));
+  s.watch_resolve = true;  // the rule before the twenty-sixth session
+  CHECK(watch_divergence(s));
+  s.trusted = false;
+  CHECK_FALSE(watch_divergence(s));
 }

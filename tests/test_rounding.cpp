@@ -23,6 +23,21 @@ const MatchingLp& dolphins_60() {
   return m;
 }
 
+// A dolphin against a bumpy ball at 60 faces: a fractional LP (the dolphins' are integral) whose
+// roundings alone by 0.3, 0.5 and 0.7 end at three energies (measured 16.61, 16.00, 16.26).
+const MatchingLp& dolphin_ball_60() {
+  static const Mesh x = decimate(shapes::dolphin(0, 0), 60);
+  static const Mesh y = [] {
+    std::mt19937 rng(8);
+    std::uniform_real_distribution<double> u(-0.2, 0.2);
+    return decimate(test::deformed(shapes::icosphere(2),
+                                   [&](const Eigen::Vector3d& p) { return Eigen::Vector3d(p * (1 + u(rng))); }),
+                    60);
+  }();
+  static const MatchingLp m = build_matching_lp(x, compute_geometry(x), y, compute_geometry(y));
+  return m;
+}
+
 // max |A x − b| over the whole LP.
 double max_residual(const LpProblem& lp, const std::vector<double>& x) {
   std::vector<double> ax(lp.rows(), 0.0);
@@ -237,14 +252,7 @@ TEST_CASE("rounding: round 1 probed at a looser tolerance hands that iterate out
 }
 
 TEST_CASE("rounding: alternative thresholds round again from round 1's optimum and keep the Γ of least energy") {
-  // A dolphin against a bumpy ball at 60 faces: a fractional LP (the dolphins' are integral) whose
-  // roundings alone by 0.3, 0.5 and 0.7 end at three energies (measured 16.61, 16.00, 16.26).
-  std::mt19937 rng(8);
-  std::uniform_real_distribution<double> u(-0.2, 0.2);
-  const Mesh x = decimate(shapes::dolphin(0, 0), 60);
-  const Mesh y = decimate(
-      test::deformed(shapes::icosphere(2), [&](const Eigen::Vector3d& p) { return Eigen::Vector3d(p * (1 + u(rng))); }), 60);
-  const MatchingLp m = build_matching_lp(x, compute_geometry(x), y, compute_geometry(y));
+  const MatchingLp& m = dolphin_ball_60();
   RoundingOptions o;
   o.solver = "pdhg-cpu";
   o.lp.tolerance = 1e-3;
@@ -302,6 +310,68 @@ TEST_CASE("rounding: alternative thresholds round again from round 1's optimum a
   o.alternative_thresholds = {0.5, 0.7};
   o.alternatives_below = m.lp.cols() - 1;
   CHECK(round_to_graph_surface(m.space, m.lp, m.energy, o).tried.size() == 1);
+}
+
+TEST_CASE("rounding: where the first rounding fails after an optimal round 1, the alternatives still try, if asked") {
+  const MatchingLp& m = dolphin_ball_60();
+  RoundingOptions o;
+  o.solver = "pdhg-cpu";
+  o.lp.tolerance = 1e-3;
+  o.threshold = 0.3;
+  o.alternative_thresholds = {};
+  const RoundingResult plain = round_to_graph_surface(m.space, m.lp, m.energy, o);
+  // The rounding at 0.3 fails right after its round 1 (its first_iterate callback throws, which
+  // the alternatives do not call); the LP is the same.
+  int failures = 0;
+  o.first_iterate = [&](const std::vector<double>&, const std::vector<double>&, double) {
+    ++failures;
+    throw SolverError("the first rounding gives up (test)");
+  };
+  o.alternative_thresholds = {0.5, 0.7};
+  CHECK_THROWS_AS(round_to_graph_surface(m.space, m.lp, m.energy, o), SolverError);  // not asked: as before
+  o.alternatives_after_failure = true;
+  const RoundingResult r = round_to_graph_surface(m.space, m.lp, m.energy, o);
+  CHECK(failures == 2);
+  REQUIRE(r.tried.size() == 3);
+  CHECK(r.tried[0].first == 0.3);
+  CHECK(std::isnan(r.tried[0].second));
+  CHECK(r.threshold != 0.3);
+  CHECK(r.energy == std::min(r.tried[1].second, r.tried[2].second));
+  CHECK(satisfies_exactly(m.lp, r.gamma));
+  CHECK(check_graph_surface(m.space, r.gamma).ok());
+  // The bound is round 1's, which the failed rounding solved.
+  CHECK(r.lower_bound >= plain.lower_bound - 1e-9);
+  CHECK(r.lower_bound <= r.energy + 1e-9);
+  CHECK(r.first_lp.iterations == plain.first_lp.iterations);
+  MESSAGE("after the failure at 0.3: ", r.tried[1].second, " (0.5), ", r.tried[2].second, " (0.7), bound ",
+          r.lower_bound);
+  // A budget for the rounds after round 1 (give_up_after): a tiny one gives up after round 2 with
+  // a StuckError, and the alternatives, under the same budget, give up too.
+  o.first_iterate = {};
+  o.give_up_after = 1e-12;
+  o.alternatives_after_failure = false;
+  int rounds = 0;
+  CHECK_THROWS_AS(round_to_graph_surface(m.space, m.lp, m.energy, o, [&](const RoundingRound&) { ++rounds; }),
+                  StuckError);
+  CHECK(rounds == 2);
+  REQUIRE(plain.rounds.size() > 2);  // else the budget shows nothing here
+  o.alternatives_after_failure = true;
+  CHECK_THROWS_AS(round_to_graph_surface(m.space, m.lp, m.energy, o), StuckError);
+  o.give_up_after = 1e6;  // a budget never spent: the rounding as without one
+  const RoundingResult budgeted = round_to_graph_surface(m.space, m.lp, m.energy, o);
+  CHECK(budgeted.energy == std::min({plain.energy, budgeted.tried[1].second, budgeted.tried[2].second}));
+  o.give_up_after = 0.0;
+  // Where no alternative finds a Γ either (one round is too few for this LP), the first error stands.
+  o.first_iterate = [&](const std::vector<double>&, const std::vector<double>&, double) {
+    throw SolverError("the first rounding gives up (test)");
+  };
+  o.max_rounds = 1;
+  try {
+    (void)round_to_graph_surface(m.space, m.lp, m.energy, o);
+    FAIL("expected the first rounding's error");
+  } catch (const SolverError& e) {
+    CHECK(std::string(e.what()).find("(test)") != std::string::npos);
+  }
 }
 
 TEST_CASE("rounding: round 1 stops at its own cap, rounds from its iterate, and its bound stays below the optimum") {

@@ -4,6 +4,7 @@
 #include "shapematch/errors.hpp"
 #include "shapematch/system.hpp"
 
+#include "divergence_rule.hpp"
 #include "key_set.hpp"
 #include "parallel.hpp"
 #include "recurring_conflicts.hpp"
@@ -502,7 +503,7 @@ CoarseToFineResult CoarseToFineMatcher::run(const Progress& progress) const {
       Chain s;
       LevelReport rep = header;
       CoarseToFineResult finest;
-      if (solve_second_start(l, model, rep, s.gamma, finest, progress)) {
+      if (solve_second_start(l, model, rep, s.gamma, finest, progress, !next.empty())) {
         rep.second_start_energy = rep.energy;
         rep.second_start_kept = true;
         for (Chain& c : next) c.pending.back().second_start_energy = rep.energy;
@@ -878,11 +879,14 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
     }
     try {
       RoundingOptions ro = rounding_for(l);
-      // While local widenings remain, a diverging first LP is reason enough to widen (it only
-      // adds variables); the last attempts wait for a proof.
-      ro.lp.stop_on_divergence =
-          trust_divergence && l > 0 && options_.local_widening && local < options_.max_local_widenings;
       const bool carrying = l > 0 && !carried_ones.empty();
+      const bool warm_resolve = price_warm && !carrying;
+      ro.lp.stop_on_divergence = detail::watch_divergence(
+          {.refined = l > 0,
+           .widenings_left = options_.local_widening && local < options_.max_local_widenings,
+           .trusted = trust_divergence,
+           .warm_resolve = warm_resolve,
+           .watch_resolve = options_.watch_resolve});
       if (l > 0 && options_.warm_widening && !carrying) {
         if (!warm.empty()) warm.apply(m, ro.lp);
       }
@@ -890,7 +894,6 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
       // fraction of the cold solve's iterations (FAUST_r at full resolution: 512-1 088 against
       // 1 920-2 624), except where its tail creeps (the cat: 11 328 against 4 480). It stops at the
       // cold count; rounding goes on from its iterate and its bound stays valid.
-      const bool warm_resolve = price_warm && !carrying;
       if (warm_resolve) {
         priced_from.apply(m, ro.lp);
         if (options_.price_dual_sweeps > 0) {
@@ -1059,13 +1062,19 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
 
 bool CoarseToFineMatcher::solve_second_start(int l, const EnergyModel& model, LevelReport& rep,
                                              std::vector<ProductTriangle>& gamma, CoarseToFineResult& finest,
-                                             const Progress& progress) const {
+                                             const Progress& progress, bool optional) const {
   const MeshLevel& lx = hx_.levels[l];
   const MeshLevel& ly = hy_.levels[l];
   MatchingLp m = build_matching_lp(ProductSpace::full(lx.mesh, ly.mesh), model, options_.matching.scale_costs);
   spdlog::info("level {}: second start over the full product space, {} variables", l + 1, m.lp.cols());
   RoundingOptions ro = rounding_for(l);
   ro.fractional_batch = options_.second_start_fractional_batch;
+  // Beside a refined Γ this one is optional: its rounding has a budget, and where it runs out the
+  // alternative thresholds still try from round 1's optimum.
+  if (optional && options_.second_start_budget > 0.0) {
+    ro.give_up_after = options_.second_start_budget;
+    ro.alternatives_after_failure = true;
+  }
   rep.ring = -1;
   RoundingResult rr;
   try {

@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cmath>
 #include <deque>
+#include <exception>
 #include <limits>
 #include <map>
 #include <numeric>
@@ -861,6 +862,7 @@ struct FirstOptimum {
   double primal_weight = 0.0;
   double seconds = 0.0;
   int64_t iterations = 0;
+  LpResult result;  // round 1's LP in the full LP's units, without x and y
 };
 
 // One rounding with options.threshold (round_to_graph_surface's alternatives aside); keeps round
@@ -1083,8 +1085,12 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
   int stalled = 0;
   Stopwatch since_low;  // since fewest_free was set
   bool waited = false;  // the last round fixed nothing: only capped parts were left
+  // Work (iterations times free variables, which unlike seconds is the same on every run) of
+  // round 1 and of the rounds after it (give_up_after).
+  double first_work = 0.0, later_work = 0.0;
   const auto record = [&](RoundingRound& info, const Stopwatch& clock) {
     info.seconds = clock.seconds();
+    if (info.round > 1) later_work += double(info.iterations) * double(info.variables);
     result.rounds.push_back(info);
     if (progress) progress(info);
   };
@@ -1134,6 +1140,10 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
       record(info, clock);
       continue;
     }
+    if (options.give_up_after > 0.0 && round > 1 && later_work > options.give_up_after * first_work)
+      throw stuck("rounding: gave up, its rounds after the first took " + fmt::format("{:.2f}", later_work / first_work) +
+                      " times round 1's work (iterations × variables)",
+                  fixer.unsatisfied_rows());
     if (options.stuck_after > 0.0 && options.stuck_stalled > 0 && round > 1 && stalled >= options.stuck_stalled &&
         since_low.seconds() > options.stuck_after * first_seconds)
       throw stuck("rounding: stuck, no fewer free variables than " + std::to_string(fewest_free) + " for " +
@@ -1224,6 +1234,13 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
         keep->primal_weight = std::isfinite(r.primal_weight) ? r.primal_weight : 0.0;
         keep->seconds = clock.seconds();
         keep->iterations = r.iterations;
+        // As result.first_lp below (which a failing first_iterate never reaches), without vectors.
+        keep->result = r;
+        keep->result.x = {};
+        keep->result.y = {};
+        keep->result.last_y = {};
+        keep->result.objective += lp.objective_scale * red.fixed_cost;
+        keep->result.lower_bound += lp.objective_scale * red.fixed_cost;
       }
       if (options.first_iterate) options.first_iterate(x, y, r.primal_weight);
     }
@@ -1239,6 +1256,7 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
     if (round == 1) {  // in the units of the full LP: add what propagation fixed to 1 before it
       first_seconds = options.reference_seconds > 0.0 ? options.reference_seconds : clock.seconds();
       first_iterations = options.reference_iterations > 0 ? options.reference_iterations : r.iterations;
+      first_work = double(first_iterations) * double(red.lp.cols());
       result.first_lp = r;
       result.first_lp.objective += lp.objective_scale * red.fixed_cost;
       result.first_lp.lower_bound += lp.objective_scale * red.fixed_cost;
@@ -1419,8 +1437,18 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
   const bool alternatives =
       !options.alternative_thresholds.empty() && options.start_ones.empty() && lp.cols() <= options.alternatives_below;
   FirstOptimum first;
-  RoundingResult best = round_once(space, lp, energy, options, progress, alternatives ? &first : nullptr);
-  best.tried.push_back({options.threshold, best.energy});
+  RoundingResult best;
+  std::exception_ptr failed;  // the first rounding's error (alternatives_after_failure)
+  try {
+    best = round_once(space, lp, energy, options, progress, alternatives ? &first : nullptr);
+  } catch (const SolverError& e) {
+    if (!options.alternatives_after_failure || first.x.empty()) throw;
+    spdlog::info("rounding: threshold {} found no Γ ({}); trying the alternatives", options.threshold, e.what());
+    failed = std::current_exception();
+    best.energy = std::numeric_limits<double>::infinity();
+    best.threshold = options.threshold;
+  }
+  best.tried.push_back({options.threshold, failed ? std::numeric_limits<double>::quiet_NaN() : best.energy});
   if (first.x.empty()) return best;  // no alternatives, or round 1 not optimal (nothing to restart from)
   for (double t : options.alternative_thresholds) {
     if (std::any_of(best.tried.begin(), best.tried.end(), [&](const auto& p) { return p.first == t; })) continue;
@@ -1446,6 +1474,8 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
       best.tried.push_back({t, r.energy});
       if (lower) {
         // The bound stays the first LP's (both solves certify the same LP; the better one counts).
+        // After a failed first rounding, round 1's optimum is that LP's (FirstOptimum).
+        if (failed) best.lower_bound = first.result.lower_bound, best.first_lp = first.result;
         r.lower_bound = std::max(r.lower_bound, best.lower_bound);
         r.first_lp = std::move(best.first_lp);
         r.gap = relative_gap(r.energy, r.lower_bound);
@@ -1457,6 +1487,7 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
       best.tried.push_back({t, std::numeric_limits<double>::quiet_NaN()});
     }
   }
+  if (failed && !std::isfinite(best.energy)) std::rethrow_exception(failed);
   return best;
 }
 

@@ -91,6 +91,10 @@ struct CoarseToFineOptions {
   // full resolution: 27 of level 6's 52 propagation widenings were Y face 6 939's π row (639
   // variables every time), in 4-step series per place (docs/results.md, twenty-fifth session).
   int recurring_margin = 2;
+  // Let the divergence watch stop the re-solve after pricing too (as before the twenty-sixth
+  // session). Off: that re-solve starts at the optimum of a space it contains, and stops at the
+  // cold first LP's iterations anyway (detail::watch_divergence says why).
+  bool watch_resolve = false;
   // Start the first LP of a widened space from the previous attempt's iterate (its dual reset
   // where it diverged), by variable and row identity. Off: measured at full resolution (FAUST_r
   // 020-024) after a diverging attempt, the widened LP took 3 008 iterations warm against 2 048
@@ -190,6 +194,12 @@ struct CoarseToFineOptions {
   // (fractional_batch below): a poor Γ there only loses the comparison.
   bool second_start = true;
   double second_start_fractional_batch = 0.125;
+  // Beside a refined Γ, the second start's rounding gives up once its rounds after the first have
+  // done this many times its first LP's work (RoundingOptions::give_up_after), and the
+  // alternative thresholds still try (RoundingOptions::alternatives_after_failure). Measured,
+  // FAUST_r 020-024 at 500 faces: its rounding at 0.5 spent 135 s after a 25 s first LP, in LPs
+  // that failed or stopped at their caps (docs/results.md, twenty-sixth session). 0: no budget.
+  double second_start_budget = 1.0;
   // Where the second start and the refined Γ both exist, both go on, each refined, through this
   // many more levels (never the finest), and the chain of lower energy there goes on. Measured
   // on 8 FAUST_r pairs at 4 000 faces (6 levels, decided at the fourth, 894 faces): the chain
@@ -293,7 +303,7 @@ private:
   // level's, with the second start's numbers), `gamma`, and at the finest level `finest`'s LP
   // and rounding; false where it found no Γ.
   bool solve_second_start(int l, const EnergyModel& model, LevelReport& rep, std::vector<ProductTriangle>& gamma,
-                          CoarseToFineResult& finest, const Progress& progress) const;
+                          CoarseToFineResult& finest, const Progress& progress, bool optional) const;
 
   CoarseToFineOptions options_;
   MeshHierarchy hx_, hy_;
