@@ -345,22 +345,6 @@ TEST_CASE("rounding: where the first rounding fails after an optimal round 1, th
   CHECK(r.first_lp.iterations == plain.first_lp.iterations);
   MESSAGE("after the failure at 0.3: ", r.tried[1].second, " (0.5), ", r.tried[2].second, " (0.7), bound ",
           r.lower_bound);
-  // A budget for the rounds after round 1 (give_up_after): a tiny one gives up after round 2 with
-  // a StuckError, and the alternatives, under the same budget, give up too.
-  o.first_iterate = {};
-  o.give_up_after = 1e-12;
-  o.alternatives_after_failure = false;
-  int rounds = 0;
-  CHECK_THROWS_AS(round_to_graph_surface(m.space, m.lp, m.energy, o, [&](const RoundingRound&) { ++rounds; }),
-                  StuckError);
-  CHECK(rounds == 2);
-  REQUIRE(plain.rounds.size() > 2);  // else the budget shows nothing here
-  o.alternatives_after_failure = true;
-  CHECK_THROWS_AS(round_to_graph_surface(m.space, m.lp, m.energy, o), StuckError);
-  o.give_up_after = 1e6;  // a budget never spent: the rounding as without one
-  const RoundingResult budgeted = round_to_graph_surface(m.space, m.lp, m.energy, o);
-  CHECK(budgeted.energy == std::min({plain.energy, budgeted.tried[1].second, budgeted.tried[2].second}));
-  o.give_up_after = 0.0;
   // Where no alternative finds a Γ either (one round is too few for this LP), the first error stands.
   o.first_iterate = [&](const std::vector<double>&, const std::vector<double>&, double) {
     throw SolverError("the first rounding gives up (test)");
@@ -529,7 +513,8 @@ LpProblem cycle_behind_a_fixing(std::vector<double>& cost, bool linked = false) 
 
 // Rounds cycle_behind_a_fixing on a stand-in space of its size (only for the sizes) with
 // PDHG, whose infeasibility proof is a dual point (Clp's names no rows), and checks A x = b.
-RoundingResult round_cycle(RoundingOptions options, bool linked = false) {
+RoundingResult round_cycle(RoundingOptions options, bool linked = false,
+                           const std::function<void(const RoundingRound&)>& progress = {}) {
   std::vector<double> cost;
   const LpProblem lp = cycle_behind_a_fixing(cost, linked);
   const Mesh sphere = shapes::icosphere(1);
@@ -537,7 +522,7 @@ RoundingResult round_cycle(RoundingOptions options, bool linked = false) {
   const ProductSpace space = ProductSpace::from_list(sphere, sphere, {id.begin(), id.begin() + lp.cols()});
   options.solver = "pdhg-cpu";
   options.exact_below = 0;
-  RoundingResult r = round_to_graph_surface(space, lp, cost, options);
+  RoundingResult r = round_to_graph_surface(space, lp, cost, options, progress);
   CHECK(satisfies_exactly(lp, r.gamma));
   return r;
 }
@@ -632,6 +617,47 @@ TEST_CASE("rounding: where the free variables reach no new low for long it gives
   CHECK(round_cycle(options).energy == 10.0);
   options.stuck_stalled = 1;
   options.stuck_after = 1e3;  // nor that long
+  CHECK(round_cycle(options).energy == 10.0);
+}
+
+TEST_CASE("rounding: a budget on the work of its later rounds gives up where they cost too much, if asked") {
+  // Work is iterations × free variables, against round 1's. The dolphin and the bumpy ball round
+  // in several rounds: a tiny budget gives up after round 2 (a StuckError, as stuck_after's, the
+  // alternative thresholds not saving it unless asked, and under the same budget where asked); a
+  // budget never spent leaves the rounding as it was.
+  const MatchingLp& m = dolphin_ball_60();
+  RoundingOptions o;
+  o.solver = "pdhg-cpu";
+  o.lp.tolerance = 1e-3;
+  const RoundingResult plain = round_to_graph_surface(m.space, m.lp, m.energy, o);
+  REQUIRE(plain.rounds.size() > 2);  // else the budget shows nothing here
+  o.give_up_after = 1e-9;
+  int rounds = 0;
+  try {
+    (void)round_to_graph_surface(m.space, m.lp, m.energy, o, [&](const RoundingRound&) { ++rounds; });
+    FAIL("no StuckError");
+  } catch (const StuckError& e) {
+    CHECK(std::string(e.what()).find("gave up") != std::string::npos);
+    CHECK(e.x().size() == size_t(m.lp.cols()));
+  }
+  CHECK(rounds == 2);
+  o.alternatives_after_failure = true;
+  CHECK_THROWS_AS(round_to_graph_surface(m.space, m.lp, m.energy, o), StuckError);
+  o.give_up_after = 1e9;
+  const RoundingResult budgeted = round_to_graph_surface(m.space, m.lp, m.energy, o);
+  CHECK(budgeted.energy == plain.energy);
+  CHECK(budgeted.gamma == plain.gamma);
+  // A failed LP counts like any (cycle_behind_a_fixing: round 2's LP is infeasible): the
+  // StuckError carries the fixings to 1 that stuck_after's would (b1, b2).
+  RoundingOptions options;
+  options.give_up_after = 1e-9;
+  try {
+    (void)round_cycle(options);
+    FAIL("no StuckError");
+  } catch (const StuckError& e) {
+    CHECK(e.ones() == std::vector<int64_t>{10, 12});
+  }
+  options.give_up_after = 0.0;
   CHECK(round_cycle(options).energy == 10.0);
 }
 
