@@ -1140,7 +1140,7 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
       record(info, clock);
       continue;
     }
-    if (options.give_up_after > 0.0 && round > 1 && later_work > options.give_up_after * first_work)
+    if (options.give_up_after > 0.0 && round > 1 && first_work > 0.0 && later_work > options.give_up_after * first_work)
       throw stuck("rounding: gave up, its rounds after the first took " + fmt::format("{:.2f}", later_work / first_work) +
                       " times round 1's work (iterations × variables)",
                   fixer.unsatisfied_rows());

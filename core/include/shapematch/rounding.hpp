@@ -155,10 +155,10 @@ struct RoundingOptions {
   int64_t alternatives_below = 1'500'000;
   // Where the rounding at `threshold` fails (no Γ, stuck, an LP that gives up) after an optimal
   // round 1, the alternatives still run from that optimum, and the error is rethrown only where
-  // none finds a Γ. For a rounding whose Γ is optional, given stuck_after as a budget (coarse to
-  // fine's second start, with give_up_after): measured, FAUST_r 020-024 at 500 faces, the 200-face
-  // full space's rounding at 0.5 spent 135 s after its 25 s round 1 (three of its LPs failed)
-  // before it ended at 2.783, where 0.7 found 2.634 in 7 s.
+  // none finds a Γ. For a rounding whose Γ is optional and that has a budget (give_up_after;
+  // coarse to fine's second start): measured, FAUST_r 020-024 at 500 faces, the 200-face full
+  // space's rounding at 0.5 spent 135 s after its 25 s round 1 (three of its LPs failed) before
+  // it ended at 2.783, where 0.7 found 2.634 in 7 s.
   bool alternatives_after_failure = false;
 };
 
