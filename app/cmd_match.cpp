@@ -58,7 +58,7 @@ struct MatchArgs {
   int max_local_widenings = CoarseToFineOptions{}.max_local_widenings;
   int max_propagation_widenings = CoarseToFineOptions{}.max_propagation_widenings;
   int recurring_margin = CoarseToFineOptions{}.recurring_margin;
-  bool watch_resolve = false;
+  bool watch_resolve = CoarseToFineOptions{}.watch_resolve;
   double second_start_budget = CoarseToFineOptions{}.second_start_budget;
   bool warm_widening = CoarseToFineOptions{}.warm_widening;
   bool carry_primal_weight = CoarseToFineOptions{}.carry_primal_weight;
