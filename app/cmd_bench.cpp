@@ -507,6 +507,7 @@ struct BenchMatchArgs {
   std::string out = "bench";
   double time_limit = 600.0;
   std::vector<std::string> match_args;  // after `--`, passed to every match run
+  bool resume = false;                  // pairs: reuse the rows an earlier run of the same command finished
 };
 
 // One match run (a size or a pair); NaN where it did not get that far.
@@ -540,14 +541,24 @@ void read_report(const fs::path& dir, MatchRow& row) {
   row.gap = report.number_or_nan("gap");
 }
 
+// The arguments of `match` for one run, less its output directory.
+std::vector<std::string> match_command(const BenchMatchArgs& args, const std::string& x, const std::string& y,
+                                       const std::string& faces) {
+  std::vector<std::string> cmd{"match", x, y};
+  if (!faces.empty()) cmd.insert(cmd.end(), {"--faces", faces});
+  cmd.insert(cmd.end(), args.match_args.begin(), args.match_args.end());
+  return cmd;
+}
+
 // `match X Y` into `dir` (kept for inspection, its log beside it as dir.match.log).
 void run_match_child(const BenchMatchArgs& args, const std::string& x, const std::string& y, const std::string& faces,
                      const fs::path& dir, MatchRow& row) {
-  // A failed run must not leave the previous benchmark's output looking like its own.
+  // A failed run must not leave the previous benchmark's output looking like its own, nor the
+  // record that --resume trusts.
   fs::remove_all(dir);
-  std::vector<std::string> cmd{"match", x, y, "-o", dir.string()};
-  if (!faces.empty()) cmd.insert(cmd.end(), {"--faces", faces});
-  cmd.insert(cmd.end(), args.match_args.begin(), args.match_args.end());
+  for (const char* suffix : {".run.json", ".eval.json"}) fs::remove(dir.string() + suffix);
+  std::vector<std::string> cmd = match_command(args, x, y, faces);
+  cmd.insert(cmd.end(), {"-o", dir.string()});
   row.run = run_child(cmd, "", dir.string() + ".match.log", args.time_limit);
   if (row.run.status != "ok") return;
   try {
@@ -759,6 +770,19 @@ std::string pairs_csv(const std::vector<MatchRow>& rows) {
   return text;
 }
 
+// The errors from `eval`'s JSON.
+void read_errors(const std::string& json_path, MatchRow& row) {
+  const JsonNode result = read_json_file(json_path);
+  row.mean_error = result.number_or_nan("mean_geodesic_error");
+  row.median_error = result.number_or_nan("median_geodesic_error");
+  row.symmetric_mean_error = result.number_or_nan("symmetric_mean_geodesic_error");
+  row.flips = result.number_or_nan("orientation_flips");
+  if (const JsonNode* points = result.get("point_map")) {
+    row.point_mean_error = points->number_or_nan("mean_geodesic_error");
+    row.point_flips = points->number_or_nan("orientation_flips");
+  }
+}
+
 // Fills the errors from `eval`'s JSON; a failed evaluation keeps the match's numbers.
 void evaluate(const BenchMatchArgs& args, const PairSpec& pair, const fs::path& dir, MatchRow& row) {
   std::vector<std::string> cmd{"eval", dir.string()};
@@ -770,17 +794,78 @@ void evaluate(const BenchMatchArgs& args, const PairSpec& pair, const fs::path& 
     return;
   }
   try {
-    const JsonNode result = read_json_file(json_path);
-    row.mean_error = result.number_or_nan("mean_geodesic_error");
-    row.median_error = result.number_or_nan("median_geodesic_error");
-    row.symmetric_mean_error = result.number_or_nan("symmetric_mean_geodesic_error");
-    row.flips = result.number_or_nan("orientation_flips");
-    if (const JsonNode* points = result.get("point_map")) {
-      row.point_mean_error = points->number_or_nan("mean_geodesic_error");
-      row.point_flips = points->number_or_nan("orientation_flips");
-    }
+    read_errors(json_path, row);
   } catch (const Error& error) {
     row.run.status = std::string("eval failed: ") + error.what();
+  }
+}
+
+// ---- resuming a list of pairs
+
+Json strings_json(const std::vector<std::string>& words) {
+  Json a = Json::array();
+  for (const std::string& w : words) a.push(w);
+  return a;
+}
+
+std::vector<std::string> strings_of(const JsonNode* node) {
+  std::vector<std::string> words;
+  if (!node || node->kind != JsonNode::Kind::Array) return words;
+  for (const auto& [key, item] : node->members) {
+    if (item.kind != JsonNode::Kind::String) return {};  // no command has an empty argument list
+    words.push_back(item.text);
+  }
+  return words;
+}
+
+// Beside each pair's run: what was asked and how it ended, written once its row is final. Full
+// resolution tables take hours per list on 2 cores; --resume picks such a list up where it stopped.
+void write_run_record(const fs::path& dir, const std::vector<std::string>& match, const PairSpec& pair,
+                      double time_limit, const MatchRow& row) {
+  Json record = Json::object();
+  record.set("match", strings_json(match));
+  record.set("truth", strings_json(pair.truth));
+  record.set("time_limit", time_limit);
+  record.set("status", row.run.status);
+  record.set("seconds", row.run.seconds);
+  record.set("peak_rss_mb", row.run.peak_rss_mb);
+  write_file_atomic(dir.string() + ".run.json", record.dump() + "\n");
+}
+
+// The row of an earlier run of the same command (and ground truth), if one finished; a run that
+// timed out counts only under a time limit no longer than its own. An evaluation that failed is
+// run again (cheap). False: run the pair.
+bool resume_row(const BenchMatchArgs& args, const PairSpec& pair, const std::vector<std::string>& match,
+                const fs::path& dir, MatchRow& row) {
+  const std::string path = dir.string() + ".run.json";
+  if (!fs::exists(path)) return false;
+  try {
+    const JsonNode record = read_json_file(path);
+    if (strings_of(record.get("match")) != match || strings_of(record.get("truth")) != pair.truth) {
+      spdlog::info("{}: the recorded run had other options; running it again", row.name);
+      return false;
+    }
+    const JsonNode* status = record.get("status");
+    if (!status || status->kind != JsonNode::Kind::String) return false;
+    if (status->text == "timed out" && !(record.number_or_nan("time_limit") >= args.time_limit)) return false;
+    row.run.status = status->text;
+    row.run.seconds = record.number_or_nan("seconds");
+    row.run.peak_rss_mb = record.number_or_nan("peak_rss_mb");
+    const bool matched = row.run.status == "ok" || row.run.status.rfind("eval ", 0) == 0;
+    if (!matched) return true;
+    read_report(dir, row);
+    if (row.run.status == "ok") {
+      read_errors(dir.string() + ".eval.json", row);
+    } else {
+      row.run.status = "ok";
+      evaluate(args, pair, dir, row);
+      write_run_record(dir, match, pair, args.time_limit, row);
+    }
+    return true;
+  } catch (const Error& e) {  // a record or output that does not read back: measure again
+    spdlog::warn("{}: cannot resume ({}); running it again", row.name, e.what());
+    row = MatchRow{.name = row.name};
+    return false;
   }
 }
 
@@ -800,9 +885,15 @@ int run_bench_pairs(const BenchMatchArgs& args) {
     row.name = fs::path(pair.x).stem().string() + "-" + fs::path(pair.y).stem().string();
     // Numbered, because a list may hold the same pair twice (e.g. with different ground truth).
     const fs::path dir = out / "runs" / fmt::format("{:02}_{}", i + 1, row.name);
-    spdlog::info("pair {} of {}: {}", i + 1, pairs.size(), row.name);
-    run_match_child(args, pair.x, pair.y, faces, dir, row);
-    if (row.run.status == "ok") evaluate(args, pair, dir, row);
+    const std::vector<std::string> match = match_command(args, pair.x, pair.y, faces);
+    if (args.resume && resume_row(args, pair, match, dir, row)) {
+      spdlog::info("pair {} of {}: {} (resumed from {}.run.json)", i + 1, pairs.size(), row.name, dir.string());
+    } else {
+      spdlog::info("pair {} of {}: {}", i + 1, pairs.size(), row.name);
+      run_match_child(args, pair.x, pair.y, faces, dir, row);
+      if (row.run.status == "ok") evaluate(args, pair, dir, row);
+      write_run_record(dir, match, pair, args.time_limit, row);
+    }
     log_row(row);
     rows.push_back(std::move(row));
     write_file_atomic(csv_path, pairs_csv(rows));
@@ -863,11 +954,16 @@ Action add_bench_command(CLI::App& app) {
                     "faces per shape; scaling: one run per entry (default 500,1000,2000,4000,full); pairs: one size "
                     "(default: match's)")
       ->delimiter(',')
+      ->allow_extra_args(false)  // one comma-separated word, so that `--faces full -- ARGS` ends at `--`
       ->check(size);
   match->add_option("--out", m->out, "directory for the tables, the plot and runs/")->capture_default_str();
   match->add_option("--time-limit", m->time_limit, "seconds per child run (match, eval); then it is killed")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
+  match->add_flag("--resume", m->resume,
+                  "pairs: reuse each pair's row where this --out already holds a finished run of the same command and "
+                  "ground truth (runs/NN_X-Y.run.json); a run that timed out is tried again under a longer --time-limit")
+      ->needs(match->get_option("--pairs"));
   match->add_option("match-args", m->match_args, "after `--`: options for every match run, verbatim");
 
   return [lp, args, match, m, bw] {

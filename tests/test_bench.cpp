@@ -12,6 +12,7 @@
 #include <fstream>
 #include <iterator>
 #include <map>
+#include <regex>
 #include <string>
 #include <sys/wait.h>
 #include <vector>
@@ -288,6 +289,65 @@ TEST_CASE("cli: bench match --pairs records a pair that fails as a row and goes 
   CHECK(rows[1].at("mean_geodesic_error").empty());
   CHECK(rows[2].at("status") == "0 of 2 ok");
   CHECK(rows[2].at("seconds").empty());
+  fs::remove_all(dir);
+}
+
+TEST_CASE("cli: bench match --pairs --resume reuses the rows of finished runs of the same command") {
+  const fs::path dir = fs::temp_directory_path() / "shapematch_bench_resume_test";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const fs::path err = dir.string() + "_stderr.txt";
+  const std::string x = kAssets + "/finger_straight.off", y = kAssets + "/finger_bent.off";
+  std::ofstream(dir / "pairs.txt") << x << " " << y << " identity\n";
+  const std::string bench = "bench match --pairs " + (dir / "pairs.txt").string() + " --out " + (dir / "out").string();
+  const fs::path record = dir / "out" / "runs" / "01_finger_straight-finger_bent.run.json";
+  // A recorded number that no run measures shows whether the row was reused or measured again.
+  auto edit_record = [&](const std::string& key, const std::string& value) {
+    const std::string text = read_text(record);
+    const std::string edited = std::regex_replace(text, std::regex("\"" + key + "\": [^,\n]+"), "\"" + key + "\": " + value);
+    REQUIRE(edited != text);
+    std::ofstream(record) << edited;
+  };
+  auto row = [&] {
+    const auto [header, rows] = read_csv(dir / "out" / "bench_pairs.csv");
+    REQUIRE(rows.size() == 2);
+    return rows[0];
+  };
+
+  // Nothing recorded yet: the pair runs, and its record is written.
+  REQUIRE(run_cli(bench + " --faces 20 --resume -- --backend cpu", err) == 0);
+  REQUIRE(fs::exists(record));
+  const auto first = row();
+  REQUIRE(first.at("status") == "ok");
+  edit_record("seconds", "12345");
+
+  SUBCASE("the same command: the recorded row, errors and all") {
+    REQUIRE(run_cli(bench + " --faces 20 --resume -- --backend cpu", err) == 0);
+    const auto again = row();
+    CHECK(std::stod(again.at("seconds")) == 12345);
+    CHECK(again.at("status") == "ok");
+    CHECK(again.at("energy") == first.at("energy"));
+    CHECK(again.at("mean_geodesic_error") == first.at("mean_geodesic_error"));
+    CHECK(again.at("point_orientation_flips") == first.at("point_orientation_flips"));
+    CHECK(read_text(err).find("resumed") != std::string::npos);
+  }
+  SUBCASE("other options or no --resume: measured again") {
+    REQUIRE(run_cli(bench + " --faces 16 --resume -- --backend cpu", err) == 0);
+    CHECK(std::stod(row().at("seconds")) < 12345);
+    CHECK(row().at("faces_x") == "16");
+    edit_record("seconds", "12345");
+    REQUIRE(run_cli(bench + " --faces 16 -- --backend cpu", err) == 0);
+    CHECK(std::stod(row().at("seconds")) < 12345);
+  }
+  SUBCASE("a run that timed out: kept under the same limit, tried again under a longer one") {
+    edit_record("status", "\"timed out\"");
+    REQUIRE(run_cli(bench + " --faces 20 --resume -- --backend cpu", err) == 0);
+    CHECK(row().at("status") == "timed out");
+    CHECK(row().at("energy").empty());
+    REQUIRE(run_cli(bench + " --faces 20 --resume --time-limit 900 -- --backend cpu", err) == 0);
+    CHECK(row().at("status") == "ok");
+    CHECK(row().at("energy") == first.at("energy"));
+  }
   fs::remove_all(dir);
 }
 
