@@ -35,6 +35,7 @@
 #include <iostream>
 #include <iterator>
 #include <limits>
+#include <map>
 #include <memory>
 #include <set>
 #include <sstream>
@@ -879,12 +880,15 @@ int run_bench_pairs(const BenchMatchArgs& args) {
   fs::create_directories(out / "runs");
   const std::string csv_path = (out / "bench_pairs.csv").string(), md_path = (out / "bench_pairs.md").string();
   std::vector<MatchRow> rows;
+  std::map<std::string, int> times_seen;
   for (size_t i = 0; i < pairs.size(); ++i) {
     const PairSpec& pair = pairs[i];
     MatchRow row;
     row.name = fs::path(pair.x).stem().string() + "-" + fs::path(pair.y).stem().string();
-    // Numbered, because a list may hold the same pair twice (e.g. with different ground truth).
-    const fs::path dir = out / "runs" / fmt::format("{:02}_{}", i + 1, row.name);
+    // Named after the pair, so that --resume finds a run again in a list that grew or was
+    // reordered; a pair that comes again (e.g. with other ground truth) is counted: X-Y.2, X-Y.3.
+    const int seen = ++times_seen[row.name];
+    const fs::path dir = out / "runs" / (seen == 1 ? row.name : fmt::format("{}.{}", row.name, seen));
     const std::vector<std::string> match = match_command(args, pair.x, pair.y, faces);
     if (args.resume && resume_row(args, pair, match, dir, row)) {
       spdlog::info("pair {} of {}: {} (resumed from {}.run.json)", i + 1, pairs.size(), row.name, dir.string());
@@ -962,7 +966,7 @@ Action add_bench_command(CLI::App& app) {
       ->capture_default_str();
   match->add_flag("--resume", m->resume,
                   "pairs: reuse each pair's row where this --out already holds a finished run of the same command and "
-                  "ground truth (runs/NN_X-Y.run.json); a run that timed out is tried again under a longer --time-limit")
+                  "ground truth (runs/X-Y.run.json); a run that timed out is tried again under a longer --time-limit")
       ->needs(match->get_option("--pairs"));
   match->add_option("match-args", m->match_args, "after `--`: options for every match run, verbatim");
 

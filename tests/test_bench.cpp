@@ -257,6 +257,9 @@ TEST_CASE("cli: bench match --pairs matches and evaluates each pair and adds a r
   CHECK(!median.at("gap").empty());
   CHECK(median.at("energy").empty());
 
+  // The same pair twice: two runs, the second one counted.
+  CHECK(fs::is_directory(dir / "out" / "runs" / "finger_straight-finger_bent"));
+  CHECK(fs::is_directory(dir / "out" / "runs" / "finger_straight-finger_bent.2"));
   const std::string md = read_text(dir / "out" / "bench_pairs.md");
   CHECK(md.rfind("| pair ", 0) == 0);
   CHECK(md.find("| **median** ") != std::string::npos);
@@ -300,7 +303,7 @@ TEST_CASE("cli: bench match --pairs --resume reuses the rows of finished runs of
   const std::string x = kAssets + "/finger_straight.off", y = kAssets + "/finger_bent.off";
   std::ofstream(dir / "pairs.txt") << x << " " << y << " identity\n";
   const std::string bench = "bench match --pairs " + (dir / "pairs.txt").string() + " --out " + (dir / "out").string();
-  const fs::path record = dir / "out" / "runs" / "01_finger_straight-finger_bent.run.json";
+  const fs::path record = dir / "out" / "runs" / "finger_straight-finger_bent.run.json";
   // A recorded number that no run measures shows whether the row was reused or measured again.
   auto edit_record = [&](const std::string& key, const std::string& value) {
     const std::string text = read_text(record);
@@ -330,6 +333,16 @@ TEST_CASE("cli: bench match --pairs --resume reuses the rows of finished runs of
     CHECK(again.at("mean_geodesic_error") == first.at("mean_geodesic_error"));
     CHECK(again.at("point_orientation_flips") == first.at("point_orientation_flips"));
     CHECK(read_text(err).find("resumed") != std::string::npos);
+  }
+  SUBCASE("a list that grew: the pair keeps its row wherever its line went") {
+    std::ofstream(dir / "pairs.txt") << y << " " << x << " identity\n" << x << " " << y << " identity\n";
+    REQUIRE(run_cli(bench + " --faces 20 --resume -- --backend cpu", err) == 0);
+    const auto [header, rows] = read_csv(dir / "out" / "bench_pairs.csv");
+    REQUIRE(rows.size() == 3);
+    CHECK(rows[0].at("pair") == "finger_bent-finger_straight");
+    CHECK(std::stod(rows[0].at("seconds")) < 12345);
+    CHECK(rows[1].at("pair") == "finger_straight-finger_bent");
+    CHECK(std::stod(rows[1].at("seconds")) == 12345);
   }
   SUBCASE("other options or no --resume: measured again") {
     REQUIRE(run_cli(bench + " --faces 16 --resume -- --backend cpu", err) == 0);
