@@ -141,7 +141,8 @@ TEST_CASE("cli: bench match (scaling) writes one row per size with the child's o
 
   const auto [header, rows] = read_csv(dir / "bench_match.csv");
   const std::vector<std::string> expected = {"faces_requested", "faces_x", "faces_y", "levels", "variables", "rounds",
-                                             "energy", "lower_bound", "gap", "seconds", "peak_rss_mb", "status"};
+                                             "energy", "lower_bound", "gap", "max_level_gap", "seconds", "peak_rss_mb",
+                                             "status"};
   REQUIRE(header == expected);
   REQUIRE(rows.size() == 2);
   for (size_t i = 0; i < rows.size(); ++i) {
@@ -164,6 +165,9 @@ TEST_CASE("cli: bench match (scaling) writes one row per size with the child's o
     CHECK(bound <= energy * (1 + 1e-9));
     CHECK(std::stod(row.at("gap")) >= -1e-9);
     CHECK(std::stod(row.at("gap")) < 1);
+    // The finest level is one of the levels.
+    CHECK(std::stod(row.at("max_level_gap")) >= std::stod(row.at("gap")) - 1e-12);
+    CHECK(std::stod(row.at("max_level_gap")) < 1);
     CHECK(std::stod(row.at("seconds")) > 0);
     CHECK(std::stod(row.at("seconds")) < 60);
     // A whole process with its meshes and LP: more than a few MiB, far less than a GiB.
@@ -219,7 +223,7 @@ TEST_CASE("cli: bench match --pairs matches and evaluates each pair and adds a r
 
   const auto [header, rows] = read_csv(dir / "out" / "bench_pairs.csv");
   const std::vector<std::string> expected = {"pair", "faces_x", "faces_y", "seconds", "peak_rss_mb", "energy",
-                                             "lower_bound", "gap", "rounds", "mean_geodesic_error",
+                                             "lower_bound", "gap", "max_level_gap", "rounds", "mean_geodesic_error",
                                              "median_geodesic_error", "symmetric_mean_geodesic_error",
                                              "orientation_flips", "point_mean_geodesic_error",
                                              "point_orientation_flips", "status"};
@@ -255,6 +259,7 @@ TEST_CASE("cli: bench match --pairs matches and evaluates each pair and adds a r
   CHECK(std::stod(median.at("seconds")) == doctest::Approx((seconds[0] + seconds[1]) / 2).epsilon(1e-4));
   CHECK(std::stod(median.at("mean_geodesic_error")) == doctest::Approx(std::stod(rows[0].at("mean_geodesic_error"))));
   CHECK(!median.at("gap").empty());
+  CHECK(!median.at("max_level_gap").empty());
   CHECK(median.at("energy").empty());
 
   // The same pair twice: two runs, the second one counted.
