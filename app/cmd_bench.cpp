@@ -755,7 +755,8 @@ std::vector<std::vector<std::string>> pairs_cells(const std::vector<MatchRow>& r
   for (const MatchRow& r : rows)
     cells.push_back({r.name, csv_int(r.faces_x), csv_int(r.faces_y), num(r.run.seconds, 6, 2),
                      num(r.run.peak_rss_mb, 5, 0), general(r.energy, 12), general(r.lower_bound, 12),
-                     general(r.gap, 4), general(r.max_level_gap, 4), csv_int(r.rounds), num(r.mean_error, 6, 4), num(r.median_error, 6, 4),
+                     general(r.gap, 4), general(r.max_level_gap, 4), csv_int(r.rounds), num(r.mean_error, 6, 4),
+                     num(r.median_error, 6, 4),
                      num(r.symmetric_mean_error, 6, 4), csv_int(r.flips), num(r.point_mean_error, 6, 4),
                      csv_int(r.point_flips), r.run.status});
   const auto ok = std::count_if(rows.begin(), rows.end(), [](const MatchRow& r) { return r.run.status == "ok"; });

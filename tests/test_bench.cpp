@@ -312,7 +312,8 @@ TEST_CASE("cli: bench match --pairs --resume reuses the rows of finished runs of
   // A recorded number that no run measures shows whether the row was reused or measured again.
   auto edit_record = [&](const std::string& key, const std::string& value) {
     const std::string text = read_text(record);
-    const std::string edited = std::regex_replace(text, std::regex("\"" + key + "\": [^,\n]+"), "\"" + key + "\": " + value);
+    const std::regex field("\"" + key + "\": [^,\n]+");
+    const std::string edited = std::regex_replace(text, field, "\"" + key + "\": " + value);
     REQUIRE(edited != text);
     std::ofstream(record) << edited;
   };
