@@ -37,6 +37,7 @@ struct MatchArgs {
   double later_round_iterations = RoundingOptions{}.later_round_iterations;
   double fractional_batch = RoundingOptions{}.fractional_batch;
   bool close_pockets = RoundingOptions{}.close_pockets;
+  int untangle_rings = PointMapOptions{}.untangle_rings;
   bool whole_lp = !RoundingOptions{}.split_parts;
   int64_t greedy_above = RoundingOptions{}.greedy_above;
   int greedy_margin = RoundingOptions{}.greedy_margin;
@@ -221,7 +222,9 @@ int run_match(const MatchArgs& args) {
   seconds.set("verify", stage.seconds());
   stage.reset();
   // Points follow Γ where one partner vertex cannot (a vertex blown up, an edge stretched).
-  const PointMaps points = point_maps(m.space, rr.gamma, maps);
+  PointMapOptions po;
+  po.untangle_rings = args.untangle_rings;
+  const PointMaps points = point_maps(m.space, rr.gamma, maps, po);
   const OrientationFlips vertex_flips = count_orientation_flips(x, y, maps.x_to_y);
   const OrientationFlips point_flips = count_orientation_flips(x, y, points.x_to_y);
   seconds.set("point_maps", stage.seconds());
@@ -343,6 +346,7 @@ int run_match(const MatchArgs& args) {
                               .set("fractional_batch", args.fractional_batch)
                               .set("later_round_iterations", args.later_round_iterations)
                               .set("close_pockets", args.close_pockets)
+                              .set("untangle_rings", args.untangle_rings)
                               .set("greedy_above", args.greedy_above)
                               .set("greedy_margin", args.greedy_margin)
                               .set("search_below", args.search_below)
@@ -473,6 +477,11 @@ Action add_match_command(CLI::App& app) {
       ->capture_default_str();
   app.add_flag("--close-pockets", a->close_pockets,
                "replace each pocket (an edge stretched over a whole star, a tear that A x = b admits) by the star collapsed onto one vertex: continuous, but costs energy");
+  app.add_option("--untangle-rings", a->untangle_rings,
+                 "where the point map still inverts a face, lay discs of up to this many rings around it out again "
+                 "(Tutte's embedding in a chart of the other shape), kept where fewer faces invert; 0: off")
+      ->check(CLI::Range(0, 16))
+      ->capture_default_str();
   app.add_option("--fractional-batch", a->fractional_batch,
                  "where no LP value exceeds the threshold, fix the largest of up to this fraction of the open faces "
                  "(0: the single largest)")

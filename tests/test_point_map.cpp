@@ -117,6 +117,52 @@ TEST_CASE("point map: a vertex collapsed onto a corner moves off it") {
   CHECK(count_orientation_flips(x, y, pm.x_to_y).flips == 0);
 }
 
+// A half turn of one vertex's ring: its faces keep their orientation, the next ring's fold over.
+// No single vertex can move back without inverting others; re-embedding the disc around the fold
+// (its rim where the identity puts it) can, and touches nothing beyond max_rings rings.
+TEST_CASE("point map: untangling a twisted ring") {
+  const Mesh m = test::bumpy_sphere(0.05);
+  const auto vf = vertex_face_table(m);
+  std::vector<SurfacePoint> map;
+  for (int v = 0; v < m.num_vertices(); ++v) map.push_back(vertex_point(m, vf, v));
+  const int c = 0;
+  // c's ring in cyclic order: face to face around c.
+  std::vector<int> ring;
+  for (int f = vf[c].front(); ring.size() < vf[c].size();) {
+    const auto& t = m.faces[f];
+    const int i = t[0] == c ? 0 : t[1] == c ? 1 : 2;
+    ring.push_back(t[(i + 1) % 3]);
+    const int next = t[(i + 2) % 3];
+    for (int g : vf[c]) {
+      const auto& u = m.faces[g];
+      const int j = u[0] == c ? 0 : u[1] == c ? 1 : 2;
+      if (u[(j + 1) % 3] == next) f = g;
+    }
+  }
+  const size_t k = ring.size();
+  for (size_t i = 0; i < k; ++i) map[ring[i]] = vertex_point(m, vf, ring[(i + k / 2) % k]);
+  const int before = count_orientation_flips(m, m, map).flips;
+  REQUIRE(before > 0);
+
+  std::vector<SurfacePoint> untangled = map;
+  CHECK(untangle_point_map(m, m, untangled, 4) > 0);
+  CHECK(count_orientation_flips(m, m, untangled).flips == 0);
+  // Vertices beyond 4 + 1 rings of c stay where they were.
+  std::vector<int> dist(m.num_vertices(), -1);
+  std::vector<int> queue{c};
+  dist[c] = 0;
+  for (size_t q = 0; q < queue.size(); ++q)
+    for (int f : vf[queue[q]])
+      for (int w : m.faces[f])
+        if (dist[w] < 0) dist[w] = dist[queue[q]] + 1, queue.push_back(w);
+  for (int v = 0; v < m.num_vertices(); ++v)
+    if (dist[v] > 5) CHECK(point_vertex(m, untangled[v]) == v);
+  // With no rings allowed nothing moves.
+  std::vector<SurfacePoint> kept = map;
+  CHECK(untangle_point_map(m, m, kept, 0) == 0);
+  CHECK(count_orientation_flips(m, m, kept).flips == before);
+}
+
 TEST_CASE("point map: text round trip, and one clear line for a bad file") {
   const Mesh m = shapes::octahedron();
   const std::vector<SurfacePoint> map{{0, {1, 0, 0}}, {3, {0.25, 0.5, 0.25}}, {7, {0.1, 0.2, 0.7}}};

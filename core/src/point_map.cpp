@@ -3,12 +3,15 @@
 #include "shapematch/errors.hpp"
 #include "shapematch/hierarchy.hpp"
 
+#include <Eigen/SparseLU>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
 #include <limits>
 #include <sstream>
+#include <unordered_map>
 
 namespace shapematch {
 
@@ -132,6 +135,342 @@ Fibres fibres(const ProductSpace& space, const std::vector<int64_t>& gamma, bool
   return fb;
 }
 
+// Lays discs of `from` out again around inverted images (untangle_point_map).
+class Untangler {
+public:
+  Untangler(const Mesh& from, const Mesh& to, const Geometry& gt, const std::vector<std::vector<int>>& from_faces,
+            const std::vector<std::vector<int>>& to_faces, std::vector<SurfacePoint>& p)
+      : from_(from), to_(to), g_(gt), from_faces_(from_faces), to_faces_(to_faces), p_(p) {}
+
+  int run(int max_rings) {
+    int kept = 0;
+    // A disc is kept when it inverts fewer faces in all, which may invert one seen before: again.
+    for (int pass = 0; pass < 3; ++pass) {
+      const int before = kept;
+      for (int f = 0; f < from_.num_faces(); ++f)
+        for (int r = 1; r <= max_rings && orientation(f) < 0; ++r) kept += embed_disc(f, r) ? 1 : 0;
+      if (kept == before) break;
+    }
+    return kept;
+  }
+
+private:
+  int orientation(int f) const {
+    const auto& t = from_.faces[f];
+    return image_orientation(to_, g_, p_[t[0]], p_[t[1]], p_[t[2]]);
+  }
+  int64_t cost(const std::vector<int>& faces) const {
+    int64_t c = 0;
+    for (int f : faces) {
+      const int o = orientation(f);
+      c += o < 0 ? 1000 : o == 0 ? 1 : 0;
+    }
+    return c;
+  }
+
+  int64_t star_cost(int v) const { return cost(from_faces_[v]); }
+  // Sample points of the faces of `to` around q's support.
+  void near_points(const SurfacePoint& q, std::vector<SurfacePoint>& out) const {
+    constexpr int kSamples = 6;
+    std::array<int, 3> s{};
+    std::vector<int> faces;
+    for (int i = 0, k = support(to_, q, s); i < k; ++i) faces.insert(faces.end(), to_faces_[s[i]].begin(), to_faces_[s[i]].end());
+    sort_unique(faces);
+    for (int f : faces)
+      for (int i = 1; i < kSamples; ++i)
+        for (int j = 1; i + j < kSamples; ++j)
+          out.push_back({f, {double(i) / kSamples, double(j) / kSamples, double(kSamples - i - j) / kSamples}});
+  }
+
+  bool embed_disc(int f0, int rings) {
+    // Vertex rings around f0's corners: inside (ring < rings) moves, the rim (ring == rings) stays.
+    std::unordered_map<int, int> ring;
+    std::vector<int> order(from_.faces[f0].begin(), from_.faces[f0].end());
+    for (int v : order) ring[v] = 0;
+    for (size_t k = 0; k < order.size(); ++k) {
+      const int v = order[k], d = ring[v];
+      if (d == rings) continue;
+      for (int f : from_faces_[v])
+        for (int w : from_.faces[f])
+          if (ring.emplace(w, d + 1).second) order.push_back(w);
+    }
+    std::vector<int> inside, faces;
+    std::unordered_map<int, int> index;  // inside vertex -> unknown
+    for (int v : order)
+      if (ring[v] < rings) {
+        index[v] = static_cast<int>(inside.size());
+        inside.push_back(v);
+        faces.insert(faces.end(), from_faces_[v].begin(), from_faces_[v].end());
+      }
+    sort_unique(faces);
+    const int64_t before = cost(faces);
+
+    // The chart: the faces of `to` within two rings of the images, if they form a disc, laid out
+    // by Tutte's embedding of its rim onto a circle (an embedding: it cannot fold).
+    // (One ring where two wrap around a thin part.)
+    std::vector<int> supports;
+    std::array<int, 3> s{};
+    for (int v : order)
+      for (int i = 0, k = support(to_, p_[v], s); i < k; ++i) supports.push_back(s[i]);
+    std::vector<int> region;
+    std::unordered_map<int, Eigen::Vector2d> chart;
+    bool laid_out = false;
+    for (int grow = 2; grow >= 1 && !laid_out; --grow) {
+      std::vector<int> near = supports;
+      for (int r = 0; r < grow; ++r) {
+        sort_unique(near);
+        region.clear();
+        for (int w : near) region.insert(region.end(), to_faces_[w].begin(), to_faces_[w].end());
+        sort_unique(region);
+        for (int f : region) near.insert(near.end(), to_.faces[f].begin(), to_.faces[f].end());
+      }
+      fill_holes(region);
+      near.clear();
+      for (int f : region) near.insert(near.end(), to_.faces[f].begin(), to_.faces[f].end());
+      sort_unique(near);
+      chart.clear();
+      laid_out = lay_out_disc(region, near, chart);
+    }
+    if (!laid_out) return false;
+    auto chart_of = [&](const SurfacePoint& q) {
+      const auto& t = to_.faces[q.face];
+      return Eigen::Vector2d(q.bary[0] * chart.at(t[0]) + q.bary[1] * chart.at(t[1]) + q.bary[2] * chart.at(t[2]));
+    };
+
+    // Tutte's embedding of the disc of `from` with its mean-value weights (positive whatever the
+    // angles), the rim where its images are.
+    const int m = static_cast<int>(inside.size());
+    Eigen::MatrixXd a = Eigen::MatrixXd::Zero(m, m);
+    Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(m, 2);
+    for (int i = 0; i < m; ++i) {
+      const int v = inside[i];
+      for (const auto& [w, weight] : mean_value_weights(from_, from_faces_, v)) {
+        a(i, i) += weight;
+        const auto at = index.find(w);
+        if (at != index.end()) {
+          a(i, at->second) -= weight;
+        } else {
+          rhs.row(i) += weight * chart_of(p_[w]).transpose();
+        }
+      }
+    }
+    const Eigen::MatrixXd u = a.partialPivLu().solve(rhs);
+    if (!u.allFinite()) return false;
+
+    // Back onto `to` through the chart's faces.
+    std::vector<SurfacePoint> placed(m);
+    for (int i = 0; i < m; ++i) {
+      const Eigen::Vector2d q = u.row(i).transpose();
+      double best = -std::numeric_limits<double>::infinity();
+      for (int f : region) {
+        const auto& t = to_.faces[f];
+        const Eigen::Vector2d p0 = chart.at(t[0]), p1 = chart.at(t[1]), p2 = chart.at(t[2]);
+        const double area = cross2(p1 - p0, p2 - p0);
+        if (area <= 0) continue;
+        std::array<double, 3> b{cross2(p1 - q, p2 - q) / area, cross2(p2 - q, p0 - q) / area, 0.0};
+        b[2] = 1 - b[0] - b[1];
+        const double worst = std::min({b[0], b[1], b[2]});
+        if (worst <= best) continue;  // the face it is deepest inside (ties at shared edges)
+        best = worst;
+        for (double& x : b) x = std::max(x, 0.0);
+        const double sum = b[0] + b[1] + b[2];
+        for (double& x : b) x /= sum;
+        placed[i] = SurfacePoint{f, b};
+      }
+      if (best < -1e-9) return false;
+    }
+    std::vector<SurfacePoint> saved(m);
+    for (int i = 0; i < m; ++i) saved[i] = p_[inside[i]], p_[inside[i]] = placed[i];
+    // Where the rim is concave, a face with two rim corners can fold over it: move such faces'
+    // inside corners (back where they were, or nearby) while that unfolds their stars.
+    for (int sweep = 0; sweep < 5; ++sweep) {
+      bool changed = false;
+      for (int i = 0; i < m; ++i) {
+        const int v = inside[i];
+        int64_t best = star_cost(v);
+        if (best < 1000) continue;
+        std::vector<SurfacePoint> candidates{saved[i]};
+        near_points(p_[v], candidates);
+        const SurfacePoint current = p_[v];
+        SurfacePoint choice = current;
+        for (const SurfacePoint& q : candidates) {
+          p_[v] = q;
+          const int64_t c = star_cost(v);
+          if (c < best) best = c, choice = q;
+        }
+        p_[v] = choice;
+        changed = changed || choice.face != current.face || choice.bary != current.bary;
+      }
+      if (!changed) break;
+    }
+    if (cost(faces) < before) return true;
+    for (int i = 0; i < m; ++i) p_[inside[i]] = saved[i];
+    return false;
+  }
+
+  // Mean-value weights (Floater 2003) of v's neighbours in `mesh`, from its 3D corner angles.
+  static std::vector<std::pair<int, double>> mean_value_weights(const Mesh& mesh,
+                                                                const std::vector<std::vector<int>>& vertex_faces,
+                                                                int v) {
+    std::vector<std::pair<int, double>> out;
+    for (int f : vertex_faces[v]) {
+      const auto& t = mesh.faces[f];
+      const int c = t[0] == v ? 0 : t[1] == v ? 1 : 2;
+      const int j = t[(c + 1) % 3], k = t[(c + 2) % 3];
+      const Eigen::Vector3d dj = mesh.vertices[j] - mesh.vertices[v], dk = mesh.vertices[k] - mesh.vertices[v];
+      const double lj = dj.norm(), lk = dk.norm();
+      if (lj == 0 || lk == 0) continue;
+      const double half_tan = std::tan(0.5 * std::acos(std::clamp(dj.dot(dk) / (lj * lk), -1.0, 1.0)));
+      out.push_back({j, half_tan / lj});
+      out.push_back({k, half_tan / lk});
+    }
+    return out;
+  }
+
+  // Adds to `faces` (sorted) what its rims other than the longest enclose: the parts of `to` the
+  // images skipped. Leaves `faces` as it was when a rim does not close or encloses too much.
+  void fill_holes(std::vector<int>& faces) const {
+    std::unordered_map<int, int> next;
+    {
+      std::unordered_map<int64_t, int> directed;
+      const int64_t n = to_.num_vertices();
+      for (int f : faces)
+        for (int i = 0; i < 3; ++i) ++directed[int64_t(to_.faces[f][i]) * n + to_.faces[f][(i + 1) % 3]];
+      for (const auto& [key, count] : directed) {
+        const int u = static_cast<int>(key / n), w = static_cast<int>(key % n);
+        if (!directed.count(int64_t(w) * n + u) && !next.emplace(u, w).second) return;  // pinched
+      }
+    }
+    std::vector<std::vector<int>> rims;
+    std::unordered_map<int, int> seen;
+    for (const auto& [start, head] : next) {
+      if (seen.count(start)) continue;
+      std::vector<int> rim{start};
+      seen[start] = 1;
+      for (int v = head; v != start; v = next.at(v)) {
+        if (seen.count(v) || !next.count(v)) return;
+        seen[v] = 1;
+        rim.push_back(v);
+      }
+      rims.push_back(std::move(rim));
+    }
+    if (rims.size() < 2) return;
+    std::sort(rims.begin(), rims.end(), [](const auto& a, const auto& b) { return a.size() > b.size(); });
+    std::vector<char> in(to_.num_faces(), 0);
+    for (int f : faces) in[f] = 1;
+    std::vector<int> added;
+    const size_t limit = faces.size();
+    for (size_t r = 1; r < rims.size(); ++r) {
+      std::vector<int> stack;
+      for (size_t i = 0; i < rims[r].size(); ++i) {
+        const int d = to_.directed_edge_index(rims[r][(i + 1) % rims[r].size()], rims[r][i]);
+        if (d < 0 || g_.halfedge_face[d] < 0) return;
+        stack.push_back(g_.halfedge_face[d]);
+      }
+      std::vector<int> hole;
+      while (!stack.empty()) {
+        const int f = stack.back();
+        stack.pop_back();
+        if (in[f]) continue;
+        in[f] = 2;
+        hole.push_back(f);
+        if (hole.size() + added.size() > limit) {  // the outside, not a hole
+          for (int h : hole) in[h] = 0;
+          for (int h : added) in[h] = 0;
+          return;
+        }
+        const auto& t = to_.faces[f];
+        for (int i = 0; i < 3; ++i) {
+          const int d = to_.directed_edge_index(t[(i + 1) % 3], t[i]);
+          if (d >= 0 && g_.halfedge_face[d] >= 0 && !in[g_.halfedge_face[d]]) stack.push_back(g_.halfedge_face[d]);
+        }
+      }
+      added.insert(added.end(), hole.begin(), hole.end());
+    }
+    faces.insert(faces.end(), added.begin(), added.end());
+    sort_unique(faces);
+  }
+
+  // Lays `faces` of `to` (with their vertices `verts`, sorted) out in the plane when they form a
+  // disc: the rim on the unit circle by arc length, the inside by Tutte's embedding. False if not
+  // a disc.
+  bool lay_out_disc(const std::vector<int>& faces, const std::vector<int>& verts,
+                    std::unordered_map<int, Eigen::Vector2d>& chart) const {
+    std::unordered_map<int64_t, int> directed;  // directed edge -> count
+    const int64_t n = to_.num_vertices();
+    for (int f : faces)
+      for (int i = 0; i < 3; ++i) ++directed[int64_t(to_.faces[f][i]) * n + to_.faces[f][(i + 1) % 3]];
+    std::unordered_map<int, int> next;  // rim: tail -> head of the edges with no twin inside
+    int64_t edges = 0;
+    for (const auto& [key, count] : directed) {
+      const int u = static_cast<int>(key / n), w = static_cast<int>(key % n);
+      if (count != 1) return false;
+      if (!directed.count(int64_t(w) * n + u)) {
+        if (!next.emplace(u, w).second) return false;  // pinched rim
+        ++edges;
+      } else if (u < w) {
+        ++edges;
+      }
+    }
+    if (next.empty() || static_cast<int64_t>(verts.size()) - edges + static_cast<int64_t>(faces.size()) != 1)
+      return false;
+    std::vector<int> rim{next.begin()->first};
+    while (true) {
+      const auto at = next.find(rim.back());
+      if (at == next.end()) return false;
+      if (at->second == rim.front()) break;
+      rim.push_back(at->second);
+      if (rim.size() > next.size()) return false;
+    }
+    if (rim.size() != next.size()) return false;  // more than one rim: not a disc
+    std::vector<double> length(rim.size() + 1, 0.0);
+    for (size_t i = 0; i < rim.size(); ++i)
+      length[i + 1] = length[i] + (to_.vertices[rim[(i + 1) % rim.size()]] - to_.vertices[rim[i]]).norm();
+    if (!(length.back() > 0)) return false;
+    constexpr double kTwoPi = 6.283185307179586;
+    for (size_t i = 0; i < rim.size(); ++i) {
+      const double angle = kTwoPi * length[i] / length.back();
+      chart[rim[i]] = Eigen::Vector2d(std::cos(angle), std::sin(angle));
+    }
+    std::vector<int> inner;
+    std::unordered_map<int, int> index;
+    for (int v : verts)
+      if (!chart.count(v)) index[v] = static_cast<int>(inner.size()), inner.push_back(v);
+    const int m = static_cast<int>(inner.size());
+    if (m > 0) {
+      std::vector<Eigen::Triplet<double>> entries;
+      Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(m, 2);
+      for (int i = 0; i < m; ++i)
+        for (const auto& [w, weight] : mean_value_weights(to_, to_faces_, inner[i])) {
+          entries.emplace_back(i, i, weight);
+          const auto at = index.find(w);
+          if (at != index.end()) {
+            entries.emplace_back(i, at->second, -weight);
+          } else {
+            rhs.row(i) += weight * chart.at(w).transpose();
+          }
+        }
+      Eigen::SparseMatrix<double> a(m, m);
+      a.setFromTriplets(entries.begin(), entries.end());
+      Eigen::SparseLU<Eigen::SparseMatrix<double>> lu(a);
+      if (lu.info() != Eigen::Success) return false;
+      const Eigen::MatrixXd u = lu.solve(rhs);
+      if (!u.allFinite()) return false;
+      for (int i = 0; i < m; ++i) chart[inner[i]] = u.row(i).transpose();
+    }
+    return true;
+  }
+
+  static double cross2(const Eigen::Vector2d& a, const Eigen::Vector2d& b) { return a.x() * b.y() - a.y() * b.x(); }
+
+  const Mesh& from_;
+  const Mesh& to_;
+  const Geometry& g_;
+  const std::vector<std::vector<int>>& from_faces_;
+  const std::vector<std::vector<int>>& to_faces_;
+  std::vector<SurfacePoint>& p_;
+};
+
 class SideMap {
 public:
   SideMap(const Mesh& from, const Mesh& to, const PointMapOptions& options)
@@ -165,6 +504,8 @@ public:
           }
           if (!changed) break;
         }
+    // 3. Discs around what single moves could not fix.
+    Untangler(from_, to_, g_, from_faces_, to_faces_, p_).run(options_.untangle_rings);
     return p_;
   }
 
@@ -291,6 +632,16 @@ PointMaps point_maps(const ProductSpace& space, const std::vector<int64_t>& gamm
   maps.x_to_y = SideMap(space.x(), space.y(), options).run(fibres(space, gamma, true), start.x_to_y);
   maps.y_to_x = SideMap(space.y(), space.x(), options).run(fibres(space, gamma, false), start.y_to_x);
   return maps;
+}
+
+int untangle_point_map(const Mesh& from, const Mesh& to, std::vector<SurfacePoint>& map, int max_rings) {
+  if (static_cast<int>(map.size()) != from.num_vertices())
+    throw InvalidInputError("untangle: the map does not have one point per vertex");
+  for (const SurfacePoint& p : map)
+    if (p.face < 0 || p.face >= to.num_faces()) throw InvalidInputError("untangle: a point is not on the target");
+  const Geometry g = compute_geometry(to);
+  const auto from_faces = vertex_face_table(from), to_faces = vertex_face_table(to);
+  return Untangler(from, to, g, from_faces, to_faces, map).run(max_rings);
 }
 
 std::string point_map_text(const std::vector<SurfacePoint>& map) {

@@ -39,6 +39,11 @@ struct PointMapOptions {
   // Interior points tried per face: barycentric (i, j, k) / samples with i, j, k >= 1.
   int samples = 8;
   int max_sweeps = 20;
+  // Where single moves leave an image inverted (they straddle a fold of Γ, or one vertex cannot
+  // move without inverting another face), the disc of up to this many rings around it is laid out
+  // again: its rim's images stay, its inside goes where Tutte's embedding with mean-value weights
+  // puts it in a plane chart of the target, kept only if that inverts fewer faces. 0: off.
+  int untangle_rings = 4;
 };
 
 struct PointMaps {
@@ -50,9 +55,18 @@ struct PointMaps {
 // fewer faces (then leaves fewer degenerate), first within the vertex's fibre (its partner
 // vertices, points of the edges it is stretched along, points of the faces it is blown up over),
 // then, for faces still inverted, to points of faces up to PointMapOptions::max_ring rings around
-// the fibre, then, for degenerate images, up to two rings. Never inverts more faces than `start`.
+// the fibre, then, for degenerate images, up to two rings; then re-embeds discs around what is
+// still inverted (untangle_point_map). Never inverts more faces than `start`.
 PointMaps point_maps(const ProductSpace& space, const std::vector<int64_t>& gamma, const VertexMaps& start,
                      const PointMapOptions& options = {});
+
+// For each face of `from` whose image under `map` is inverted: lays the disc of r = 1, 2, ...,
+// `max_rings` vertex rings around its corners out again, keeping the images of the disc's rim and
+// moving its inside to Tutte's embedding (mean-value weights of `from`) of the rim's images in a
+// plane chart of `to`, and keeps that where fewer of the disc's faces are inverted (or, as many,
+// fewer degenerate). With a convex rim in the chart the disc cannot fold (Floater 2003); other
+// rims are only kept where they help. Returns the number of discs kept.
+int untangle_point_map(const Mesh& from, const Mesh& to, std::vector<SurfacePoint>& map, int max_rings = 4);
 
 // `face b0 b1 b2` per line (0-based face of the target mesh).
 std::string point_map_text(const std::vector<SurfacePoint>& map);
