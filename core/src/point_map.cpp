@@ -169,17 +169,60 @@ private:
   }
 
   int64_t star_cost(int v) const { return cost(from_faces_[v]); }
-  // Sample points of the faces of `to` around q's support.
+  // Sample points of the faces of `to` within kRepairRings rings of q's support (3: on the saved
+  // TOSCA_r Γ, 1 and 2 left one more face inverted).
   void near_points(const SurfacePoint& q, std::vector<SurfacePoint>& out) const {
     constexpr int kSamples = 6;
     std::array<int, 3> s{};
     std::vector<int> faces;
-    for (int i = 0, k = support(to_, q, s); i < k; ++i) faces.insert(faces.end(), to_faces_[s[i]].begin(), to_faces_[s[i]].end());
-    sort_unique(faces);
+    std::vector<int> verts;
+    for (int i = 0, k = support(to_, q, s); i < k; ++i) verts.push_back(s[i]);
+    for (int r = 0; r < kRepairRings; ++r) {
+      faces.clear();
+      for (int w : verts) faces.insert(faces.end(), to_faces_[w].begin(), to_faces_[w].end());
+      sort_unique(faces);
+      for (int f : faces) verts.insert(verts.end(), to_.faces[f].begin(), to_.faces[f].end());
+      sort_unique(verts);
+    }
     for (int f : faces)
       for (int i = 1; i < kSamples; ++i)
         for (int j = 1; i + j < kSamples; ++j)
           out.push_back({f, {double(i) / kSamples, double(j) / kSamples, double(kSamples - i - j) / kSamples}});
+  }
+
+  // The point of the chart deepest inside all of v's star's half-planes (where every face of the
+  // star keeps its orientation), searched on a grid over the star's box; false if outside `to`.
+  template <class InChart, class ChartOf, class Locate>
+  bool kernel_point(int v, const InChart& in_chart, const ChartOf& chart_of, const Locate& locate,
+                    SurfacePoint& out) const {
+    std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>> edges;  // (j, k): v must lie left of j->k
+    Eigen::Vector2d lo(std::numeric_limits<double>::infinity(), std::numeric_limits<double>::infinity());
+    Eigen::Vector2d hi = -lo;
+    for (int f : from_faces_[v]) {
+      const auto& t = from_.faces[f];
+      const int c = t[0] == v ? 0 : t[1] == v ? 1 : 2;
+      const SurfacePoint &pj = p_[t[(c + 1) % 3]], &pk = p_[t[(c + 2) % 3]];
+      if (!in_chart(pj) || !in_chart(pk)) return false;
+      const Eigen::Vector2d j = chart_of(pj), k = chart_of(pk);
+      edges.push_back({j, k});
+      lo = lo.cwiseMin(j).cwiseMin(k);
+      hi = hi.cwiseMax(j).cwiseMax(k);
+    }
+    if (edges.empty()) return false;
+    constexpr int kGrid = 24;
+    double best = -std::numeric_limits<double>::infinity();
+    Eigen::Vector2d at = lo;
+    for (int gx = 0; gx <= kGrid; ++gx)
+      for (int gy = 0; gy <= kGrid; ++gy) {
+        const Eigen::Vector2d q = lo + Eigen::Vector2d(gx, gy).cwiseProduct(hi - lo) / kGrid;
+        double worst = std::numeric_limits<double>::infinity();
+        for (const auto& [j, k] : edges) {
+          const double len = (k - j).norm();
+          worst = std::min(worst, len > 0 ? cross2(k - j, q - j) / len : 0.0);
+        }
+        if (worst > best) best = worst, at = q;
+      }
+    return best > 0 && locate(at, out);
   }
 
   bool embed_disc(int f0, int rings) {
@@ -232,6 +275,10 @@ private:
       laid_out = lay_out_disc(region, near, chart);
     }
     if (!laid_out) return false;
+    auto in_chart = [&](const SurfacePoint& q) {
+      const auto& t = to_.faces[q.face];
+      return chart.count(t[0]) && chart.count(t[1]) && chart.count(t[2]);
+    };
     auto chart_of = [&](const SurfacePoint& q) {
       const auto& t = to_.faces[q.face];
       return Eigen::Vector2d(q.bary[0] * chart.at(t[0]) + q.bary[1] * chart.at(t[1]) + q.bary[2] * chart.at(t[2]));
@@ -257,10 +304,8 @@ private:
     const Eigen::MatrixXd u = a.partialPivLu().solve(rhs);
     if (!u.allFinite()) return false;
 
-    // Back onto `to` through the chart's faces.
-    std::vector<SurfacePoint> placed(m);
-    for (int i = 0; i < m; ++i) {
-      const Eigen::Vector2d q = u.row(i).transpose();
+    // Back onto `to` through the chart's faces: the one q is deepest inside (ties at shared edges).
+    auto locate = [&](const Eigen::Vector2d& q, SurfacePoint& out) {
       double best = -std::numeric_limits<double>::infinity();
       for (int f : region) {
         const auto& t = to_.faces[f];
@@ -270,19 +315,23 @@ private:
         std::array<double, 3> b{cross2(p1 - q, p2 - q) / area, cross2(p2 - q, p0 - q) / area, 0.0};
         b[2] = 1 - b[0] - b[1];
         const double worst = std::min({b[0], b[1], b[2]});
-        if (worst <= best) continue;  // the face it is deepest inside (ties at shared edges)
+        if (worst <= best) continue;
         best = worst;
         for (double& x : b) x = std::max(x, 0.0);
         const double sum = b[0] + b[1] + b[2];
         for (double& x : b) x /= sum;
-        placed[i] = SurfacePoint{f, b};
+        out = SurfacePoint{f, b};
       }
-      if (best < -1e-9) return false;
-    }
+      return best >= -1e-9;
+    };
+    std::vector<SurfacePoint> placed(m);
+    for (int i = 0; i < m; ++i)
+      if (!locate(u.row(i).transpose(), placed[i])) return false;
     std::vector<SurfacePoint> saved(m);
     for (int i = 0; i < m; ++i) saved[i] = p_[inside[i]], p_[inside[i]] = placed[i];
-    // Where the rim is concave, a face with two rim corners can fold over it: move such faces'
-    // inside corners (back where they were, or nearby) while that unfolds their stars.
+    // Where the rim is concave, a face with two rim corners can fold over it: move the inside
+    // corners of inverted stars (back where they were, into their star's kernel in the chart, or
+    // nearby) while that unfolds their stars.
     for (int sweep = 0; sweep < 5; ++sweep) {
       bool changed = false;
       for (int i = 0; i < m; ++i) {
@@ -291,6 +340,7 @@ private:
         if (best < 1000) continue;
         std::vector<SurfacePoint> candidates{saved[i]};
         near_points(p_[v], candidates);
+        if (SurfacePoint k; kernel_point(v, in_chart, chart_of, locate, k)) candidates.push_back(k);
         const SurfacePoint current = p_[v];
         SurfacePoint choice = current;
         for (const SurfacePoint& q : candidates) {
@@ -469,6 +519,7 @@ private:
   const std::vector<std::vector<int>>& from_faces_;
   const std::vector<std::vector<int>>& to_faces_;
   std::vector<SurfacePoint>& p_;
+  static constexpr int kRepairRings = 3;
 };
 
 class SideMap {
