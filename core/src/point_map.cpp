@@ -284,6 +284,8 @@ private:
       return Eigen::Vector2d(q.bary[0] * chart.at(t[0]) + q.bary[1] * chart.at(t[1]) + q.bary[2] * chart.at(t[2]));
     };
 
+    for (int v : order)
+      if (ring[v] == rings && !in_chart(p_[v])) return false;
     // Tutte's embedding of the disc of `from` with its mean-value weights (positive whatever the
     // angles), the rim where its images are.
     const int m = static_cast<int>(inside.size());
@@ -496,8 +498,10 @@ private:
           const auto at = index.find(w);
           if (at != index.end()) {
             entries.emplace_back(i, at->second, -weight);
+          } else if (const auto rim_at = chart.find(w); rim_at != chart.end()) {
+            rhs.row(i) += weight * rim_at->second.transpose();
           } else {
-            rhs.row(i) += weight * chart.at(w).transpose();
+            return false;  // not a disc after all (a star leaves it)
           }
         }
       Eigen::SparseMatrix<double> a(m, m);
