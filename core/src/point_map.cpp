@@ -148,7 +148,11 @@ public:
     for (int pass = 0; pass < 3; ++pass) {
       const int before = kept;
       for (int f = 0; f < from_.num_faces(); ++f)
-        for (int r = 1; r <= max_rings && orientation(f) < 0; ++r) kept += embed_disc(f, r) ? 1 : 0;
+        for (int r = 1; r <= max_rings && orientation(f) < 0; ++r) {
+          const Disc d = embed_disc(f, r);
+          kept += d == Disc::kept ? 1 : 0;
+          if (d == Disc::no_rim) break;  // r rings hold f's whole component: more cannot help
+        }
       if (kept == before) break;
     }
     return kept;
@@ -159,16 +163,18 @@ private:
     const auto& t = from_.faces[f];
     return image_orientation(to_, g_, p_[t[0]], p_[t[1]], p_[t[2]]);
   }
-  int64_t cost(const std::vector<int>& faces) const {
-    int64_t c = 0;
+  // Inverted, then degenerate images among `faces` (compared in that order).
+  std::pair<int, int> cost(const std::vector<int>& faces) const {
+    std::pair<int, int> c{0, 0};
     for (int f : faces) {
       const int o = orientation(f);
-      c += o < 0 ? 1000 : o == 0 ? 1 : 0;
+      c.first += o < 0 ? 1 : 0;
+      c.second += o == 0 ? 1 : 0;
     }
     return c;
   }
 
-  int64_t star_cost(int v) const { return cost(from_faces_[v]); }
+  std::pair<int, int> star_cost(int v) const { return cost(from_faces_[v]); }
   // Sample points of the faces of `to` within kRepairRings rings of q's support (3: on the saved
   // TOSCA_r Γ, 1 and 2 left one more face inverted).
   void near_points(const SurfacePoint& q, std::vector<SurfacePoint>& out) const {
@@ -225,7 +231,9 @@ private:
     return best > 0 && locate(at, out);
   }
 
-  bool embed_disc(int f0, int rings) {
+  enum class Disc { kept, rejected, no_rim };
+
+  Disc embed_disc(int f0, int rings) {
     // Vertex rings around f0's corners: inside (ring < rings) moves, the rim (ring == rings) stays.
     std::unordered_map<int, int> ring;
     std::vector<int> order(from_.faces[f0].begin(), from_.faces[f0].end());
@@ -246,7 +254,16 @@ private:
         faces.insert(faces.end(), from_faces_[v].begin(), from_faces_[v].end());
       }
     sort_unique(faces);
-    const int64_t before = cost(faces);
+    {
+      // Tutte needs a rim that spans something: at least three distinct points.
+      std::vector<std::pair<int, std::array<double, 3>>> rim_points;
+      for (int v : order)
+        if (ring[v] == rings) rim_points.push_back({p_[v].face, p_[v].bary});
+      if (rim_points.empty()) return Disc::no_rim;
+      sort_unique(rim_points);
+      if (rim_points.size() < 3) return Disc::rejected;
+    }
+    const std::pair<int, int> before = cost(faces);
 
     // The chart: the faces of `to` within two rings of the images, if they form a disc, laid out
     // by Tutte's embedding of its rim onto a circle (an embedding: it cannot fold).
@@ -274,7 +291,7 @@ private:
       chart.clear();
       laid_out = lay_out_disc(region, near, chart);
     }
-    if (!laid_out) return false;
+    if (!laid_out) return Disc::rejected;
     auto in_chart = [&](const SurfacePoint& q) {
       const auto& t = to_.faces[q.face];
       return chart.count(t[0]) && chart.count(t[1]) && chart.count(t[2]);
@@ -285,26 +302,30 @@ private:
     };
 
     for (int v : order)
-      if (ring[v] == rings && !in_chart(p_[v])) return false;
+      if (ring[v] == rings && !in_chart(p_[v])) return Disc::rejected;
     // Tutte's embedding of the disc of `from` with its mean-value weights (positive whatever the
     // angles), the rim where its images are.
     const int m = static_cast<int>(inside.size());
-    Eigen::MatrixXd a = Eigen::MatrixXd::Zero(m, m);
+    std::vector<Eigen::Triplet<double>> entries;
     Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(m, 2);
     for (int i = 0; i < m; ++i) {
       const int v = inside[i];
       for (const auto& [w, weight] : mean_value_weights(from_, from_faces_, v)) {
-        a(i, i) += weight;
+        entries.emplace_back(i, i, weight);
         const auto at = index.find(w);
         if (at != index.end()) {
-          a(i, at->second) -= weight;
+          entries.emplace_back(i, at->second, -weight);
         } else {
           rhs.row(i) += weight * chart_of(p_[w]).transpose();
         }
       }
     }
-    const Eigen::MatrixXd u = a.partialPivLu().solve(rhs);
-    if (!u.allFinite()) return false;
+    Eigen::SparseMatrix<double> a(m, m);
+    a.setFromTriplets(entries.begin(), entries.end());
+    Eigen::SparseLU<Eigen::SparseMatrix<double>> lu(a);
+    if (lu.info() != Eigen::Success) return Disc::rejected;
+    const Eigen::MatrixXd u = lu.solve(rhs);
+    if (lu.info() != Eigen::Success || !u.allFinite()) return Disc::rejected;
 
     // Back onto `to` through the chart's faces: the one q is deepest inside (ties at shared edges).
     auto locate = [&](const Eigen::Vector2d& q, SurfacePoint& out) {
@@ -328,7 +349,7 @@ private:
     };
     std::vector<SurfacePoint> placed(m);
     for (int i = 0; i < m; ++i)
-      if (!locate(u.row(i).transpose(), placed[i])) return false;
+      if (!locate(u.row(i).transpose(), placed[i])) return Disc::rejected;
     std::vector<SurfacePoint> saved(m);
     for (int i = 0; i < m; ++i) saved[i] = p_[inside[i]], p_[inside[i]] = placed[i];
     // Where the rim is concave, a face with two rim corners can fold over it: move the inside
@@ -338,8 +359,8 @@ private:
       bool changed = false;
       for (int i = 0; i < m; ++i) {
         const int v = inside[i];
-        int64_t best = star_cost(v);
-        if (best < 1000) continue;
+        std::pair<int, int> best = star_cost(v);
+        if (best.first == 0) continue;
         std::vector<SurfacePoint> candidates{saved[i]};
         near_points(p_[v], candidates);
         if (SurfacePoint k; kernel_point(v, in_chart, chart_of, locate, k)) candidates.push_back(k);
@@ -347,7 +368,7 @@ private:
         SurfacePoint choice = current;
         for (const SurfacePoint& q : candidates) {
           p_[v] = q;
-          const int64_t c = star_cost(v);
+          const std::pair<int, int> c = star_cost(v);
           if (c < best) best = c, choice = q;
         }
         p_[v] = choice;
@@ -355,9 +376,14 @@ private:
       }
       if (!changed) break;
     }
-    if (cost(faces) < before) return true;
+    // Kept: fewer inverted and no more degenerate, or as many inverted and fewer degenerate (so a
+    // disc collapsed onto a curve never pays for an unfolded face).
+    const std::pair<int, int> after = cost(faces);
+    if ((after.first < before.first && after.second <= before.second) ||
+        (after.first == before.first && after.second < before.second))
+      return Disc::kept;
     for (int i = 0; i < m; ++i) p_[inside[i]] = saved[i];
-    return false;
+    return Disc::rejected;
   }
 
   // Mean-value weights (Floater 2003) of v's neighbours in `mesh`, from its 3D corner angles.

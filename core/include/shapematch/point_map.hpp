@@ -39,10 +39,9 @@ struct PointMapOptions {
   // Interior points tried per face: barycentric (i, j, k) / samples with i, j, k >= 1.
   int samples = 8;
   int max_sweeps = 20;
-  // Where single moves leave an image inverted (they straddle a fold of Γ, or one vertex cannot
-  // move without inverting another face), the disc of up to this many rings around it is laid out
-  // again: its rim's images stay, its inside goes where Tutte's embedding with mean-value weights
-  // puts it in a plane chart of the target, kept only if that inverts fewer faces. 0: off.
+  // Where single moves leave an image inverted (Γ folds there, so one vertex cannot move without
+  // inverting another face), the discs of 1..this many rings around it are laid out again
+  // (untangle_point_map). 0: off.
   int untangle_rings = 4;
 };
 
@@ -60,12 +59,17 @@ struct PointMaps {
 PointMaps point_maps(const ProductSpace& space, const std::vector<int64_t>& gamma, const VertexMaps& start,
                      const PointMapOptions& options = {});
 
-// For each face of `from` whose image under `map` is inverted: lays the disc of r = 1, 2, ...,
-// `max_rings` vertex rings around its corners out again, keeping the images of the disc's rim and
-// moving its inside to Tutte's embedding (mean-value weights of `from`) of the rim's images in a
-// plane chart of `to`, and keeps that where fewer of the disc's faces are inverted (or, as many,
-// fewer degenerate). With a convex rim in the chart the disc cannot fold (Floater 2003); other
-// rims are only kept where they help. Returns the number of discs kept.
+// For each face of `from` whose image under `map` is inverted, for r = 1, 2, ..., `max_rings`
+// while it stays inverted: the disc of r vertex rings around its corners is laid out again. The
+// rim's points stay; the inside goes to Tutte's embedding (mean-value weights of `from`) of the
+// rim's points in a chart of `to` (the faces around the points, if they form a disc, embedded by
+// Tutte onto a circle); then inside vertices whose star is still inverted move one at a time (back,
+// into their star's kernel in the chart, or nearby). The disc is kept if it leaves fewer of its
+// faces inverted and none more degenerate, or as many inverted and fewer degenerate; else it is
+// undone. A convex rim cannot fold in the chart (Floater 2003), but orientation is judged on `to`
+// (image_orientation) and rims need not be convex, hence the check. A disc that holds the whole
+// of f's component (no rim) is never laid out. Up to three passes over the faces. `map` must have
+// one point per vertex of `from` on a face of `to`. Returns the number of discs kept.
 int untangle_point_map(const Mesh& from, const Mesh& to, std::vector<SurfacePoint>& map, int max_rings = 4);
 
 // `face b0 b1 b2` per line (0-based face of the target mesh).
