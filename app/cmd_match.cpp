@@ -479,7 +479,7 @@ Action add_match_command(CLI::App& app) {
                "replace each pocket (an edge stretched over a whole star, a tear that A x = b admits) by the star collapsed onto one vertex: continuous, but costs energy");
   app.add_option("--untangle-rings", a->untangle_rings,
                  "where the point map still inverts a face, lay discs of up to this many rings around it out again "
-                 "(Tutte's embedding in a chart of the other shape), kept where fewer faces invert; 0: off")
+                 "(Tutte's embedding in a chart of the other shape), kept where fewer faces invert and none more are degenerate; 0: off")
       ->check(CLI::Range(0, 16))
       ->capture_default_str();
   app.add_option("--fractional-batch", a->fractional_batch,
