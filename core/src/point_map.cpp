@@ -135,6 +135,19 @@ Fibres fibres(const ProductSpace& space, const std::vector<int64_t>& gamma, bool
   return fb;
 }
 
+// How many of `faces` of `from` have inverted, and how many degenerate, images under p.
+std::pair<int, int> image_tally(const Mesh& from, const Mesh& to, const Geometry& g, const std::vector<SurfacePoint>& p,
+                                const std::vector<int>& faces) {
+  std::pair<int, int> c{0, 0};
+  for (int f : faces) {
+    const auto& t = from.faces[f];
+    const int o = image_orientation(to, g, p[t[0]], p[t[1]], p[t[2]]);
+    c.first += o < 0 ? 1 : 0;
+    c.second += o == 0 ? 1 : 0;
+  }
+  return c;
+}
+
 // Lays discs of `from` out again around inverted images (untangle_point_map).
 class Untangler {
 public:
@@ -164,15 +177,7 @@ private:
     return image_orientation(to_, g_, p_[t[0]], p_[t[1]], p_[t[2]]);
   }
   // Inverted, then degenerate images among `faces` (compared in that order).
-  std::pair<int, int> cost(const std::vector<int>& faces) const {
-    std::pair<int, int> c{0, 0};
-    for (int f : faces) {
-      const int o = orientation(f);
-      c.first += o < 0 ? 1 : 0;
-      c.second += o == 0 ? 1 : 0;
-    }
-    return c;
-  }
+  std::pair<int, int> cost(const std::vector<int>& faces) const { return image_tally(from_, to_, g_, p_, faces); }
 
   std::pair<int, int> star_cost(int v) const { return cost(from_faces_[v]); }
   // Sample points of the faces of `to` within kRepairRings rings of q's support (3: on the saved
@@ -180,17 +185,8 @@ private:
   void near_points(const SurfacePoint& q, std::vector<SurfacePoint>& out) const {
     constexpr int kSamples = 6;
     std::array<int, 3> s{};
-    std::vector<int> faces;
-    std::vector<int> verts;
-    for (int i = 0, k = support(to_, q, s); i < k; ++i) verts.push_back(s[i]);
-    for (int r = 0; r < kRepairRings; ++r) {
-      faces.clear();
-      for (int w : verts) faces.insert(faces.end(), to_faces_[w].begin(), to_faces_[w].end());
-      sort_unique(faces);
-      for (int f : faces) verts.insert(verts.end(), to_.faces[f].begin(), to_.faces[f].end());
-      sort_unique(verts);
-    }
-    for (int f : faces)
+    const int k = support(to_, q, s);
+    for (int f : ring_faces(to_, to_faces_, std::vector<int>(s.begin(), s.begin() + k), kRepairRings))
       for (int i = 1; i < kSamples; ++i)
         for (int j = 1; i + j < kSamples; ++j)
           out.push_back({f, {double(i) / kSamples, double(j) / kSamples, double(kSamples - i - j) / kSamples}});
@@ -276,16 +272,9 @@ private:
     std::unordered_map<int, Eigen::Vector2d> chart;
     bool laid_out = false;
     for (int grow = 2; grow >= 1 && !laid_out; --grow) {
-      std::vector<int> near = supports;
-      for (int r = 0; r < grow; ++r) {
-        sort_unique(near);
-        region.clear();
-        for (int w : near) region.insert(region.end(), to_faces_[w].begin(), to_faces_[w].end());
-        sort_unique(region);
-        for (int f : region) near.insert(near.end(), to_.faces[f].begin(), to_.faces[f].end());
-      }
+      region = ring_faces(to_, to_faces_, supports, grow);
       fill_holes(region);
-      near.clear();
+      std::vector<int> near;
       for (int f : region) near.insert(near.end(), to_.faces[f].begin(), to_.faces[f].end());
       sort_unique(near);
       chart.clear();
@@ -605,12 +594,8 @@ private:
   }
   // An inverted image outweighs any number of degenerate ones.
   int64_t cost(int v) const {
-    int64_t c = 0;
-    for (int f : from_faces_[v]) {
-      const int o = orientation(f);
-      c += o < 0 ? 1000 : o == 0 ? 1 : 0;
-    }
-    return c;
+    const auto [inverted, degenerate] = image_tally(from_, to_, g_, p_, from_faces_[v]);
+    return 1000 * int64_t(inverted) + degenerate;
   }
   // The worst shape in v's star: area over the sum of squared sides (a tie-break).
   double quality(int v) const {
@@ -674,19 +659,8 @@ private:
     std::vector<int> verts = fb.vertices[v];
     std::array<int, 3> s{};
     for (int i = 0, k = support(to_, p_[v], s); i < k; ++i) verts.push_back(s[i]);
-    sort_unique(verts);
-    std::vector<int> faces;
-    for (int r = 0; r < ring; ++r) {
-      faces.clear();
-      for (int w : verts) faces.insert(faces.end(), to_faces_[w].begin(), to_faces_[w].end());
-      sort_unique(faces);
-      if (r + 1 < ring) {
-        for (int f : faces) verts.insert(verts.end(), to_.faces[f].begin(), to_.faces[f].end());
-        sort_unique(verts);
-      }
-    }
     std::vector<SurfacePoint> out;
-    for (int f : faces) add_face_samples(f, out);
+    for (int f : ring_faces(to_, to_faces_, verts, ring)) add_face_samples(f, out);
     return out;
   }
 
