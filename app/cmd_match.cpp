@@ -38,6 +38,7 @@ struct MatchArgs {
   double fractional_batch = RoundingOptions{}.fractional_batch;
   bool close_pockets = RoundingOptions{}.close_pockets;
   int untangle_rings = PointMapOptions{}.untangle_rings;
+  double untangle_max_shift = PointMapOptions{}.untangle_max_shift;
   bool whole_lp = !RoundingOptions{}.split_parts;
   int64_t greedy_above = RoundingOptions{}.greedy_above;
   int greedy_margin = RoundingOptions{}.greedy_margin;
@@ -224,6 +225,7 @@ int run_match(const MatchArgs& args) {
   // Points follow Γ where one partner vertex cannot (a vertex blown up, an edge stretched).
   PointMapOptions po;
   po.untangle_rings = args.untangle_rings;
+  po.untangle_max_shift = args.untangle_max_shift;
   const PointMaps points = point_maps(m.space, rr.gamma, maps, po);
   const OrientationFlips vertex_flips = count_orientation_flips(x, y, maps.x_to_y);
   const OrientationFlips point_flips = count_orientation_flips(x, y, points.x_to_y);
@@ -347,6 +349,7 @@ int run_match(const MatchArgs& args) {
                               .set("later_round_iterations", args.later_round_iterations)
                               .set("close_pockets", args.close_pockets)
                               .set("untangle_rings", args.untangle_rings)
+                              .set("untangle_max_shift", args.untangle_max_shift)
                               .set("greedy_above", args.greedy_above)
                               .set("greedy_margin", args.greedy_margin)
                               .set("search_below", args.search_below)
@@ -479,8 +482,15 @@ Action add_match_command(CLI::App& app) {
                "replace each pocket (an edge stretched over a whole star, a tear that A x = b admits) by the star collapsed onto one vertex: continuous, but costs energy");
   app.add_option("--untangle-rings", a->untangle_rings,
                  "where the point map still inverts a face, lay discs of up to this many rings around it out again "
-                 "(Tutte's embedding in a chart of the other shape), kept where fewer faces invert and none more are degenerate; 0: off")
-      ->check(CLI::Range(0, 16))
+                 "(Tutte's embedding in a chart of the other shape, then back towards the old points where that inverts "
+                 "no more faces), kept where fewer faces invert, none more are degenerate and the points moved little "
+                 "(--untangle-max-shift); 0: off")
+      ->check(CLI::Range(0, 64))
+      ->capture_default_str();
+  app.add_option("--untangle-max-shift", a->untangle_max_shift,
+                 "the most one untangled disc may move the point map's points, summed, divided by sqrt(area) of the "
+                 "other shape and by the vertex count: about what one disc may add to the mean geodesic error")
+      ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   app.add_option("--fractional-batch", a->fractional_batch,
                  "where no LP value exceeds the threshold, fix the largest of up to this fraction of the open faces "

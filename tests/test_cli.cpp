@@ -125,7 +125,8 @@ TEST_CASE("cli: match writes a verified, complete output directory, or nothing")
   CHECK(fs::exists(out / "y.ply"));
   CHECK(report.find("\"close_pockets\": false") != std::string::npos);  // off by default
   CHECK(json_number(report, "pockets_closed") == 0);
-  CHECK(json_number(report, "untangle_rings") == 4);  // the default reaches the report
+  CHECK(json_number(report, "untangle_rings") == 24);  // the defaults reach the report
+  CHECK(json_number(report, "untangle_max_shift") == doctest::Approx(1e-3));
   // One level of 30 faces: rounded with 0.5, and again with the default alternative 0.7.
   CHECK(json_number(report, "roundings") == 2);
 

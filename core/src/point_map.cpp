@@ -152,19 +152,28 @@ std::pair<int, int> image_tally(const Mesh& from, const Mesh& to, const Geometry
 class Untangler {
 public:
   Untangler(const Mesh& from, const Mesh& to, const Geometry& gt, const std::vector<std::vector<int>>& from_faces,
-            const std::vector<std::vector<int>>& to_faces, std::vector<SurfacePoint>& p)
-      : from_(from), to_(to), g_(gt), from_faces_(from_faces), to_faces_(to_faces), p_(p) {}
+            const std::vector<std::vector<int>>& to_faces, std::vector<SurfacePoint>& p, double max_shift)
+      : from_(from), to_(to), g_(gt), from_faces_(from_faces), to_faces_(to_faces), p_(p) {
+    double area = 0;
+    for (const double a : gt.face_area) area += a;
+    shift_budget_ = max_shift * std::sqrt(area) * from.num_vertices();
+  }
 
+  // Small discs for every face first, then larger ones: the work of a disc grows with its area,
+  // and where no disc helps (a map mirrored as a whole) the budget runs out on the large ones.
   int run(int max_rings) {
     int kept = 0;
+    std::vector<char> whole(from_.num_faces(), 0);  // r rings held the face's whole component
     // A disc is kept when it inverts fewer faces in all, which may invert one seen before: again.
     for (int pass = 0; pass < 3; ++pass) {
       const int before = kept;
-      for (int f = 0; f < from_.num_faces(); ++f)
-        for (int r = 1; r <= max_rings && orientation(f) < 0; ++r) {
+      for (int r = 1; r <= max_rings; ++r)
+        for (int f = 0; f < from_.num_faces(); ++f) {
+          if (whole[f] || orientation(f) >= 0) continue;
+          if (work_ > kWorkPerVertex * from_.num_vertices()) return kept;
           const Disc d = embed_disc(f, r);
           kept += d == Disc::kept ? 1 : 0;
-          if (d == Disc::no_rim) break;  // r rings hold f's whole component: more cannot help
+          whole[f] = d == Disc::no_rim;
         }
       if (kept == before) break;
     }
@@ -177,9 +186,12 @@ private:
     return image_orientation(to_, g_, p_[t[0]], p_[t[1]], p_[t[2]]);
   }
   // Inverted, then degenerate images among `faces` (compared in that order).
-  std::pair<int, int> cost(const std::vector<int>& faces) const { return image_tally(from_, to_, g_, p_, faces); }
+  std::pair<int, int> cost(const std::vector<int>& faces) {
+    work_ += static_cast<int64_t>(faces.size());
+    return image_tally(from_, to_, g_, p_, faces);
+  }
 
-  std::pair<int, int> star_cost(int v) const { return cost(from_faces_[v]); }
+  std::pair<int, int> star_cost(int v) { return cost(from_faces_[v]); }
   // Sample points of the faces of `to` within kRepairRings rings of q's support (3: on the saved
   // TOSCA_r Γ, 1 and 2 left one more face inverted).
   void near_points(const SurfacePoint& q, std::vector<SurfacePoint>& out) const {
@@ -317,9 +329,20 @@ private:
     if (lu.info() != Eigen::Success || !u.allFinite()) return Disc::rejected;
 
     // Back onto `to` through the chart's faces: the one q is deepest inside (ties at shared edges).
+    // The chart lies in the unit disc; a grid of its faces' boxes keeps this local.
+    const int cells = std::max(1, static_cast<int>(std::sqrt(double(region.size()))));
+    std::vector<std::vector<int>> grid(size_t(cells) * cells);
+    auto cell = [cells](double c) { return std::clamp(static_cast<int>((c + 1) * 0.5 * cells), 0, cells - 1); };
+    for (int f : region) {
+      const auto& t = to_.faces[f];
+      Eigen::Vector2d lo = chart.at(t[0]), hi = lo;
+      for (int i = 1; i < 3; ++i) lo = lo.cwiseMin(chart.at(t[i])), hi = hi.cwiseMax(chart.at(t[i]));
+      for (int gx = cell(lo.x() - 4e-9); gx <= cell(hi.x() + 4e-9); ++gx)
+        for (int gy = cell(lo.y() - 4e-9); gy <= cell(hi.y() + 4e-9); ++gy) grid[size_t(gx) * cells + gy].push_back(f);
+    }
     auto locate = [&](const Eigen::Vector2d& q, SurfacePoint& out) {
       double best = -std::numeric_limits<double>::infinity();
-      for (int f : region) {
+      for (int f : grid[size_t(cell(q.x())) * cells + cell(q.y())]) {
         const auto& t = to_.faces[f];
         const Eigen::Vector2d p0 = chart.at(t[0]), p1 = chart.at(t[1]), p2 = chart.at(t[2]);
         const double area = cross2(p1 - p0, p2 - p0);
@@ -367,12 +390,72 @@ private:
     }
     // Kept: fewer inverted and no more degenerate, or as many inverted and fewer degenerate (so a
     // disc collapsed onto a curve never pays for an unfolded face).
-    const std::pair<int, int> after = cost(faces);
-    if ((after.first < before.first && after.second <= before.second) ||
-        (after.first == before.first && after.second < before.second))
-      return Disc::kept;
+    // (Fewer degenerate alone counts only for small discs: a large one would move hundreds of
+    // points far from Γ for it.)
+    auto better = [&before, rings](const std::pair<int, int>& after) {
+      return (after.first < before.first && after.second <= before.second) ||
+             (rings <= 4 && after.first == before.first && after.second < before.second);
+    };
+    // Tutte's layout is needed only near the fold; elsewhere it moves points off where Γ put them
+    // (on FAUST_r, 24 rings of it doubled the point map's error). So the inside goes back towards
+    // its old points wherever that inverts nothing more: first letting degenerate images come back
+    // too (Γ collapses faces where X is compressed), then, if that loses the disc, only where they
+    // do not.
+    // A disc may move the points only so far in all: where Γ collapsed a whole part (a hand onto a
+    // point), unfolding one face re-spreads hundreds of points far from their truth.
+    auto shift_ok = [&] {
+      double moved = 0;
+      for (int i = 0; i < m; ++i) moved += (point_position(to_, p_[inside[i]]) - point_position(to_, saved[i])).norm();
+      return moved <= shift_budget_;
+    };
+    if (!better(cost(faces))) {
+      for (int i = 0; i < m; ++i) p_[inside[i]] = saved[i];
+      return Disc::rejected;
+    }
+    std::vector<SurfacePoint> laid(m);
+    for (int i = 0; i < m; ++i) laid[i] = p_[inside[i]];
+    for (const bool strict : {false, true}) {
+      pull_back(inside, saved, strict, in_chart, chart_of, locate);
+      if (better(cost(faces)) && shift_ok()) return Disc::kept;
+      for (int i = 0; i < m; ++i) p_[inside[i]] = laid[i];
+    }
+    if (shift_ok()) return Disc::kept;
     for (int i = 0; i < m; ++i) p_[inside[i]] = saved[i];
     return Disc::rejected;
+  }
+
+  // Moves each vertex of `inside` to its old point, or a half, quarter or eighth of the way there
+  // in the chart, where its star inverts no more faces than now (and, if `strict`, has no more
+  // degenerate images); sweeps while anything moves.
+  template <class InChart, class ChartOf, class Locate>
+  void pull_back(const std::vector<int>& inside, const std::vector<SurfacePoint>& old, bool strict,
+                 const InChart& in_chart, const ChartOf& chart_of, const Locate& locate) {
+    constexpr int kSweeps = 12;
+    for (int sweep = 0; sweep < kSweeps; ++sweep) {
+      bool moved = false;
+      for (size_t i = 0; i < inside.size(); ++i) {
+        const int v = inside[i];
+        const SurfacePoint current = p_[v];
+        if (current.face == old[i].face && current.bary == old[i].bary) continue;
+        const std::pair<int, int> now = star_cost(v);
+        for (const double t : {1.0, 0.5, 0.25, 0.125}) {
+          SurfacePoint q = old[i];
+          if (t < 1) {
+            if (!in_chart(current) || !in_chart(old[i])) break;
+            const Eigen::Vector2d a = chart_of(current), b = chart_of(old[i]);
+            if (!locate(Eigen::Vector2d(a + t * (b - a)), q)) continue;
+          }
+          p_[v] = q;
+          const std::pair<int, int> c = star_cost(v);
+          if (c.first <= now.first && (!strict || c.second <= now.second)) {
+            moved = true;
+            break;
+          }
+          p_[v] = current;
+        }
+      }
+      if (!moved) break;
+    }
   }
 
   // Mean-value weights (Floater 2003) of v's neighbours in `mesh`, from its 3D corner angles.
@@ -538,6 +621,11 @@ private:
   const std::vector<std::vector<int>>& from_faces_;
   const std::vector<std::vector<int>>& to_faces_;
   std::vector<SurfacePoint>& p_;
+  double shift_budget_ = 0;  // the most one disc may move the points, summed (lengths of `to`)
+  // Faces judged (image_orientation) so far, and the most per vertex of `from`: a 10 000-face
+  // result with a dozen folds judges about 1e6 in all.
+  int64_t work_ = 0;
+  static constexpr int64_t kWorkPerVertex = 4000;
   static constexpr int kRepairRings = 3;
 };
 
@@ -575,7 +663,7 @@ public:
           if (!changed) break;
         }
     // 3. Discs around what single moves could not fix.
-    Untangler(from_, to_, g_, from_faces_, to_faces_, p_).run(options_.untangle_rings);
+    Untangler(from_, to_, g_, from_faces_, to_faces_, p_, options_.untangle_max_shift).run(options_.untangle_rings);
     return p_;
   }
 
@@ -689,14 +777,16 @@ PointMaps point_maps(const ProductSpace& space, const std::vector<int64_t>& gamm
   return maps;
 }
 
-int untangle_point_map(const Mesh& from, const Mesh& to, std::vector<SurfacePoint>& map, int max_rings) {
+int untangle_point_map(const Mesh& from, const Mesh& to, std::vector<SurfacePoint>& map, int max_rings,
+                       double max_shift) {
   if (static_cast<int>(map.size()) != from.num_vertices())
     throw InvalidInputError("untangle: the map does not have one point per vertex");
+  if (!(max_shift >= 0)) throw InvalidInputError("untangle: the shift bound must be a number >= 0");
   for (const SurfacePoint& p : map)
     if (p.face < 0 || p.face >= to.num_faces()) throw InvalidInputError("untangle: a point is not on the target");
   const Geometry g = compute_geometry(to);
   const auto from_faces = vertex_face_table(from), to_faces = vertex_face_table(to);
-  return Untangler(from, to, g, from_faces, to_faces, map).run(max_rings);
+  return Untangler(from, to, g, from_faces, to_faces, map, max_shift).run(max_rings);
 }
 
 std::string point_map_text(const std::vector<SurfacePoint>& map) {

@@ -41,8 +41,13 @@ struct PointMapOptions {
   int max_sweeps = 20;
   // Where single moves leave an image inverted (Γ folds there, so one vertex cannot move without
   // inverting another face), the discs of 1..this many rings around it are laid out again
-  // (untangle_point_map). 0: off.
-  int untangle_rings = 4;
+  // (untangle_point_map). 0: off. (A fold in a slit of Γ needs a disc that reaches past the slit:
+  // 8-13 rings on the TOSCA_r results, where 4 left faces inverted.)
+  int untangle_rings = 24;
+  // The most one disc may move the points, summed, divided by √area(to) and by the vertices of
+  // `from`: about what one disc may add to the mean geodesic error (each disc kept must unfold a
+  // face, so they are few).
+  double untangle_max_shift = 1e-3;
 };
 
 struct PointMaps {
@@ -64,13 +69,20 @@ PointMaps point_maps(const ProductSpace& space, const std::vector<int64_t>& gamm
 // rim's points stay; the inside goes to Tutte's embedding (mean-value weights of `from`) of the
 // rim's points in a chart of `to` (the faces around the points, if they form a disc, embedded by
 // Tutte onto a circle); then inside vertices whose star is still inverted move one at a time (back,
-// into their star's kernel in the chart, or nearby). The disc is kept if it leaves fewer of its
-// faces inverted and none more degenerate, or as many inverted and fewer degenerate; else it is
-// undone. A convex rim cannot fold in the chart (Floater 2003), but orientation is judged on `to`
-// (image_orientation) and rims need not be convex, hence the check. A disc that holds the whole
-// of f's component (no rim) is never laid out. Up to three passes over the faces. `map` must have
-// one point per vertex of `from` on a face of `to`. Returns the number of discs kept.
-int untangle_point_map(const Mesh& from, const Mesh& to, std::vector<SurfacePoint>& map, int max_rings = 4);
+// into their star's kernel in the chart, or nearby); then every inside vertex moves back towards
+// its old point (all the way, or a half, quarter or eighth of it in the chart) where its star
+// inverts no more faces than before the move, first letting degenerate images return, then not.
+// The disc is kept if it leaves fewer of its faces inverted and none more degenerate (or, up to 4
+// rings, as many inverted and fewer degenerate) and moves the points by at most
+// `max_shift` · √area(to) · |V(from)| summed (per disc); else it is undone. A convex rim cannot
+// fold in the chart (Floater 2003), but orientation is judged on `to` (image_orientation) and rims
+// need not be convex, hence the check. A disc that holds the whole of f's component (no rim) is
+// never laid out. Every inverted face gets its 1-ring disc, then every face still inverted its
+// 2-ring disc, and so on; up to three such passes, and no new disc once 4 000 · |V(from)| faces
+// have been judged. `map` must have one point per vertex of `from` on a face of `to`; `max_shift`
+// >= 0. Returns the number of discs kept.
+int untangle_point_map(const Mesh& from, const Mesh& to, std::vector<SurfacePoint>& map, int max_rings = 24,
+                       double max_shift = 1e-3);
 
 // `face b0 b1 b2` per line (0-based face of the target mesh).
 std::string point_map_text(const std::vector<SurfacePoint>& map);
