@@ -192,6 +192,16 @@ int run_eval(const EvalArgs& args) {
                                         read_vts_ground_truth(args.gt_x, args.gt_y_sym, x_input, y_input), options);
     point_flips = count_orientation_flips(xm, ym, points);
   }
+  // The other direction's point map (faces of Y inverted), where match wrote it.
+  const fs::path back_path = dir / "map_y_to_x_points.txt";
+  std::optional<OrientationFlips> back_flips;
+  if (point_flips && fs::exists(back_path)) {
+    const std::vector<SurfacePoint> back = read_point_map(back_path.string(), xm);
+    if (static_cast<int>(back.size()) != ym.num_vertices())
+      throw InvalidInputError(fmt::format("{}: {} lines, but y.ply has {} vertices", back_path.string(), back.size(),
+                                          ym.num_vertices()));
+    back_flips = count_orientation_flips(ym, xm, back);
+  }
 
   std::string csv = "threshold,fraction\n";
   Json pck = Json::array();
@@ -234,6 +244,8 @@ int run_eval(const EvalArgs& args) {
                   .set("auc", point_errors->auc)
                   .set("orientation_flips", point_flips->flips)
                   .set("degenerate_faces", point_flips->degenerate);
+    if (back_flips)
+      pm.set("y_to_x_orientation_flips", back_flips->flips).set("y_to_x_degenerate_faces", back_flips->degenerate);
     if (point_symmetric)
       pm.set("symmetric_mean_geodesic_error", point_symmetric->mean)
           .set("best_mean_geodesic_error", std::min(point_errors->mean, point_symmetric->mean));

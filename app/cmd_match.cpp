@@ -229,9 +229,14 @@ int run_match(const MatchArgs& args) {
   const PointMaps points = point_maps(m.space, rr.gamma, maps, po);
   const OrientationFlips vertex_flips = count_orientation_flips(x, y, maps.x_to_y);
   const OrientationFlips point_flips = count_orientation_flips(x, y, points.x_to_y);
+  // The other way too: a matching is judged in both directions.
+  const OrientationFlips vertex_flips_yx = count_orientation_flips(y, x, maps.y_to_x);
+  const OrientationFlips point_flips_yx = count_orientation_flips(y, x, points.y_to_x);
   seconds.set("point_maps", stage.seconds());
   spdlog::info("faces of X inverted by the vertex map: {} ({} degenerate); by the point map: {} ({} degenerate)",
                vertex_flips.flips, vertex_flips.degenerate, point_flips.flips, point_flips.degenerate);
+  spdlog::info("faces of Y inverted by the vertex map: {} ({} degenerate); by the point map: {} ({} degenerate)",
+               vertex_flips_yx.flips, vertex_flips_yx.degenerate, point_flips_yx.flips, point_flips_yx.degenerate);
   spdlog::info("energy {:.6g}, lower bound {:.6g}, gap {:.2f} %, {} rounds{}, verified", rr.energy, rr.lower_bound,
                100 * rr.gap, rr.rounds.size(),
                rr.pockets_closed > 0 ? fmt::format(", {} pockets closed", rr.pockets_closed) : std::string());
@@ -333,7 +338,9 @@ int run_match(const MatchArgs& args) {
     };
     report.set("maps", Json::object()
                            .set("vertex_x_to_y", flips_json(vertex_flips))
-                           .set("point_x_to_y", flips_json(point_flips)));
+                           .set("point_x_to_y", flips_json(point_flips))
+                           .set("vertex_y_to_x", flips_json(vertex_flips_yx))
+                           .set("point_y_to_x", flips_json(point_flips_yx)));
     report.set("options", Json::object()
                               .set("bending", args.pair.bending)
                               .set("lame_lambda", args.pair.lame.at(0))

@@ -249,4 +249,9 @@ TEST_CASE("cli: the bundled pair matches sensibly" * doctest::test_suite("slow")
   const std::string points = r.out.substr(at);
   CHECK(json_number(points, "orientation_flips") == 0);
   CHECK(json_number(points, "mean_geodesic_error") < 0.15);
+  // And the other direction's point map, as match reported it.
+  CHECK(json_number(points, "y_to_x_orientation_flips") == 0);
+  const size_t back = report.find("\"point_y_to_x\"");
+  REQUIRE(back != std::string::npos);
+  CHECK(json_number(report.substr(back), "inverted") == json_number(points, "y_to_x_orientation_flips"));
 }
