@@ -1,0 +1,90 @@
+#!/usr/bin/env bash
+# Packs a queue of full-resolution matches for a lent GPU machine (docs/benchmarks.md, "A queue of
+# pairs on a lent GPU"): the Release binary with the libraries it needs beyond glibc, the pairs'
+# files (copied, never committed: keep DIR ignored), one pairs file per job and a runner.
+#   tools/gpu_queue.sh PAIRS [on|off|both] [DIR] [-- MATCH-ARGS...]
+# PAIRS: lines as for `bench match --pairs` (tools/make_pairs.sh). on/off/both: WKS (default on).
+# DIR: default .dev. MATCH-ARGS replace the defaults below (the tables' command) for every job.
+# On the machine: `cp -r DIR /root/q && cd /root/q && LIMIT=515 P=10 ./q.sh` (q.sh says more).
+set -euo pipefail
+pairs=$1
+wks=${2:-on}
+dir=${3:-.dev}
+shift $(($# < 3 ? $# : 3))
+[ "${1:-}" = "--" ] && shift
+args=("$@")
+[ ${#args[@]} -gt 0 ] || args=(--levels 6 --tol 3e-3 --greedy-above 200000 --later-round-iterations 1 --max-rounds 200)
+case $wks in on | off | both) ;; *) echo "gpu_queue: WKS must be on, off or both, not '$wks'" >&2; exit 2 ;; esac
+bin=${SHAPEMATCH:-build/shapematch}
+[ -x "$bin" ] || { echo "gpu_queue: no binary at $bin (build Release first)" >&2; exit 2; }
+
+mkdir -p "$dir/lib" "$dir/data" "$dir/pairs"
+cp "$bin" "$dir/shapematch"
+# Everything ldd resolves except glibc's own and the Vulkan loader (the machine brings its own).
+ldd "$bin" | awk '$3 ~ /^\// {print $3}' | while read -r lib; do
+  case $(basename "$lib") in
+    libc.so* | libm.so* | libpthread.so* | libdl.so* | librt.so* | ld-linux* | libvulkan.so*) ;;
+    *) cp -L "$lib" "$dir/lib/" ;;
+  esac
+done
+
+: > "$dir/jobs.txt"
+n=0
+while read -r line; do
+  [ -n "$line" ] || continue
+  n=$((n + 1))
+  set -- $line
+  name=$(printf '%02d-%s-%s' "$n" "$(basename "${1%.*}")" "$(basename "${2%.*}")")
+  mkdir -p "$dir/data/$name"
+  out=()
+  for field in "$@"; do
+    if [ -f "$field" ]; then
+      cp "$field" "$dir/data/$name/"
+      out+=("../data/$name/$(basename "$field")")
+    else
+      out+=("$field")  # identity, map
+    fi
+  done
+  echo "${out[*]}" > "$dir/pairs/$name.txt"
+  case $wks in
+    both) printf '%s on\n%s off\n' "$name" "$name" >> "$dir/jobs.txt" ;;
+    *) echo "$name $wks" >> "$dir/jobs.txt" ;;
+  esac
+done < "$pairs"
+
+printf '%s\n' "${args[@]}" > "$dir/match_args.txt"
+cat > "$dir/q.sh" <<'EOF'
+#!/bin/bash
+# Runs the jobs of jobs.txt (or $JOBS), P at once, each `bench match` of one pair with the options
+# of match_args.txt and --backend $BACKEND (vulkan; cpu where no NVIDIA device shows) at FACES faces
+# (full), killed at LIMIT seconds; then packs logs, tables and results (no meshes) into $OUT/q.txz. Run it from a
+# folder outside the checkout (a later call would replace an ignored folder it does not carry).
+LIMIT=${LIMIT:-515}; P=${P:-8}; BACKEND=${BACKEND:-vulkan}; FACES=${FACES:-full}
+export LD_LIBRARY_PATH=$PWD/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}
+mkdir -p out log
+{ date; nproc; free -g | head -2; nvidia-smi --query-gpu=name,driver_version,memory.total --format=csv 2>&1; } > log/machine.txt
+./shapematch devices > log/devices.txt 2>&1
+if [ "$BACKEND" = vulkan ] && ! grep -q "0: NVIDIA" log/devices.txt; then
+  echo "no NVIDIA device: cpu backend" >> log/machine.txt
+  BACKEND=cpu
+fi
+(while true; do { date +%T; nvidia-smi --query-gpu=utilization.gpu,memory.used --format=csv,noheader 2>&1; uptime; } >> log/smi.txt; sleep 30; done) &
+SMI=$!
+run1() {
+  local n=$1 w=$2 extra=()
+  [ "$w" = off ] && extra=(--wks off)
+  mapfile -t margs < match_args.txt
+  ./shapematch bench match --pairs "pairs/$n.txt" --faces "$FACES" --time-limit "$LIMIT" --out "out/$n-$w" -- \
+    "${margs[@]}" --backend "$BACKEND" "${extra[@]}" > "log/$n-$w.bench.log" 2>&1
+  echo "$n $w exit $? at $(date +%T)" >> log/done.txt
+}
+export -f run1
+export LIMIT BACKEND FACES
+timeout $((LIMIT + 45)) xargs -P "$P" -L 1 bash -c 'run1 "$@"' _ < "${JOBS:-jobs.txt}"
+kill $SMI
+cat out/*/bench_pairs.md > log/tables.md 2>/dev/null
+tar cJf "${OUT:-/tmp}/q.txz" --exclude='*.ply' --exclude='*.png' --exclude=levels log out
+ls -la "${OUT:-/tmp}/q.txz"
+EOF
+chmod +x "$dir/q.sh"
+echo "gpu_queue: $(wc -l < "$dir/jobs.txt") jobs in $dir ($(du -sh "$dir" | cut -f1))"
