@@ -396,13 +396,8 @@ private:
       return (after.first < before.first && after.second <= before.second) ||
              (rings <= 4 && after.first == before.first && after.second < before.second);
     };
-    // Tutte's layout is needed only near the fold; elsewhere it moves points off where Γ put them
-    // (on FAUST_r, 24 rings of it doubled the point map's error). So the inside goes back towards
-    // its old points wherever that inverts nothing more: first letting degenerate images come back
-    // too (Γ collapses faces where X is compressed), then, if that loses the disc, only where they
-    // do not.
     // A disc may move the points only so far in all: where Γ collapsed a whole part (a hand onto a
-    // point), unfolding one face re-spreads hundreds of points far from their truth.
+    // curve), unfolding one face re-spreads hundreds of points far from their truth.
     auto shift_ok = [&] {
       double moved = 0;
       for (int i = 0; i < m; ++i) moved += (point_position(to_, p_[inside[i]]) - point_position(to_, saved[i])).norm();
@@ -412,6 +407,11 @@ private:
       for (int i = 0; i < m; ++i) p_[inside[i]] = saved[i];
       return Disc::rejected;
     }
+    // Tutte's layout is needed only near the fold; elsewhere it moves points off where Γ put them
+    // (on FAUST_r, 24 rings of it nearly doubled the point map's error). So the inside goes back
+    // towards its old points wherever that inverts no more faces: first letting degenerate images
+    // come back too (Γ collapses faces where X is compressed), then, if that loses the disc, only
+    // where they do not.
     std::vector<SurfacePoint> laid(m);
     for (int i = 0; i < m; ++i) laid[i] = p_[inside[i]];
     for (const bool strict : {false, true}) {
@@ -622,8 +622,8 @@ private:
   const std::vector<std::vector<int>>& to_faces_;
   std::vector<SurfacePoint>& p_;
   double shift_budget_ = 0;  // the most one disc may move the points, summed (lengths of `to`)
-  // Faces judged (image_orientation) so far, and the most per vertex of `from`: a 10 000-face
-  // result with a dozen folds judges about 1e6 in all.
+  // Faces judged (image_orientation) so far, and the most per vertex of `from` (the saved
+  // full-resolution results judged 1-510 per vertex; a mirrored map would go on for minutes).
   int64_t work_ = 0;
   static constexpr int64_t kWorkPerVertex = 4000;
   static constexpr int kRepairRings = 3;
