@@ -70,13 +70,17 @@ if [ "$BACKEND" = vulkan ] && ! grep -q "0: NVIDIA" log/devices.txt; then
 fi
 (while true; do { date +%T; nvidia-smi --query-gpu=utilization.gpu,memory.used --format=csv,noheader 2>&1; uptime; } >> log/smi.txt; sleep 30; done) &
 SMI=$!
+# A job line: NAME on|off [TAG MATCH-ARGS...]: a TAG names a variant with options of its own
+# (added by hand, e.g. `03-024-043 on ring2 --ring 2`), so that one call compares them.
 run1() {
-  local n=$1 w=$2 extra=()
+  local n=$1 w=$2 tag=${3:-} extra=()
   [ "$w" = off ] && extra=(--wks off)
+  [ $# -gt 3 ] && extra+=("${@:4}")
+  local id=$n-$w${tag:+-$tag}
   mapfile -t margs < match_args.txt
-  ./shapematch bench match --pairs "pairs/$n.txt" --faces "$FACES" --time-limit "$LIMIT" --out "out/$n-$w" -- \
-    "${margs[@]}" --backend "$BACKEND" "${extra[@]}" > "log/$n-$w.bench.log" 2>&1
-  echo "$n $w exit $? at $(date +%T)" >> log/done.txt
+  ./shapematch bench match --pairs "pairs/$n.txt" --faces "$FACES" --time-limit "$LIMIT" --out "out/$id" -- \
+    "${margs[@]}" --backend "$BACKEND" "${extra[@]}" > "log/$id.bench.log" 2>&1
+  echo "$id exit $? at $(date +%T)" >> log/done.txt
 }
 export -f run1
 export LIMIT BACKEND FACES
