@@ -160,7 +160,7 @@ TEST_CASE("point map: untangling a twisted ring") {
         if (dist[w] < 0) dist[w] = dist[queue[q]] + 1, queue.push_back(w);
   for (int v = 0; v < m.num_vertices(); ++v)
     if (dist[v] > 5) CHECK(point_vertex(m, untangled[v]) == v);
-  // The discs' insides go back where they were wherever that inverts nothing: only the twisted
+  // The discs' insides go back where they were wherever that inverts no more faces: only the twisted
   // ring itself moves (without that, c and two vertices of the next ring moved too).
   int moved = 0;
   for (int v = 0; v < m.num_vertices(); ++v)
