@@ -173,14 +173,19 @@ int run_eval(const EvalArgs& args) {
   }
   // The point map (written by match since it has one): the same scores for points, whose
   // corners are vertices of the matched Y, i.e. input vertices of Y.
+  // A point map file of match's, one line per vertex of `from` (named as match wrote it).
+  auto read_points = [](const fs::path& path, const Mesh& target, const Mesh& from, const char* from_name) {
+    std::vector<SurfacePoint> points = read_point_map(path.string(), target);
+    if (static_cast<int>(points.size()) != from.num_vertices())
+      throw InvalidInputError(fmt::format("{}: {} lines, but {} has {} vertices", path.string(), points.size(),
+                                          from_name, from.num_vertices()));
+    return points;
+  };
   const fs::path points_path = dir / "map_x_to_y_points.txt";
   std::optional<GeodesicErrors> point_errors, point_symmetric;
   std::optional<OrientationFlips> point_flips;
   if (fs::exists(points_path)) {
-    const std::vector<SurfacePoint> points = read_point_map(points_path.string(), ym);
-    if (static_cast<int>(points.size()) != xm.num_vertices())
-      throw InvalidInputError(fmt::format("{}: {} lines, but x.ply has {} vertices", points_path.string(),
-                                          points.size(), xm.num_vertices()));
+    const std::vector<SurfacePoint> points = read_points(points_path, ym, xm, "x.ply");
     std::vector<MappedPoint> phi_points(x_input);
     for (int v = 0; v < xm.num_vertices(); ++v) {
       const auto& f = ym.faces[points[v].face];
@@ -195,13 +200,8 @@ int run_eval(const EvalArgs& args) {
   // The other direction's point map (faces of Y inverted), where match wrote it.
   const fs::path back_path = dir / "map_y_to_x_points.txt";
   std::optional<OrientationFlips> back_flips;
-  if (point_flips && fs::exists(back_path)) {
-    const std::vector<SurfacePoint> back = read_point_map(back_path.string(), xm);
-    if (static_cast<int>(back.size()) != ym.num_vertices())
-      throw InvalidInputError(fmt::format("{}: {} lines, but y.ply has {} vertices", back_path.string(), back.size(),
-                                          ym.num_vertices()));
-    back_flips = count_orientation_flips(ym, xm, back);
-  }
+  if (point_flips && fs::exists(back_path))
+    back_flips = count_orientation_flips(ym, xm, read_points(back_path, xm, ym, "y.ply"));
 
   std::string csv = "threshold,fraction\n";
   Json pck = Json::array();

@@ -363,7 +363,11 @@ private:
     for (int i = 0; i < m; ++i)
       if (!locate(u.row(i).transpose(), placed[i])) return Disc::rejected;
     std::vector<SurfacePoint> saved(m);
-    for (int i = 0; i < m; ++i) saved[i] = p_[inside[i]], p_[inside[i]] = placed[i];
+    for (int i = 0; i < m; ++i) saved[i] = p_[inside[i]];
+    auto put = [&](const std::vector<SurfacePoint>& points) {
+      for (int i = 0; i < m; ++i) p_[inside[i]] = points[i];
+    };
+    put(placed);
     // Where the rim is concave, a face with two rim corners can fold over it: move the inside
     // corners of inverted stars (back where they were, into their star's kernel in the chart, or
     // nearby) while that unfolds their stars.
@@ -404,7 +408,7 @@ private:
       return moved <= shift_budget_;
     };
     if (!better(cost(faces))) {
-      for (int i = 0; i < m; ++i) p_[inside[i]] = saved[i];
+      put(saved);
       return Disc::rejected;
     }
     // Tutte's layout is needed only near the fold; elsewhere it moves points off where Γ put them
@@ -417,10 +421,10 @@ private:
     for (const bool strict : {false, true}) {
       pull_back(inside, saved, strict, in_chart, chart_of, locate);
       if (better(cost(faces)) && shift_ok()) return Disc::kept;
-      for (int i = 0; i < m; ++i) p_[inside[i]] = laid[i];
+      put(laid);
     }
     if (shift_ok()) return Disc::kept;
-    for (int i = 0; i < m; ++i) p_[inside[i]] = saved[i];
+    put(saved);
     return Disc::rejected;
   }
 
