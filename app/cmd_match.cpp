@@ -44,6 +44,7 @@ struct MatchArgs {
   int greedy_margin = RoundingOptions{}.greedy_margin;
   int64_t search_below = RoundingOptions{}.search_below;
   bool converged_first = RoundingOptions{}.converged_first;
+  int release_after_trims = RoundingOptions{}.release_after_trims;
   double tolerance = 1e-4;
   double coarse_tolerance = CoarseToFineOptions{}.coarse_tolerance;
   double time_limit = std::numeric_limits<double>::infinity();
@@ -166,6 +167,7 @@ int run_match(const MatchArgs& args) {
   ro.search_below = args.search_below;
   ro.stuck_stalled = args.stuck_stalled;
   ro.converged_first = args.converged_first;
+  ro.release_after_trims = args.release_after_trims;
   ro.lp.tolerance = args.tolerance;
   ro.lp.time_limit = args.time_limit;
   ro.lp.device = args.device;
@@ -193,7 +195,8 @@ int run_match(const MatchArgs& args) {
                                                 -r.fixed_to_zero)
                                   : fmt::format("fixed {} to 1 and {} to 0", r.fixed_to_one, r.fixed_to_zero);
     const std::string undone =
-        r.released > 0 ? fmt::format(" (a part failed away from the last fixing: released {} fixings around it)",
+        r.released > 0 ? fmt::format(" (a part failed away from the last fixing or again after trims: released {} "
+                                     "fixings around it)",
                                      r.released)
         : r.undone     ? std::string(" (undone: fixed fewer)")
                        : std::string();
@@ -361,6 +364,7 @@ int run_match(const MatchArgs& args) {
                               .set("greedy_margin", args.greedy_margin)
                               .set("search_below", args.search_below)
                               .set("converged_first", args.converged_first)
+                              .set("release_after_trims", args.release_after_trims)
                               .set("split_parts", !args.whole_lp)
                               .set("tolerance", args.tolerance)
                               .set("coarse_tolerance", co.coarse_tolerance)
@@ -508,6 +512,11 @@ Action add_match_command(CLI::App& app) {
   app.add_flag("--converged-first", a->converged_first,
                "in a later round whose LP stopped at its iteration cap in some parts, fix only from the parts that "
                "converged; the others go on from their iterate one round more");
+  app.add_option("--release-after-trims", a->release_after_trims,
+                 "where a part's LP has failed after this many trims of the last fixing in a row, release the "
+                 "fixings around the part instead of trimming again (0: never)")
+      ->check(CLI::Range(0, 1000))
+      ->capture_default_str();
   app.add_option("--search-below", a->search_below,
                  "where rounding stalls on at most this many free variables, finish each part by depth-first "
                  "search over exact LPs, releasing the fixings around a part without a binary solution (0: never)")

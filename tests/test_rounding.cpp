@@ -3,6 +3,7 @@
 #include "shapematch/matching.hpp"
 #include "shapematch/rounding.hpp"
 #include "shapematch/shapes.hpp"
+#include "failing_again.hpp"
 #include "solve_in_parts.hpp"
 #include "test_helpers.hpp"
 
@@ -1051,4 +1052,27 @@ TEST_CASE("rounding: a part one solver gives up on goes to the other") {
   CHECK(d.r.status == LpStatus::NumericalTrouble);
   CHECK(other.calls == 1);
   CHECK(quitter.calls == 4);
+}
+
+TEST_CASE("rounding: trims in a row count only while the same part fails after each") {
+  // The count behind release_after_trims: a failure continues the streak where it shares a row
+  // with the failure just before it and that one trimmed the last fixing.
+  detail::FailingAgain f;
+  CHECK(f.failed({7, 3, 5}) == 0);  // the first failure
+  f.trimmed();
+  CHECK(f.failed({9, 5}) == 1);     // row 5 again, after one trim
+  f.trimmed();
+  CHECK(f.failed({9, 11}) == 2);    // row 9 again: two trims in a row before it
+  f.trimmed();
+  CHECK(f.failed({1, 2}) == 0);     // another part: a new streak
+  // Not trimmed (undone whole, released, or gone on at a larger cap): the streak ends.
+  CHECK(f.failed({1, 2}) == 0);
+  f.trimmed();
+  // A round that solved in between ends it too.
+  f.solved();
+  CHECK(f.failed({1, 2}) == 0);
+  f.trimmed();
+  CHECK(f.failed({2}) == 1);
+  f.trimmed();
+  CHECK(f.failed({}) == 0);  // nothing failed in parts: nothing to release around
 }

@@ -1,5 +1,6 @@
 #include "shapematch/rounding.hpp"
 #include "parallel.hpp"
+#include "failing_again.hpp"
 #include "solve_in_parts.hpp"
 
 #include "shapematch/errors.hpp"
@@ -1001,6 +1002,7 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
   // made (parts are independent; the last fixing is as likely in another). Returns how many went.
   std::unique_ptr<LpSolver> search_solver;
   int releases = 0;
+  detail::FailingAgain failing_again;  // release_after_trims
   // With `refute`, the released fixings to 1 join those not tried again while anything else
   // remains (the LP after the release would often pick them again: they came from its optimum;
   // and where two alternatives each fail, refuting only the last released swaps them forever).
@@ -1291,6 +1293,12 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
       // cap. Measured, FAUST_r 020-021 at full resolution (converged_first): a 578 589-variable
       // part looked infeasible after the last round fixed 27 in other parts, and halving those 27
       // solved the same LP five times.
+      // The same part failing again after trims of the last fixing: the fault lies in fixings
+      // around it that the trims do not reach (earlier rounds', or ones propagation puts back),
+      // so those are released instead (release_after_trims).
+      const int trims = failing_again.failed(failed);
+      const bool again =
+          options.release_after_trims > 0 && trims >= options.release_after_trims && releases < options.max_releases;
       int64_t touched = -1;
       std::vector<std::pair<int64_t, int>> away;  // what the proof leaves of the last fixing
       if (!history.back().batch.empty())
@@ -1305,19 +1313,29 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
         keep_iterate(red, r);
         info.undone = false;
         ++forward;
-      } else if (touched == 0 && !failed.empty() && failed.size() < red.rows.size()) {
+      } else if ((touched == 0 || again) && !failed.empty() && failed.size() < red.rows.size()) {
         const int64_t ones = fixer.state().ones, zeros = fixer.state().zeros;
-        spdlog::debug("round {}: a part failed away from the last fixing ({} rows): releasing the fixings around it",
-                      round, failed.size());
+        spdlog::debug("round {}: a part failed {} ({} rows): releasing the fixings around it", round,
+                      touched == 0 ? "away from the last fixing" : "again after a trim", failed.size());
         info.released = release_around(failed, true);
         info.fixed_to_one = fixer.state().ones - ones;
         info.fixed_to_zero = fixer.state().zeros - zeros;
+        // A release frees far more than the next rounds fix at once; measured from the low
+        // before it, the stall rule gave up 12 rounds later (FAUST_r 024-043 at full resolution:
+        // a low of 52 543 free variables, then 142 288 to 623 929 after the release), and its
+        // widening covered the faces of every open row.
+        if (again) {
+          fewest_free = std::numeric_limits<int64_t>::max();
+          stalled = 0;
+          since_low.reset();
+        }
       } else {
         // (Without a proof, or for a single fixing, nothing local: halve.)
         if (blame.empty() || history.back().batch.size() < 2) away.clear();
         const bool whole = backtrack(std::move(away));
         info.fixed_to_one = whole ? 0 : fixer.state().ones - history.back().ones;
         info.fixed_to_zero = whole ? 0 : fixer.state().zeros - history.back().zeros;
+        if (!whole) failing_again.trimmed();
       }
       record(info, clock);
       ++failing_rounds;
@@ -1332,6 +1350,7 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
     }
     failing_rounds = 0;
     failing_seconds = 0.0;
+    failing_again.solved();
     if (r.status == LpStatus::NumericalTrouble || r.x.size() != size_t(red.lp.cols()))
       throw SolverError(std::string("rounding: LP solve failed (") + to_string(r.status) + ")");
     keep_iterate(red, r);

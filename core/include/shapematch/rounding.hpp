@@ -83,6 +83,15 @@ struct RoundingOptions {
   int search_stall = 3;
   int64_t search_nodes = 2000;
   int max_releases = 12;
+  // Where a part's LP has failed after this many trims of the last fixing in a row (each failure
+  // sharing a row with the next), release the fixings around it (as above) instead of trimming
+  // again: the trims only reach the last round's fixings. 0: never (the default). Measured, FAUST_r
+  // 024-043 at full resolution: without it (an H200), four failures in a row trimmed 19, 16, 1 and
+  // half of one fixing, and the level was solved again in a widened space four times in 9
+  // minutes; with 1 (2 cores), the releases took the rounding on without a stuck widening for 31
+  // rounds, but the rounds after a release fixed 15-40 variables each from capped LPs, and it
+  // ended in the stall rule and a widening of 4 730 faces (docs/results.md, thirtieth session).
+  int release_after_trims = 0;
   int max_backtracks = 200;    // fixings undone after an infeasible LP (each one more, smaller LP
                                // solve), then fail with InfeasibleError naming the open rows
   // Fixings to 1 made before round 1: a partial Γ carried over from an attempt in a narrower
