@@ -89,8 +89,9 @@ struct RoundingOptions {
   // 024-043 at full resolution: without it (an H200), four failures in a row trimmed 19, 16, 1 and
   // half of one fixing, and the level was solved again in a widened space four times in 9
   // minutes; with 1 (2 cores), the releases took the rounding on without a stuck widening for 31
-  // rounds, but the rounds after a release fixed 15-40 variables each from capped LPs, and it
-  // ended in the stall rule and a widening of 4 730 faces (docs/results.md, thirtieth session).
+  // rounds, but the rounds after a release fixed 15-40 variables each from capped LPs, and the
+  // stall rule gave up into a widening of 4 730 faces, after which the level finished (verified,
+  // the pair's first completed run; docs/results.md, thirtieth session).
   int release_after_trims = 0;
   int max_backtracks = 200;    // fixings undone after an infeasible LP (each one more, smaller LP
                                // solve), then fail with InfeasibleError naming the open rows
