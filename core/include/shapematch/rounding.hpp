@@ -86,9 +86,9 @@ struct RoundingOptions {
   // Where a part's LP has failed after this many trims of the last fixing in a row (each failure
   // sharing a row with the next), release the fixings around it (as above) instead of trimming
   // again: the trims only reach the last round's fixings. 0: never (the default). Measured, FAUST_r
-  // 024-043 at full resolution: without it (an H200), four failures in a row trimmed 19, 16, 1 and
-  // half of one fixing, and the level was solved again in a widened space four times in 9
-  // minutes; with 1 (2 cores), the releases took the rounding on without a stuck widening for 31
+  // 024-043 at full resolution: without it (an H200), four failures in a row trimmed 19, 16 and
+  // 1 fixings and then halved the rest, and the level was solved again in a widened space four
+  // times before the run's 8.5-minute limit; with 1 (2 cores), the releases took the rounding on without a stuck widening for 31
   // rounds, but the rounds after a release fixed 15-40 variables each from capped LPs, and the
   // stall rule gave up into a widening of 4 730 faces, after which the level finished (verified,
   // the pair's first completed run; docs/results.md, thirtieth session).
