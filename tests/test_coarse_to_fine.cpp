@@ -708,6 +708,55 @@ TEST_CASE("coarse to fine: a stuck rounding widens around its failed parts and g
   MESSAGE("ascended: energy ", la.energy, ", gap ", la.gap, ", iterations ", la.iterations, " (", l.iterations, ")");
 }
 
+TEST_CASE("coarse to fine: after pricing, the later rounds' caps scale with the cold first LP, not the warm re-solve") {
+  // Pricing's re-solve starts warm and takes a fraction of the cold solve's iterations; the later
+  // rounds' caps (later_round_iterations times round 1's) must not shrink with it. Here the caps
+  // are round 1's count exactly and every later round is solved by PDHG. (Measured: 3 264
+  // iterations cold, 320 warm, and round 2 took 384.)
+  CoarseToFineOptions o = two_levels(24);
+  o.ring = 0;
+  o.rounding.later_round_iterations = 1.0;
+  o.rounding.later_round_min_iterations = 1;
+  o.rounding.exact_below = 0;
+  o.rounding.max_rounds = 200;
+  o.rounding.greedy_above = 0;
+  o.rounding.greedy_margin = 2;
+  const Mesh x = decimate(shapes::bent_finger(10, 8, 8), 120), y = decimate(shapes::bent_finger(60, 8, 8), 130);
+  struct Seen {
+    int level;
+    RoundingRound round;
+  };
+  std::vector<Seen> seen;
+  const CoarseToFineMatcher matcher(x, y, o);
+  const CoarseToFineResult r = matcher.run([&](const LevelReport& l, const RoundingRound& round) {
+    seen.push_back({l.level, round});
+  });
+  const int finest = static_cast<int>(r.levels.size()) - 1;
+  REQUIRE(r.levels.back().price_widenings > 0);
+  std::vector<int64_t> firsts;           // the finest level's round-1 iterations, attempt by attempt
+  std::vector<RoundingRound> later;      // the last attempt's later rounds
+  for (const Seen& s : seen) {
+    if (s.level != finest) continue;
+    if (s.round.round == 1) {
+      firsts.push_back(s.round.iterations);
+      later.clear();
+    } else {
+      later.push_back(s.round);
+    }
+  }
+  REQUIRE(firsts.size() >= 2);
+  const int64_t cold = firsts.front(), warm = firsts.back();
+  REQUIRE(warm < cold);  // else this pair shows nothing
+  // A later round that needs more than the warm re-solve's count: the old cap would have stopped it.
+  int64_t longest = 0;
+  for (const RoundingRound& round : later) {
+    longest = std::max(longest, round.iterations);
+    if (round.status == LpStatus::IterationLimit) CHECK(round.iterations >= cold);  // never the warm count
+  }
+  CHECK(longest > warm);
+  CHECK(satisfies_exactly(r.finest.lp, r.rounding.gamma));
+}
+
 TEST_CASE("coarse to fine: pricing a wider space against an exact dual says whether it lowers the optimum") {
   // The finger pair's fine level at ring 1 (narrow) and with one more ring on every X face
   // (wide), both solved exactly by Clp: the narrow dual prices the wide columns.

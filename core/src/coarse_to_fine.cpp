@@ -722,8 +722,10 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
   std::vector<char> released_x;  // X vertices of the faces just widened: fixings over them go
   CarriedIterate first, last;
   int64_t first_iterations = 0;  // of the first LP of the attempt that started afresh
-  int64_t cold_iterations = 0;   // of the last first LP solved cold (a pricing's re-solve is warm)
-  double first_seconds = 0.0;
+  // Of the last first LP solved cold (a pricing's re-solve is warm), and what the rounding of the
+  // attempt that started afresh scaled its caps and stuck rules with (the cold solve's).
+  int64_t cold_iterations = 0, reference_iterations = 0;
+  double cold_seconds = 0.0, reference_seconds = 0.0;
   // Pricing (price_widenings): the first LP's iterate, and after a widening it called for, the
   // same kept by identity to start the widened LP from (it was optimal, unlike after divergence).
   int priced = 0;
@@ -904,6 +906,12 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
                        l + 1, fresh, options_.price_dual_sweeps, certified_lower_bound(m.lp, ro.lp.initial_y), at_zero);
         }
         ro.first_max_iterations = cold_iterations;
+        // The later rounds' caps and the stuck rules scale with what a solve of this level costs,
+        // which the warm re-solve understates: FAUST_r 024-043 at full resolution, level 6 (thirtieth
+        // session), 704 iterations and 114 s against 2 944 and 418 s cold. Its rounding's later
+        // rounds then sat at the 2 000-iteration floor and the stall rule gave up after 319 s.
+        ro.reference_seconds = cold_seconds;
+        ro.reference_iterations = cold_iterations;
       }
       price_warm = false;
       const bool pricing = l > 0 && !carrying && priced < options_.price_widenings && options_.local_widening &&
@@ -945,8 +953,8 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
         SolverParams bound;
         first.apply(m, bound);
         ro.start_dual = std::move(bound.initial_y);
-        ro.reference_seconds = first_seconds;
-        ro.reference_iterations = first_iterations;
+        ro.reference_seconds = reference_seconds;
+        ro.reference_iterations = reference_iterations;
         rep.carried_fixings = static_cast<int64_t>(ro.start_ones.size());
         spdlog::info("level {}: rounding goes on from {} of {} fixings to 1 in the widened space", l + 1,
                      ro.start_ones.size(), carried_ones.size());
@@ -958,8 +966,12 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
                                                  [&](const RoundingRound& r) {
                                                    if (r.round == 1 && !carrying) {
                                                      first_iterations = r.iterations;
-                                                     first_seconds = r.seconds;
-                                                     if (!warm_resolve) cold_iterations = r.iterations;
+                                                     if (!warm_resolve) {
+                                                       cold_iterations = r.iterations;
+                                                       cold_seconds = r.seconds;
+                                                     }
+                                                     reference_iterations = cold_iterations;
+                                                     reference_seconds = cold_seconds;
                                                    }
                                                    if (progress) progress(rep, r);
                                                    if (pricing && !probing && r.round == 1) {
