@@ -158,8 +158,7 @@ struct CoarseToFineOptions {
   int price_widenings = 2;
   double price_threshold = 1e-4;
   // Stop pricing a level early where the last pricing's re-solve lowered the first LP's objective
-  // by less than this fraction of it (0: never early; price_widenings stays the most; not with
-  // price_tolerance's probe, which has no objective to compare). Where it
+  // by less than this fraction of it (0: never early; price_widenings stays the most). Where it
   // still pays, a larger price_widenings then prices on: at full resolution the second pricing
   // lowered level 6's LP by 1.7-2.1 % on three of six pairs, and where rounding got stuck there
   // its widening lowered it by 5.6-6.5 % (docs/results.md, thirty-first session).
