@@ -74,7 +74,6 @@ struct MatchArgs {
   int lookahead_levels = CoarseToFineOptions{}.lookahead_levels;
   double price_threshold = CoarseToFineOptions{}.price_threshold;
   double price_tolerance = CoarseToFineOptions{}.price_tolerance;
-  double price_until_gain = CoarseToFineOptions{}.price_until_gain;
 };
 
 // auto: a GPU if there is one, else the native solver (lavapipe is for testing, not speed).
@@ -152,7 +151,6 @@ int run_match(const MatchArgs& args) {
   co.lookahead_levels = args.lookahead_levels;
   co.price_threshold = args.price_threshold;
   co.price_tolerance = args.price_tolerance;
-  co.price_until_gain = args.price_until_gain;
   co.matching = matching_options(args.pair, p);
   RoundingOptions& ro = co.rounding;
   ro.solver = solver_for(args);
@@ -403,8 +401,7 @@ int run_match(const MatchArgs& args) {
                               .set("stuck_stalled", args.stuck_stalled)
                               .set("price_widenings", args.price_widenings)
                               .set("price_threshold", args.price_threshold)
-                              .set("price_tolerance", args.price_tolerance)
-                              .set("price_until_gain", args.price_until_gain));
+                              .set("price_tolerance", args.price_tolerance));
     report.set("seconds", seconds);
     report.set("peak_rss_mb", peak_rss_mb());
     report.set("round_log", rounds);
@@ -659,11 +656,6 @@ Action add_match_command(CLI::App& app) {
   app.add_option("--price-tolerance", a->price_tolerance,
                  "price the wider space at this looser LP tolerance, then solve on (0: price the optimum)")
       ->check(CLI::NonNegativeNumber)
-      ->capture_default_str();
-  app.add_option("--price-until-gain", a->price_until_gain,
-                 "with --price-widenings: price a level again only while the last pricing lowered its first LP by at "
-                 "least this fraction (0: always, up to --price-widenings)")
-      ->check(CLI::Range(0.0, 1.0))
       ->capture_default_str();
   app.add_option("--price-threshold", a->price_threshold,
                  "with --price-widenings: how far below zero (energy units) a column's reduced cost must be")

@@ -1,5 +1,4 @@
 // End-to-end tests of the `shapematch` executable: exit codes, one-line errors, JSON output.
-#include "shapematch/coarse_to_fine.hpp"
 #include "shapematch/rounding.hpp"
 #include "test_helpers.hpp"
 
@@ -130,7 +129,6 @@ TEST_CASE("cli: match writes a verified, complete output directory, or nothing")
   CHECK(json_number(report, "untangle_rings") == 24);  // the defaults reach the report
   CHECK(json_number(report, "untangle_max_shift") == doctest::Approx(1e-3));
   CHECK(json_number(report, "release_after_trims") == shapematch::RoundingOptions{}.release_after_trims);
-  CHECK(json_number(report, "price_until_gain") == shapematch::CoarseToFineOptions{}.price_until_gain);
   // One level of 30 faces: rounded with 0.5, and again with the default alternative 0.7.
   CHECK(json_number(report, "roundings") == 2);
 

@@ -733,7 +733,6 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
   double first_omega = 0.0;
   CarriedIterate priced_from;
   bool price_warm = false;
-  double priced_objective = 0.0;  // of the first LP the last pricing priced (price_until_gain)
   // Widenings where propagation found the conflict have a budget of their own
   // (max_propagation_widenings): they cost a rebuild, not an LP.
   int propagated = 0;
@@ -934,16 +933,6 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
           first_y = {};
         };
       }
-      // After a pricing, whether its re-solve lowered the objective enough to price again.
-      const auto still_gaining = [&](double objective) {
-        if (!warm_resolve || options_.price_until_gain <= 0.0) return true;
-        const double gain = priced_objective - objective;
-        const bool on = gain >= options_.price_until_gain * std::abs(priced_objective);
-        if (!on)
-          spdlog::info("level {}: pricing stops: its last widening lowered the first LP by {:.3g} ({:.2f} %)", l + 1,
-                       gain, 100.0 * gain / std::abs(priced_objective));
-        return on;
-      };
       const bool may_carry = options_.stuck_after > 0.0 && options_.stuck_carry;
       if (l > 0 && (options_.warm_widening || may_carry || pricing) && !carrying)
         ro.first_iterate = [&](const std::vector<double>& x, const std::vector<double>& y, double omega) {
@@ -987,14 +976,8 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
                                                    if (progress) progress(rep, r);
                                                    if (pricing && !probing && r.round == 1) {
                                                      if (r.status == LpStatus::Optimal &&
-                                                         first_y.size() == size_t(m.lp.rows()) &&
-                                                         still_gaining(r.objective)) {
-                                                       const double objective = r.objective;
-                                                       if (price_and_widen(m)) {
-                                                         priced_objective = objective;
-                                                         throw PricedWider{};
-                                                       }
-                                                     }
+                                                         first_y.size() == size_t(m.lp.rows()) && price_and_widen(m))
+                                                       throw PricedWider{};
                                                      first_x = {};  // not needed for the rest of the rounding
                                                      first_y = {};
                                                    }

@@ -157,12 +157,6 @@ struct CoarseToFineOptions {
   // level 6 spent every local widening on propagation conflicts).
   int price_widenings = 2;
   double price_threshold = 1e-4;
-  // Stop pricing a level early where the last pricing's re-solve lowered the first LP's objective
-  // by less than this fraction of it (0: never early; price_widenings stays the most). Where it
-  // still pays, a larger price_widenings then prices on: at full resolution the second pricing
-  // lowered level 6's LP by 1.7-2.1 % on three of six pairs, and where rounding got stuck there
-  // its widening lowered it by 5.6-6.5 % (docs/results.md, thirty-first session).
-  double price_until_gain = 0.0;
   // While price_widenings remain, the first LP is solved to this looser tolerance, priced, and
   // (where nothing prices below) solved on from there to its own (RoundingOptions::probe);
   // 0 or not above the LP's tolerance: price the optimum itself. Off: measured with 1e-2, FAUST_r
