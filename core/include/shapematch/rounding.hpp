@@ -102,9 +102,10 @@ struct RoundingOptions {
   // value per row, e.g. an earlier first LP's dual mapped over; −∞ without it).
   std::vector<int64_t> start_ones;
   std::vector<double> start_dual;
-  // Round 1 of the attempt that began afresh, for a start from carried fixings (whose round 1
-  // is a smaller, warm LP): its seconds scale stuck_after, its iterations the later rounds' cap.
-  // 0: this rounding's own round 1.
+  // A cold solve of the whole LP, where round 1 is a warm LP that understates it: a start from
+  // carried fixings (a smaller LP) or coarse to fine's re-solve after pricing (from a nearby
+  // optimum). Its seconds scale stuck_after, its iterations the later rounds' cap. 0: this
+  // rounding's own round 1.
   double reference_seconds = 0.0;
   int64_t reference_iterations = 0;
   // Round 1's iterations at most (0: lp.max_iterations alone). Coarse to fine caps a warm solve
