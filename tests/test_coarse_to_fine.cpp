@@ -733,8 +733,8 @@ TEST_CASE("coarse to fine: after pricing, the later rounds' caps scale with the 
   });
   const int finest = static_cast<int>(r.levels.size()) - 1;
   REQUIRE(r.levels.back().price_widenings > 0);
-  std::vector<int64_t> firsts;           // the finest level's round-1 iterations, attempt by attempt
-  std::vector<RoundingRound> later;      // the last attempt's later rounds
+  std::vector<int64_t> firsts;       // the finest level's round-1 iterations, attempt by attempt
+  std::vector<RoundingRound> later;  // the last attempt's later rounds
   for (const Seen& s : seen) {
     if (s.level != finest) continue;
     if (s.round.round == 1) {

@@ -909,7 +909,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
         // The later rounds' caps and the stuck rules scale with what a solve of this level costs,
         // which the warm re-solve understates: FAUST_r 024-043 at full resolution, level 6 (thirtieth
         // session), 704 iterations and 114 s against 2 944 and 418 s cold. Its rounding's later
-        // rounds then sat at the 2 000-iteration floor and the stall rule gave up after 319 s.
+        // rounds then sat at the 2 000-iteration floor and the stall rule gave up 319 s after the low.
         ro.reference_seconds = cold_seconds;
         ro.reference_iterations = cold_iterations;
       }
