@@ -35,6 +35,21 @@ CoarseToFineMatcher finger_matcher(const CoarseToFineOptions& o) {
   return CoarseToFineMatcher(decimate(shapes::bent_finger(10, 8, 8), 80), decimate(shapes::bent_finger(60, 8, 8), 90), o);
 }
 
+// The same pair a little finer (120 and 130 faces), built once, and options under which its
+// finest rounding is slow: ring 0, and few fixings per round (every round greedy, a wide margin).
+const std::pair<Mesh, Mesh>& fine_fingers() {
+  static const std::pair<Mesh, Mesh> p{decimate(shapes::bent_finger(10, 8, 8), 120),
+                                       decimate(shapes::bent_finger(60, 8, 8), 130)};
+  return p;
+}
+CoarseToFineOptions slow_finest_rounding() {
+  CoarseToFineOptions o = two_levels(24);
+  o.ring = 0;
+  o.rounding.greedy_above = 0;
+  o.rounding.greedy_margin = 2;
+  return o;
+}
+
 std::set<int64_t> full_indices(const ProductSpace& full, const std::vector<ProductTriangle>& list) {
   std::set<int64_t> s;
   for (const auto& t : list) s.insert(full.index_in_full(t));
@@ -652,13 +667,10 @@ TEST_CASE("coarse to fine: a stuck rounding widens around its failed parts and g
   // widens there and solves the level again: afresh, or (stuck_carry) from the fixings to 1
   // elsewhere, the widened LP then solved again for a certified bound. Off, running out of
   // rounds widens too, as an infeasible LP (not counted as stuck).
-  CoarseToFineOptions o = two_levels(24);
-  o.ring = 0;
+  CoarseToFineOptions o = slow_finest_rounding();
   o.rounding.max_rounds = 3;
-  o.rounding.greedy_above = 0;
-  o.rounding.greedy_margin = 2;
   o.price_widenings = 0;  // pricing widens this ring-0 space before rounding, which then is not stuck
-  const Mesh x = decimate(shapes::bent_finger(10, 8, 8), 120), y = decimate(shapes::bent_finger(60, 8, 8), 130);
+  const auto& [x, y] = fine_fingers();
   for (const int mode : {0, 1, 2}) {  // off, afresh, carried
     CAPTURE(mode);
     o.stuck_after = mode == 0 ? 0.0 : 1e-12;
@@ -713,15 +725,12 @@ TEST_CASE("coarse to fine: after pricing, the later rounds' caps scale with the 
   // rounds' caps (later_round_iterations times round 1's) must not shrink with it. Here the caps
   // are round 1's count exactly and every later round is solved by PDHG. (Measured: 3 264
   // iterations cold, 320 warm, and round 2 took 384.)
-  CoarseToFineOptions o = two_levels(24);
-  o.ring = 0;
+  CoarseToFineOptions o = slow_finest_rounding();
   o.rounding.later_round_iterations = 1.0;
   o.rounding.later_round_min_iterations = 1;
   o.rounding.exact_below = 0;
   o.rounding.max_rounds = 200;
-  o.rounding.greedy_above = 0;
-  o.rounding.greedy_margin = 2;
-  const Mesh x = decimate(shapes::bent_finger(10, 8, 8), 120), y = decimate(shapes::bent_finger(60, 8, 8), 130);
+  const auto& [x, y] = fine_fingers();
   struct Seen {
     int level;
     RoundingRound round;
