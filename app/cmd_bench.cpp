@@ -61,7 +61,7 @@ struct BandwidthOptions {
 // local). Bytes are counted STREAM's way, 24 per element without write-allocate, the same
 // convention as pdhg_bytes_per_iteration.
 double measure_bandwidth_gbps(const BandwidthOptions& options) {
-  const int threads = options.threads > 0 ? options.threads : std::max(1, int(std::thread::hardware_concurrency()));
+  const int threads = options.threads > 0 ? options.threads : worker_threads();
   const int64_t n = options.elements;
   std::unique_ptr<double[]> a(new double[n]), b(new double[n]), c(new double[n]);
   std::barrier sync(threads + 1);
@@ -983,7 +983,7 @@ Action add_bench_command(CLI::App& app) {
     if (match->parsed()) return m->pairs_file.empty() ? run_bench_scaling(*m) : run_bench_pairs(*m);
     const double gbps = measure_bandwidth_gbps(*bw);
     Json out = Json::object();
-    out.set("threads", bw->threads > 0 ? bw->threads : int(std::thread::hardware_concurrency()));
+    out.set("threads", bw->threads > 0 ? bw->threads : worker_threads());
     out.set("array_mib", double(bw->elements) * 8.0 / (1 << 20));
     out.set("gbps", gbps);
     std::cout << out.dump() << std::endl;

@@ -30,6 +30,7 @@ struct MatchArgs {
   PairArgs pair{.faces = 100};
   std::string out = "shapematch-out";
   std::string backend = "auto";
+  int threads = 0;
   double threshold = 0.5;
   std::vector<double> alternative_thresholds = RoundingOptions{}.alternative_thresholds;
   int64_t alternatives_below = RoundingOptions{}.alternatives_below;
@@ -318,7 +319,7 @@ int run_match(const MatchArgs& args) {
     report.set("x", shape(fs::absolute(p.x_file).lexically_normal().string(), p.x_input_vertices, x));
     report.set("y", shape(fs::absolute(p.y_file).lexically_normal().string(), p.y_input_vertices, y));
     report.set("variables", m.lp.cols()).set("constraints", m.lp.rows()).set("nonzeros", m.lp.nonzeros());
-    report.set("backend", ro.solver).set("device", rr.first_lp.device);
+    report.set("backend", ro.solver).set("device", rr.first_lp.device).set("threads", worker_threads());
     report.set("energy", rr.energy).set("lower_bound", rr.lower_bound).set("gap", rr.gap);
     // Above one level the bound certifies the finest level's reduced space, not the full one.
     report.set("bound_scope", c2f.levels.size() > 1 ? "reduced space of the finest level" : "full product space");
@@ -461,6 +462,11 @@ Action add_match_command(CLI::App& app) {
       ->check(CLI::IsMember({"auto", "vulkan", "cpu", "cpu-f32", "clp"}))
       ->capture_default_str();
   app.add_option("--device", a->device, "Vulkan device index (see `shapematch devices`)");
+  // Several matches sharing a machine (a pair table's jobs) each start one thread per CPU by
+  // default; fewer each spares the scheduler the oversubscription.
+  app.add_option("--threads", a->threads, "host threads (0: every CPU this process may use)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
   app.add_option("--threshold", a->threshold, "fix LP values above this to 1")
       ->check(CLI::Range(0.0, 1.0))
       ->capture_default_str();
@@ -665,7 +671,10 @@ Action add_match_command(CLI::App& app) {
                  "more fine rings on Y around every face's candidates, at every ring (fine neighbourhood)")
       ->check(CLI::Range(0, 8))
       ->capture_default_str();
-  return [a] { return run_match(*a); };
+  return [a] {
+    set_worker_threads(a->threads);
+    return run_match(*a);
+  };
 }
 
 }  // namespace shapematch::app

@@ -1,5 +1,6 @@
 // End-to-end tests of the `shapematch` executable: exit codes, one-line errors, JSON output.
 #include "shapematch/rounding.hpp"
+#include "shapematch/system.hpp"
 #include "test_helpers.hpp"
 
 #include <doctest/doctest.h>
@@ -131,6 +132,18 @@ TEST_CASE("cli: match writes a verified, complete output directory, or nothing")
   CHECK(json_number(report, "release_after_trims") == shapematch::RoundingOptions{}.release_after_trims);
   // One level of 30 faces: rounded with 0.5, and again with the default alternative 0.7.
   CHECK(json_number(report, "roundings") == 2);
+
+  // --threads 1: one host thread (the report says so), the same Γ (PDHG's iterates are the same on
+  // any thread count).
+  CHECK(json_number(report, "threads") == shapematch::worker_threads());
+  const fs::path single_thread = out.string() + "_t1";
+  r = run("match --faces 30 --backend cpu --threads 1 -o " + single_thread.string());
+  REQUIRE(r.code == 0);
+  std::ifstream ft(single_thread / "report.json");
+  const std::string one_thread((std::istreambuf_iterator<char>(ft)), {});
+  CHECK(json_number(one_thread, "threads") == 1);
+  CHECK(json_number(one_thread, "energy") == doctest::Approx(json_number(report, "energy")).epsilon(1e-9));
+  fs::remove_all(single_thread);
 
   // --close-pockets reaches the rounding and the report (no pocket at 30 faces; the repair
   // itself is tested in test_rounding).

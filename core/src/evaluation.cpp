@@ -3,6 +3,7 @@
 #include "shapematch/errors.hpp"
 #include "shapematch/geodesic.hpp"
 #include "shapematch/geometry.hpp"
+#include "shapematch/system.hpp"
 
 #include <algorithm>
 #include <atomic>
@@ -231,7 +232,7 @@ GeodesicErrors geodesic_errors(const Mesh& y, const std::vector<MappedPoint>& ph
         if (!failure) failure = std::current_exception();
       }
     };
-    int threads = options.threads > 0 ? options.threads : static_cast<int>(std::thread::hardware_concurrency());
+    int threads = options.threads > 0 ? options.threads : worker_threads();
     threads = static_cast<int>(std::clamp<size_t>(threads, 1, groups));
     std::vector<std::thread> pool;
     for (int t = 1; t < threads; ++t) pool.emplace_back(work);

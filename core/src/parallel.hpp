@@ -1,6 +1,8 @@
 #pragma once
 // A minimal static-partition parallel loop over index ranges (the hot loops of assembly and the
 // native PDHG kernels are uniform, so static chunks balance well and need no scheduler).
+#include "shapematch/system.hpp"
+
 #include <algorithm>
 #include <cstdint>
 #include <exception>
@@ -9,10 +11,7 @@
 
 namespace shapematch::detail {
 
-inline int hardware_threads() {
-  const unsigned n = std::thread::hardware_concurrency();
-  return n == 0 ? 1 : static_cast<int>(n);
-}
+inline int hardware_threads() { return worker_threads(); }
 
 // Calls body(begin, end, chunk) for `threads` contiguous chunks of [0, n), each of about `grain`
 // items at least (a thread costs a spawn). If bodies throw, every chunk still runs to its end and

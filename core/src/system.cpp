@@ -1,6 +1,11 @@
 #include "shapematch/system.hpp"
 
+#include <sched.h>
 #include <sys/resource.h>
+
+#include <algorithm>
+#include <atomic>
+#include <thread>
 
 namespace shapematch {
 
@@ -9,5 +14,28 @@ double peak_rss_mb() {
   getrusage(RUSAGE_SELF, &usage);
   return static_cast<double>(usage.ru_maxrss) / 1024.0;  // Linux reports KiB
 }
+
+namespace {
+std::atomic<int> g_thread_limit{0};
+
+int affinity_cpus() {
+  cpu_set_t set;
+  CPU_ZERO(&set);
+  if (sched_getaffinity(0, sizeof(set), &set) == 0) {
+    const int n = CPU_COUNT(&set);
+    if (n > 0) return n;
+  }
+  const unsigned n = std::thread::hardware_concurrency();
+  return n == 0 ? 1 : static_cast<int>(n);
+}
+}  // namespace
+
+int worker_threads() {
+  const int cpus = affinity_cpus();  // a system call of a microsecond; a parallel loop costs far more
+  const int limit = g_thread_limit.load(std::memory_order_relaxed);
+  return limit > 0 ? std::min(limit, cpus) : cpus;
+}
+
+void set_worker_threads(int threads) { g_thread_limit.store(std::max(0, threads), std::memory_order_relaxed); }
 
 }  // namespace shapematch

@@ -7,6 +7,15 @@ namespace shapematch {
 // Peak resident set size of this process so far, in MiB.
 double peak_rss_mb();
 
+// Threads of this process's parallel loops (assembly, pricing, the native PDHG kernels): the
+// CPUs it may run on (its affinity mask, so `taskset` limits it), or fewer where
+// set_worker_threads asked for fewer. Sums are split per thread, so results can differ in their
+// last digits with the count.
+int worker_threads();
+// At most `threads` (0: every CPU of the affinity mask). Call it before the first solve: a
+// solver keeps the count it started with.
+void set_worker_threads(int threads);
+
 class Stopwatch {
 public:
   Stopwatch() : start_(std::chrono::steady_clock::now()) {}
