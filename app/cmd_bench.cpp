@@ -22,6 +22,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <barrier>
 #include <cerrno>
 #include <chrono>
@@ -30,6 +31,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <exception>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
@@ -37,6 +39,7 @@
 #include <limits>
 #include <map>
 #include <memory>
+#include <mutex>
 #include <set>
 #include <sstream>
 #include <thread>
@@ -509,6 +512,7 @@ struct BenchMatchArgs {
   double time_limit = 600.0;
   std::vector<std::string> match_args;  // after `--`, passed to every match run
   bool resume = false;                  // pairs: reuse the rows an earlier run of the same command finished
+  int jobs = 1;                         // pairs: runs at once, each with its share of the CPUs
 };
 
 // One match run (a size or a pair); NaN where it did not get that far.
@@ -547,6 +551,9 @@ void read_report(const fs::path& dir, MatchRow& row) {
   row.gap = report.number_or_nan("gap");
 }
 
+// Each of --jobs runs' share of this process's CPUs.
+int threads_per_job(const BenchMatchArgs& args) { return std::max(1, worker_threads() / std::max(1, args.jobs)); }
+
 // The arguments of `match` for one run, less its output directory.
 std::vector<std::string> match_command(const BenchMatchArgs& args, const std::string& x, const std::string& y,
                                        const std::string& faces) {
@@ -565,6 +572,10 @@ void run_match_child(const BenchMatchArgs& args, const std::string& x, const std
   for (const char* suffix : {".run.json", ".eval.json"}) fs::remove(dir.string() + suffix);
   std::vector<std::string> cmd = match_command(args, x, y, faces);
   cmd.insert(cmd.end(), {"-o", dir.string()});
+  // Runs side by side share the CPUs (not part of the command --resume compares: the count
+  // changes no Γ), unless the match options say how.
+  if (args.jobs > 1 && std::find(cmd.begin(), cmd.end(), "--threads") == cmd.end())
+    cmd.insert(cmd.end(), {"--threads", std::to_string(threads_per_job(args))});
   row.run = run_child(cmd, "", dir.string() + ".match.log", args.time_limit);
   if (row.run.status != "ok") return;
   try {
@@ -796,6 +807,7 @@ void read_errors(const std::string& json_path, MatchRow& row) {
 void evaluate(const BenchMatchArgs& args, const PairSpec& pair, const fs::path& dir, MatchRow& row) {
   std::vector<std::string> cmd{"eval", dir.string()};
   cmd.insert(cmd.end(), pair.truth.begin(), pair.truth.end());
+  if (args.jobs > 1) cmd.insert(cmd.end(), {"--threads", std::to_string(threads_per_job(args))});
   const std::string json_path = dir.string() + ".eval.json";
   const ChildRun e = run_child(cmd, json_path, dir.string() + ".eval.log", args.time_limit);
   if (e.status != "ok") {
@@ -878,38 +890,81 @@ bool resume_row(const BenchMatchArgs& args, const PairSpec& pair, const std::vec
   }
 }
 
-int run_bench_pairs(const BenchMatchArgs& args) {
-  if (args.faces.size() > 1)
+int run_bench_pairs(const BenchMatchArgs& asked) {
+  if (asked.faces.size() > 1)
     throw InvalidInputError("--faces: one size with --pairs (a list of sizes is for the scaling mode, --pair)");
   // Read before any run, so that a malformed file costs nothing.
-  const std::vector<PairSpec> pairs = read_pairs_file(args.pairs_file);
+  const std::vector<PairSpec> pairs = read_pairs_file(asked.pairs_file);
+  // No more runs at once than pairs, so that each gets its share of the CPUs.
+  BenchMatchArgs args = asked;
+  args.jobs = static_cast<int>(std::clamp<size_t>(pairs.size(), 1, std::max(1, asked.jobs)));
   const std::string faces = args.faces.empty() ? std::string() : std::to_string(faces_value(args.faces[0]));
   const fs::path out(args.out);
   fs::create_directories(out / "runs");
   const std::string csv_path = (out / "bench_pairs.csv").string(), md_path = (out / "bench_pairs.md").string();
-  std::vector<MatchRow> rows;
+  // Names and directories first, in the file's order, so that they do not depend on which run
+  // ends first.
+  std::vector<MatchRow> rows(pairs.size());
+  std::vector<fs::path> dirs(pairs.size());
   std::map<std::string, int> times_seen;
   for (size_t i = 0; i < pairs.size(); ++i) {
-    const PairSpec& pair = pairs[i];
-    MatchRow row;
-    row.name = fs::path(pair.x).stem().string() + "-" + fs::path(pair.y).stem().string();
+    MatchRow& row = rows[i];
+    row.name = fs::path(pairs[i].x).stem().string() + "-" + fs::path(pairs[i].y).stem().string();
     // Named after the pair, so that --resume finds a run again in a list that grew or was
     // reordered; a pair that comes again (e.g. with other ground truth) is counted: X-Y.2, X-Y.3.
     const int seen = ++times_seen[row.name];
-    const fs::path dir = out / "runs" / (seen == 1 ? row.name : fmt::format("{}.{}", row.name, seen));
+    dirs[i] = out / "runs" / (seen == 1 ? row.name : fmt::format("{}.{}", row.name, seen));
+  }
+  // The tables list the rows finished so far, in the file's order, rewritten as each one ends.
+  std::vector<char> finished(pairs.size(), 0);
+  std::mutex table_mutex;
+  auto finish = [&](size_t i) {
+    const std::lock_guard lock(table_mutex);
+    log_row(rows[i]);
+    finished[i] = 1;
+    std::vector<MatchRow> so_far;
+    for (size_t k = 0; k < rows.size(); ++k)
+      if (finished[k]) so_far.push_back(rows[k]);
+    write_file_atomic(csv_path, pairs_csv(so_far));
+    write_file_atomic(md_path, markdown_table(kPairsHeader, pairs_cells(so_far, false)));
+  };
+  auto run_pair = [&](size_t i) {
+    const PairSpec& pair = pairs[i];
+    MatchRow& row = rows[i];
     const std::vector<std::string> match = match_command(args, pair.x, pair.y, faces);
-    if (args.resume && resume_row(args, pair, match, dir, row)) {
-      spdlog::info("pair {} of {}: {} (resumed from {}.run.json)", i + 1, pairs.size(), row.name, dir.string());
+    if (args.resume && resume_row(args, pair, match, dirs[i], row)) {
+      spdlog::info("pair {} of {}: {} (resumed from {}.run.json)", i + 1, pairs.size(), row.name, dirs[i].string());
     } else {
       spdlog::info("pair {} of {}: {}", i + 1, pairs.size(), row.name);
-      run_match_child(args, pair.x, pair.y, faces, dir, row);
-      if (row.run.status == "ok") evaluate(args, pair, dir, row);
-      write_run_record(dir, match, pair, args.time_limit, row);
+      run_match_child(args, pair.x, pair.y, faces, dirs[i], row);
+      if (row.run.status == "ok") evaluate(args, pair, dirs[i], row);
+      write_run_record(dirs[i], match, pair, args.time_limit, row);
     }
-    log_row(row);
-    rows.push_back(std::move(row));
-    write_file_atomic(csv_path, pairs_csv(rows));
-    write_file_atomic(md_path, markdown_table(kPairsHeader, pairs_cells(rows, false)));
+    finish(i);
+  };
+  const int jobs = args.jobs;
+  if (jobs == 1) {
+    for (size_t i = 0; i < pairs.size(); ++i) run_pair(i);
+  } else {
+    spdlog::info("{} runs at once, {} threads each", jobs, threads_per_job(args));
+    std::atomic<size_t> next{0};
+    std::exception_ptr failure;
+    std::mutex failure_mutex;
+    std::vector<std::thread> workers;
+    for (int w = 0; w < jobs; ++w)
+      workers.emplace_back([&] {
+        for (size_t i; (i = next.fetch_add(1)) < pairs.size();) {
+          try {
+            run_pair(i);
+          } catch (...) {  // a run's own failure is a row; this is the harness's (a full disk…)
+            const std::lock_guard lock(failure_mutex);
+            if (!failure) failure = std::current_exception();
+            next = pairs.size();
+          }
+        }
+      });
+    for (auto& w : workers) w.join();
+    if (failure) std::rethrow_exception(failure);
   }
   std::cout << markdown_table(kPairsHeader, pairs_cells(rows, false)) << std::flush;
   spdlog::info("wrote {} and {}", csv_path, md_path);
@@ -976,6 +1031,12 @@ Action add_bench_command(CLI::App& app) {
                   "pairs: reuse each pair's row where this --out already holds a finished run of the same command and "
                   "ground truth (runs/X-Y.run.json); a run that timed out is tried again under a longer --time-limit")
       ->needs(match->get_option("--pairs"));
+  match->add_option("--jobs", m->jobs,
+                    "pairs: runs at once (a GPU machine with many cores); each match and eval gets its share of "
+                    "the CPUs as --threads")
+      ->check(CLI::PositiveNumber)
+      ->needs(match->get_option("--pairs"))
+      ->capture_default_str();
   match->add_option("match-args", m->match_args, "after `--`: options for every match run, verbatim");
 
   return [lp, args, match, m, bw] {

@@ -2,6 +2,8 @@
 // and size, the solvers agree, and the plot is made where Debian's Python has matplotlib. bench
 // match: whole match runs per size or per pair of a pairs file, where a failed pair is a row.
 #include "shapematch/mesh.hpp"
+#include "shapematch/system.hpp"
+#include "test_helpers.hpp"
 
 #include <doctest/doctest.h>
 
@@ -297,6 +299,48 @@ TEST_CASE("cli: bench match --pairs records a pair that fails as a row and goes 
   CHECK(rows[1].at("mean_geodesic_error").empty());
   CHECK(rows[2].at("status") == "0 of 2 ok");
   CHECK(rows[2].at("seconds").empty());
+  fs::remove_all(dir);
+}
+
+TEST_CASE("cli: bench match --pairs --jobs runs pairs side by side: the rows of one at a time, in the file's order") {
+  const fs::path dir = fs::temp_directory_path() / "shapematch_bench_pairs_jobs_test";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const fs::path err = dir.string() + "_stderr.txt";
+  const std::string x = kAssets + "/finger_straight.off", y = kAssets + "/finger_bent.off";
+  // The failing pair is first, so that it ends first and a table in the order of ending would show.
+  std::ofstream(dir / "pairs.txt") << "missing.off " << y << "\n"
+                                   << x << " " << y << " identity\n"
+                                   << y << " " << x << " identity\n";
+  std::map<int, Csv> tables;
+  for (int jobs : {1, 3}) {
+    const fs::path out = dir / ("out" + std::to_string(jobs));
+    REQUIRE(run_cli("bench match --pairs " + (dir / "pairs.txt").string() + " --jobs " + std::to_string(jobs) +
+                        " --faces 20 --out " + out.string() + " -- --backend cpu",
+                    err) == 0);
+    tables[jobs] = read_csv(out / "bench_pairs.csv");
+    // Each of the three runs at once gets its share of the CPUs (at least one thread).
+    const std::string report = read_text(out / "runs" / "finger_straight-finger_bent" / "report.json");
+    const int cpus = shapematch::worker_threads();
+    CHECK(shapematch::test::json_number(report, "threads") == (jobs == 1 ? cpus : std::max(1, cpus / 3)));
+  }
+  const auto& one = tables[1].rows;
+  const auto& three = tables[3].rows;
+  REQUIRE(one.size() == 4);
+  REQUIRE(three.size() == 4);
+  for (size_t i = 0; i < 4; ++i) {
+    CAPTURE(i);
+    CHECK(three[i].at("pair") == one[i].at("pair"));
+    CHECK(three[i].at("status") == one[i].at("status"));
+    CHECK(three[i].at("energy") == one[i].at("energy"));  // the thread count changes no Γ
+    CHECK(three[i].at("mean_geodesic_error") == one[i].at("mean_geodesic_error"));
+  }
+  CHECK(one[0].at("status").rfind("failed: ", 0) == 0);
+  CHECK(one[1].at("status") == "ok");
+  CHECK(one[2].at("pair") == "finger_bent-finger_straight");
+  CHECK(one[3].at("status") == "2 of 3 ok");
+  // --jobs is for lists of pairs.
+  CHECK(run_cli("bench match --jobs 2 --faces 20 --out " + (dir / "scaling").string(), err) != 0);
   fs::remove_all(dir);
 }
 
