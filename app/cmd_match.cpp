@@ -347,6 +347,7 @@ int run_match(const MatchArgs& args) {
                            .set("point_y_to_x", flips_json(point_flips_yx)));
     report.set("options", Json::object()
                               .set("bending", args.pair.bending)
+                              .set("curvature_radius", args.pair.curvature_radius)
                               .set("lame_lambda", args.pair.lame.at(0))
                               .set("lame_mu", args.pair.lame.at(1))
                               .set("threshold", args.threshold)

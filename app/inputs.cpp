@@ -27,6 +27,10 @@ void add_pair_options(CLI::App& app, PairArgs& args) {
                  "extra cost per unit area of every degenerate product triangle")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
+  app.add_option("--curvature-radius", args.curvature_radius,
+                 "average the bending term's mean curvature over this radius, in units of √area (0: per vertex)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
   app.add_option("--membrane", args.membrane, "membrane energy: compressive (default) or svk (the paper's St. Venant–Kirchhoff)")
       ->check(CLI::IsMember({"svk", "compressive"}))
       ->capture_default_str();
@@ -99,6 +103,7 @@ MeshPair load_pair(const PairArgs& args) {
 MatchingLpOptions matching_options(const PairArgs& args, const MeshPair& pair) {
   MatchingLpOptions o;
   o.energy.degenerate_penalty = args.degenerate_penalty;
+  o.energy.curvature_radius = args.curvature_radius;
   o.energy.membrane = args.membrane == "svk" ? MembraneModel::StVenantKirchhoff : MembraneModel::Compressive;
   o.energy.feature_weight = pair.features_x.size() > 0 ? args.feature_weight : 0.0;
   o.features_x = pair.features_x;

@@ -6,6 +6,7 @@
 #include <doctest/doctest.h>
 
 #include <cmath>
+#include <numeric>
 
 using namespace shapematch;
 
@@ -186,4 +187,39 @@ TEST_CASE("energy: the feature term is Σ (corner areas) ‖f_X − f_Y‖² ove
   same.set_features(fx, fx);
   for (const auto& t : identity_matching(x)) CHECK(same.feature(t) == 0.0);
   CHECK_THROWS_AS(same.set_features(fx, fy.leftCols(4)), InvalidInputError);
+}
+
+TEST_CASE("energy: with a curvature radius the bending term reads H averaged over it, the radius in units of √area") {
+  // X of area 4π · 4 (radius 2), so the radius 0.1 is 0.1 · √(16π) in X's units; Y of area 4π.
+  const Mesh x = test::deformed(test::bumpy_sphere(0.2), [](const Eigen::Vector3d& p) { return Eigen::Vector3d(2 * p); });
+  const Mesh y = test::bumpy_sphere(0.1);
+  const Geometry gx = compute_geometry(x), gy = compute_geometry(y);
+  auto total = [](const Geometry& g) { return std::accumulate(g.face_area.begin(), g.face_area.end(), 0.0); };
+  const std::vector<double> hx = smoothed_mean_curvature(x, gx, 0.1 * std::sqrt(total(gx)));
+  const std::vector<double> hy = smoothed_mean_curvature(y, gy, 0.1 * std::sqrt(total(gy)));
+  CHECK(hx != gx.mean_curvature);  // the radius reaches past each vertex's own neighbours
+  EnergyModel per_vertex(x, gx, y, gy), averaged(x, gx, y, gy, EnergyOptions{.curvature_radius = 0.1});
+  auto area = [](const Mesh& m, const Geometry& g, int f, int v) {
+    if (f < 0) return 0.0;
+    for (int c = 0; c < 3; ++c)
+      if (m.faces[f][c] == v) return g.corner_area[f][c];
+    return -1.0;
+  };
+  const ProductSpace s = ProductSpace::full(x, y);
+  int differ = 0;
+  for (int64_t j = 0; j < s.size(); j += 101) {
+    const ProductTriangle t = s[j];
+    double expected = 0.0, raw = 0.0;
+    for (int i = 0; i < 3; ++i) {
+      const double a = area(x, gx, t.fa, t.a[i]) + area(y, gy, t.fb, t.b[i]);
+      expected += a * (hx[t.a[i]] - hy[t.b[i]]) * (hx[t.a[i]] - hy[t.b[i]]);
+      raw += a * (gx.mean_curvature[t.a[i]] - gy.mean_curvature[t.b[i]]) *
+             (gx.mean_curvature[t.a[i]] - gy.mean_curvature[t.b[i]]);
+    }
+    CHECK(averaged.bending(t) == doctest::Approx(expected).epsilon(1e-12));
+    CHECK(per_vertex.bending(t) == doctest::Approx(raw).epsilon(1e-12));
+    differ += std::abs(expected - raw) > 1e-9 * std::max(1.0, raw);
+  }
+  CHECK(differ > 0);
+  CHECK(averaged.membrane(s[7]) == per_vertex.membrane(s[7]));  // the membrane does not care
 }

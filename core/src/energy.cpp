@@ -74,7 +74,15 @@ double membrane_energy_springs(const Triangle3& s, const Triangle3& t, double la
 }
 
 EnergyModel::EnergyModel(const Mesh& x, const Geometry& gx, const Mesh& y, const Geometry& gy, EnergyOptions options)
-    : x_(x), gx_(gx), y_(y), gy_(gy), options_(options) {}
+    : x_(x), gx_(gx), y_(y), gy_(gy), options_(options) {
+  auto curvature = [&](const Mesh& m, const Geometry& g) {
+    double area = 0.0;
+    for (double a : g.face_area) area += a;
+    return smoothed_mean_curvature(m, g, options_.curvature_radius * std::sqrt(area));
+  };
+  hx_ = curvature(x, gx);
+  hy_ = curvature(y, gy);
+}
 
 void EnergyModel::set_features(Eigen::MatrixXd fx, Eigen::MatrixXd fy) {
   if (fx.size() > 0 && (fx.rows() != x_.num_vertices() || fy.rows() != y_.num_vertices() || fx.cols() != fy.cols()))
@@ -100,7 +108,7 @@ double EnergyModel::bending(const ProductTriangle& p) const {
     // A vertex repeated in a degenerate tuple is counted once per corner, with zero area on that side.
     const double ax = p.fa >= 0 ? gx_.corner_area[p.fa][corner_of(x_.faces[p.fa], p.a[i])] : 0.0;
     const double ay = p.fb >= 0 ? gy_.corner_area[p.fb][corner_of(y_.faces[p.fb], p.b[i])] : 0.0;
-    const double dh = gx_.mean_curvature[p.a[i]] - gy_.mean_curvature[p.b[i]];
+    const double dh = hx_[p.a[i]] - hy_[p.b[i]];
     e += (ax + ay) * dh * dh;
   }
   return e;

@@ -79,6 +79,34 @@ Geometry compute_geometry(const Mesh& mesh) {
   return g;
 }
 
+std::vector<double> smoothed_mean_curvature(const Mesh& mesh, const Geometry& g, double radius) {
+  if (radius <= 0.0) return g.mean_curvature;
+  const int nv = mesh.num_vertices();
+  std::vector<std::vector<int>> next(nv);
+  for (const auto& f : mesh.faces)
+    for (int i = 0; i < 3; ++i) next[f[i]].push_back(f[(i + 1) % 3]);  // each edge both ways on a closed mesh
+  std::vector<double> h(nv, 0.0);
+  std::vector<int> seen(nv, -1), queue;
+  const double r2 = radius * radius;
+  for (int v = 0; v < nv; ++v) {
+    double sum = 0.0, weight = 0.0;
+    queue.assign(1, v);
+    seen[v] = v;
+    for (size_t q = 0; q < queue.size(); ++q) {
+      const int u = queue[q];
+      sum += g.vertex_area[u] * g.mean_curvature[u];
+      weight += g.vertex_area[u];
+      for (int w : next[u])
+        if (seen[w] != v && (mesh.vertices[w] - mesh.vertices[v]).squaredNorm() <= r2) {
+          seen[w] = v;
+          queue.push_back(w);
+        }
+    }
+    h[v] = weight > 0.0 ? sum / weight : g.mean_curvature[v];
+  }
+  return h;
+}
+
 int image_orientation(const Mesh& y, const Geometry& gy, int a, int b, int c) {
   const Eigen::Vector3d ab = y.vertices[b] - y.vertices[a], ac = y.vertices[c] - y.vertices[a];
   const Eigen::Vector3d normal = ab.cross(ac);

@@ -23,6 +23,9 @@ struct EnergyOptions {
   // the St. Venant–Kirchhoff membrane charges a face squashed to a segment only 0.75 of its area,
   // so without it the LP prefers folding both shapes onto curves (docs/architecture.md).
   double degenerate_penalty = 0.0;
+  // The bending term's mean curvature averaged over this radius (times √area of each shape, so
+  // that with unit area it is in those units; smoothed_mean_curvature). 0: per vertex, the paper's.
+  double curvature_radius = 0.0;
 };
 
 using Triangle3 = std::array<Eigen::Vector3d, 3>;
@@ -56,6 +59,7 @@ private:
   const Mesh& y_;
   const Geometry& gy_;
   EnergyOptions options_;
+  std::vector<double> hx_, hy_;  // the mean curvature the bending term reads (curvature_radius)
   // Row-major: the feature term reads one vertex's descriptor at a time (column-major put each
   // of its numbers on a cache line of its own).
   Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> fx_, fy_;
