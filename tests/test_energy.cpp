@@ -18,6 +18,15 @@ Triangle3 random_triangle(std::mt19937& rng) {
           Eigen::Vector3d(u(rng), u(rng), u(rng))};
 }
 
+// The bending and feature weight of vertex v in face f: its corner's mixed Voronoi area (0 on a
+// degenerate side, -1 where v is not a corner of f).
+double corner_area_of(const Mesh& m, const Geometry& g, int f, int v) {
+  if (f < 0) return 0.0;
+  for (int c = 0; c < 3; ++c)
+    if (m.faces[f][c] == v) return g.corner_area[f][c];
+  return -1.0;
+}
+
 }  // namespace
 
 TEST_CASE("energy: membrane equals Delingette's spring form on random triangles") {
@@ -165,12 +174,6 @@ TEST_CASE("energy: the feature term is Σ (corner areas) ‖f_X − f_Y‖² ove
   EnergyModel model(x, gx, y, gy);
   CHECK(model.feature(identity_matching(x).front()) == 0.0);  // no features: no term
   model.set_features(fx, fy);
-  auto area = [](const Mesh& m, const Geometry& g, int f, int v) {
-    if (f < 0) return 0.0;
-    for (int c = 0; c < 3; ++c)
-      if (m.faces[f][c] == v) return g.corner_area[f][c];
-    return -1.0;
-  };
   const ProductSpace s = ProductSpace::full(x, y);
   int degenerate = 0;
   for (int64_t j = 0; j < s.size(); j += 13) {
@@ -178,7 +181,8 @@ TEST_CASE("energy: the feature term is Σ (corner areas) ‖f_X − f_Y‖² ove
     degenerate += t.fa < 0 || t.fb < 0;
     double expected = 0.0;
     for (int i = 0; i < 3; ++i)
-      expected += (area(x, gx, t.fa, t.a[i]) + area(y, gy, t.fb, t.b[i])) * (fx.row(t.a[i]) - fy.row(t.b[i])).squaredNorm();
+      expected += (corner_area_of(x, gx, t.fa, t.a[i]) + corner_area_of(y, gy, t.fb, t.b[i])) *
+                  (fx.row(t.a[i]) - fy.row(t.b[i])).squaredNorm();
     CHECK(model.feature(t) == expected);  // the same additions in the same order
   }
   CHECK(degenerate > 0);
@@ -199,19 +203,13 @@ TEST_CASE("energy: with a curvature radius the bending term reads H averaged ove
   const std::vector<double> hy = smoothed_mean_curvature(y, gy, 0.1 * std::sqrt(total(gy)));
   CHECK(hx != gx.mean_curvature);  // the radius reaches past each vertex's own neighbours
   EnergyModel per_vertex(x, gx, y, gy), averaged(x, gx, y, gy, EnergyOptions{.curvature_radius = 0.1});
-  auto area = [](const Mesh& m, const Geometry& g, int f, int v) {
-    if (f < 0) return 0.0;
-    for (int c = 0; c < 3; ++c)
-      if (m.faces[f][c] == v) return g.corner_area[f][c];
-    return -1.0;
-  };
   const ProductSpace s = ProductSpace::full(x, y);
   int differ = 0;
   for (int64_t j = 0; j < s.size(); j += 101) {
     const ProductTriangle t = s[j];
     double expected = 0.0, raw = 0.0;
     for (int i = 0; i < 3; ++i) {
-      const double a = area(x, gx, t.fa, t.a[i]) + area(y, gy, t.fb, t.b[i]);
+      const double a = corner_area_of(x, gx, t.fa, t.a[i]) + corner_area_of(y, gy, t.fb, t.b[i]);
       expected += a * (hx[t.a[i]] - hy[t.b[i]]) * (hx[t.a[i]] - hy[t.b[i]]);
       raw += a * (gx.mean_curvature[t.a[i]] - gy.mean_curvature[t.b[i]]) *
              (gx.mean_curvature[t.a[i]] - gy.mean_curvature[t.b[i]]);
