@@ -39,7 +39,7 @@ double certified_lower_bound(const LpProblem& p, const std::vector<double>& y) {
   double by = 0.0;
   for (int64_t i = 0; i < p.rows(); ++i) by += p.b[i] * y[i];
   // Σ_j min(0, c_j − (Aᵀy)_j), summed per thread then combined (deterministic for a fixed thread count).
-  const int threads = detail::hardware_threads();
+  const int threads = worker_threads();
   std::vector<double> partial(threads, 0.0);
   detail::parallel_chunks(p.cols(), threads, [&](int64_t b, int64_t e, int t) {
     double s = 0.0;

@@ -11,15 +11,13 @@
 
 namespace shapematch::detail {
 
-inline int hardware_threads() { return worker_threads(); }
-
 // Calls body(begin, end, chunk) for `threads` contiguous chunks of [0, n), each of about `grain`
 // items at least (a thread costs a spawn). If bodies throw, every chunk still runs to its end and
 // the first chunk's exception is rethrown here (an exception escaping a std::thread would
 // terminate the process).
 template <class Body>
 void parallel_chunks(int64_t n, int threads, Body&& body, int64_t grain = 4096) {
-  if (threads <= 0) threads = hardware_threads();
+  if (threads <= 0) threads = worker_threads();
   threads = static_cast<int>(std::max<int64_t>(1, std::min<int64_t>(threads, n / std::max<int64_t>(1, grain) + 1)));
   if (threads == 1) {
     body(int64_t{0}, n, 0);
@@ -63,7 +61,7 @@ template <class Body>
 void parallel_rows(const std::vector<uint32_t>& row_ptr, int threads, Body&& body) {
   const int64_t n = static_cast<int64_t>(row_ptr.size()) - 1;
   if (n <= 0) return;
-  if (threads <= 0) threads = hardware_threads();
+  if (threads <= 0) threads = worker_threads();
   const int64_t total = int64_t(row_ptr[n]) + n;
   threads = static_cast<int>(std::max<int64_t>(1, std::min<int64_t>(threads, total / 16384 + 1)));
   std::vector<int64_t> cut(threads + 1, n);
@@ -90,7 +88,7 @@ void parallel_rows(const std::vector<uint32_t>& row_ptr, int threads, Body&& bod
 // parallel, then merged pairwise, the merges of each round in parallel too.
 template <class T>
 void parallel_sort(T* first, int64_t n, int threads = 0) {
-  if (threads <= 0) threads = hardware_threads();
+  if (threads <= 0) threads = worker_threads();
   const int64_t chunks = std::max<int64_t>(1, std::min<int64_t>(threads, n / 65536));
   std::vector<int64_t> cut(chunks + 1);
   for (int64_t c = 0; c <= chunks; ++c) cut[c] = n * c / chunks;

@@ -26,7 +26,7 @@ bool spin_until(Ready ready) {
 }  // namespace
 
 ThreadPool::ThreadPool(int threads) {
-  if (threads <= 0) threads = hardware_threads();
+  if (threads <= 0) threads = worker_threads();
   for (int t = 1; t < threads; ++t) workers_.emplace_back([this] { work(); });
 }
 
