@@ -57,9 +57,13 @@ cat > "$dir/q.sh" <<'EOF'
 #!/bin/bash
 # Runs the jobs of jobs.txt (or $JOBS), P at once, each `bench match` of one pair with the options
 # of match_args.txt and --backend $BACKEND (vulkan; cpu where no NVIDIA device shows) at FACES faces
-# (full), killed at LIMIT seconds; then packs logs, tables and results (no meshes) into $OUT/q.txz. Run it from a
-# folder outside the checkout (a later call would replace an ignored folder it does not carry).
+# (full), THREADS threads each (default nproc / P), killed at LIMIT seconds; then packs logs,
+# tables and results (no meshes) into $OUT/q.txz. Run it from a folder outside the checkout (a
+# later call would replace an ignored folder it does not carry).
 LIMIT=${LIMIT:-515}; P=${P:-8}; BACKEND=${BACKEND:-vulkan}; FACES=${FACES:-full}
+# Each run's share of the cores: P runs of all threads each leave the host oversubscribed and the
+# GPU waiting (thirty-third session: one thread each was 6.5 % faster than sixteen, 11 at once).
+THREADS=${THREADS:-$(( $(nproc) / P > 0 ? $(nproc) / P : 1 ))}
 export LD_LIBRARY_PATH=$PWD/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}
 mkdir -p out log
 { date; nproc; free -g | head -2; nvidia-smi --query-gpu=name,driver_version,memory.total --format=csv 2>&1; } > log/machine.txt
@@ -79,11 +83,11 @@ run1() {
   local id=$n-$w${tag:+-$tag}
   mapfile -t margs < match_args.txt
   ./shapematch bench match --pairs "pairs/$n.txt" --faces "$FACES" --time-limit "$LIMIT" --out "out/$id" -- \
-    "${margs[@]}" --backend "$BACKEND" "${extra[@]}" > "log/$id.bench.log" 2>&1
+    "${margs[@]}" --backend "$BACKEND" --threads "$THREADS" "${extra[@]}" > "log/$id.bench.log" 2>&1
   echo "$id exit $? at $(date +%T)" >> log/done.txt
 }
 export -f run1
-export LIMIT BACKEND FACES
+export LIMIT BACKEND FACES THREADS
 timeout $((LIMIT + 45)) xargs -P "$P" -L 1 bash -c 'run1 "$@"' _ < "${JOBS:-jobs.txt}"
 kill $SMI
 cat out/*/bench_pairs.md > log/tables.md 2>/dev/null
