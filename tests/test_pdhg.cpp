@@ -482,8 +482,8 @@ TEST_CASE("pdhg: the divergence watch on the windows of measured full-resolution
   struct Window {
     double primal, gap, objective, bound;
   };
-  auto first_stop = [](const std::vector<Window>& windows) {
-    detail::DivergenceWatch watch(3e-3);
+  auto first_stop = [](const std::vector<Window>& windows, double tolerance = 3e-3) {
+    detail::DivergenceWatch watch(tolerance);
     for (size_t w = 0; w < windows.size(); ++w)
       if (watch.diverging(windows[w].primal, windows[w].gap, windows[w].objective, windows[w].bound)) return int(w);
     return -1;
@@ -522,6 +522,18 @@ TEST_CASE("pdhg: the divergence watch on the windows of measured full-resolution
   CHECK(first_stop({{3.53e-3, 3.83e-3, 99.60, 100.37}, {2.61e-3, 5.72e-3, 99.81, 100.96},
                     {2.26e-3, 6.48e-3, 99.90, 101.20}, {2.09e-3, 6.64e-3, 100.00, 101.34},
                     {2.13e-3, 6.30e-3, 100.10, 101.37}, {2.16e-3, 6.33e-3, 100.20, 101.48}}) == -1);
+  // TOSCA_r horse0-5's 1 414-face first LP at the curvature radius 0.05 (tolerance 1e-3, the
+  // watch off): the gap tripled and the bound climbed 1.4 in the second window, the residual still
+  // 5.8e-2; then it fell 30× in one window, the bound went below the objective, and the LP
+  // converged (gap 2.1e-3 at 3 840 iterations, when it was stopped). With the watch on, the gap
+  // rule had stopped it at the second window, 24 times in a row as its space widened.
+  CHECK(first_stop({{7.608e-2, 6.977e-2, 2.344, 2.697}, {5.843e-2, 1.966e-1, 2.929, 4.364},
+                    {1.853e-3, 4.766e-2, 4.890, 4.444}, {3.262e-4, 1.857e-2, 4.942, 4.762},
+                    {1.504e-4, 1.106e-2, 4.927, 4.819}, {6.155e-4, 6.526e-3, 4.916, 4.853},
+                    {2.333e-4, 2.891e-3, 4.906, 4.878}},
+                   1e-3) == -1);
+  // The same windows with the residual near feasible would stop at the second, as before.
+  CHECK(first_stop({{7.608e-3, 6.977e-2, 2.344, 2.697}, {5.843e-3, 1.966e-1, 2.929, 4.364}}, 1e-3) == 1);
   // A flat residual with the bound far above and rising stops whatever the gap (made-up first
   // window; the second is FAUST_r 021-024's at 1 536 iterations with a smaller gap).
   CHECK(first_stop({{1.20e-2, 2.0e-2, 44.80, 46.0}, {1.16e-2, 2.5e-2, 45.56, 58.84}}) == 1);

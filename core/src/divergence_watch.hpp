@@ -27,6 +27,13 @@ public:
       // far above it and have grown (a 1 474-face reduced LP at tolerance 1e-3 sat at residual
       // 5.6e-4 with its bound 4.3 above an objective of 8.6, still rising, for 35 000 iterations).
       const bool flat = primal >= 0.8 * primal_;
+      // The rules below that fire while the residual still falls wait until it is near feasible:
+      // far from it, cᵀx and the bound say little yet. Measured, TOSCA_r horse0-5 at the curvature
+      // radius 0.05, the 1 414-face level's first LP (tolerance 1e-3): at 1 024 iterations residual
+      // 6.0e-2, gap 0.20, the bound 1.44 above an objective of 2.87 and rising, so the gap rule
+      // stopped it; let run, it was feasible (residual 1.9e-3 at 1 536, gap 2.1e-3 at 3 840). The
+      // infeasible LPs these rules were set on (tests/test_pdhg.cpp) stopped at 1.2e-2 and below.
+      const bool near = primal < kNearFeasible;
       const bool stalled = primal > tolerance_ || (gap > 10.0 * tolerance_ && gap > gap_);
       stop = flat && stalled && bound - objective > 0.1 * scale && bound - bound_ > 0.05 * scale;
       // A gap that grew past 10× the tolerance with the bound over 5 % above the objective and
@@ -34,7 +41,8 @@ public:
       // resolution runs, every one that stopped optimal stayed short of this, and FAUST_r 020-024's
       // and 021-024's infeasible finest LPs meet it at 1 024 iterations (gap 3.7e-2 and 5.0e-2,
       // bound 7 % and 10 % above), 1 024 and 512 iterations before the rule above.
-      stop = stop || (gap > 10.0 * tolerance_ && gap > gap_ && bound - objective > 0.05 * scale && bound > bound_);
+      stop = stop || (near && gap > 10.0 * tolerance_ && gap > gap_ && bound - objective > 0.05 * scale &&
+                      bound > bound_);
       // A slower climb counts too where it held kCreepingWindows windows in a row: the bound above
       // the objective, the gap growing, the residual flat (TOSCA_r horse0-5's finest LP: residual
       // 1.2e-3 → 1.0e-3 while the gap grew 4.3e-3 → 3.8e-2 over 3 600 iterations, its bound rising
@@ -42,14 +50,14 @@ public:
       creeping_ = flat && bound > objective && gap > tolerance_ && gap > gap_ ? creeping_ + 1 : 0;
       stop = stop || creeping_ >= kCreepingWindows;
       // The bound pulling away from the objective for three windows in a row, whatever the
-      // residual does: above it and further each window, at the last more than twice as far as
+      // residual does once near feasible: above it and further each window, at the last more than twice as far as
       // at the first, the gap above the tolerance (FAUST_r 020-024's second infeasible finest
       // LPs: excess 0.17, 0.48, 0.98 at 512-1 536 iterations, stopped by the rules above at
       // 2 048, or at 3 584 with 0.15, 0.25, 0.26, 0.43, 0.54, …; the cat's at 2 560 instead of
       // 3 584). No LP that ended optimal in this session's full-resolution logs met it (155;
       // feasible LPs' excess shrinks or changes sign within three windows).
-      stop = stop || (windows_ >= 2 && excess_[0] > 0.0 && excess_[1] > excess_[0] && excess > excess_[1] &&
-                      excess > 2.0 * excess_[0] && gap > tolerance_);
+      stop = stop || (near && windows_ >= 2 && excess_[0] > 0.0 && excess_[1] > excess_[0] &&
+                      excess > excess_[1] && excess > 2.0 * excess_[0] && gap > tolerance_);
     }
     ++windows_;
     excess_[0] = excess_[1];
@@ -62,6 +70,7 @@ public:
 
 private:
   static constexpr int kCreepingWindows = 4;
+  static constexpr double kNearFeasible = 2e-2;  // primal residual, relative to 1 + ‖b‖
   double tolerance_;
   double primal_ = 0.0, gap_ = 0.0, bound_ = 0.0;
   int creeping_ = 0;
