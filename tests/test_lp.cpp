@@ -87,6 +87,28 @@ TEST_CASE("lp: the certified lower bound holds for arbitrary duals") {
   }
 }
 
+TEST_CASE("lp: the Farkas rate is positive along an infeasible LP's ray and never on a feasible LP") {
+  // x0 + x1 = 3 in the box: d = 1 gives 3 − 2 = 1 > 0; Clp's ray likewise.
+  const LpProblem bad = dense_lp({{1, 1, 0, 0}, {0, 0, 1, 1}, {0, 0, 1, -1}}, {3, 1, 0}, {1, 1, 1, 2});
+  CHECK(farkas_rate(bad, {1.0, 0.0, 0.0}) == doctest::Approx(1.0));
+  const LpResult r = solve_lp(bad, "clp-dual");
+  REQUIRE(r.status == LpStatus::Infeasible);
+  CHECK(std::abs(farkas_rate(bad, r.y)) > 0.0);  // Clp's sign convention may be either
+  CHECK(std::max(farkas_rate(bad, r.y), farkas_rate(bad, std::vector<double>{-r.y[0], -r.y[1], -r.y[2]})) > 0.0);
+  // A feasible matching LP: no direction at all grows without limit.
+  const Mesh x = shapes::tetrahedron();
+  const Mesh y = test::deformed(x, [](const Eigen::Vector3d& p) { return Eigen::Vector3d(p.x(), 1.5 * p.y(), p.z()); });
+  const MatchingLp m = build_matching_lp(x, compute_geometry(x), y, compute_geometry(y));
+  std::mt19937 rng(3);
+  std::normal_distribution<double> n(0.0, 1.0);
+  for (int k = 0; k < 50; ++k) {
+    std::vector<double> d(m.lp.rows());
+    for (auto& v : d) v = n(rng);
+    CHECK(farkas_rate(m.lp, d) <= 1e-9);
+  }
+  CHECK(farkas_rate(m.lp, {}) == -std::numeric_limits<double>::infinity());  // a wrong size
+}
+
 namespace {
 // max cᵀx over the LP's feasible set, by Clp on −c.
 double largest_objective(LpProblem p) {

@@ -34,17 +34,18 @@ const char* to_string(LpStatus status) {
   return "unknown";
 }
 
-double certified_lower_bound(const LpProblem& p, const std::vector<double>& y) {
-  if (y.size() != size_t(p.rows())) return -std::numeric_limits<double>::infinity();
+namespace {
+// bᵀy + Σ_j min(0, c_j − (Aᵀy)_j), with c taken as 0 where `costs` is false; summed per thread
+// then combined (deterministic for a fixed thread count).
+double lagrangian(const LpProblem& p, const std::vector<double>& y, bool costs) {
   double by = 0.0;
   for (int64_t i = 0; i < p.rows(); ++i) by += p.b[i] * y[i];
-  // Σ_j min(0, c_j − (Aᵀy)_j), summed per thread then combined (deterministic for a fixed thread count).
   const int threads = worker_threads();
   std::vector<double> partial(threads, 0.0);
   detail::parallel_chunks(p.cols(), threads, [&](int64_t b, int64_t e, int t) {
     double s = 0.0;
     for (int64_t j = b; j < e; ++j) {
-      double r = p.c[j];
+      double r = costs ? p.c[j] : 0.0;
       for (uint32_t k = p.at.row_ptr[j]; k < p.at.row_ptr[j + 1]; ++k) {
         const uint32_t en = p.at.entry[k];
         r -= (en & SignedCsr::kNegative) ? -y[col_of(en)] : y[col_of(en)];
@@ -53,7 +54,18 @@ double certified_lower_bound(const LpProblem& p, const std::vector<double>& y) {
     }
     partial[t] = s;
   });
-  return p.objective_scale * (by + std::accumulate(partial.begin(), partial.end(), 0.0));
+  return by + std::accumulate(partial.begin(), partial.end(), 0.0);
+}
+}  // namespace
+
+double certified_lower_bound(const LpProblem& p, const std::vector<double>& y) {
+  if (y.size() != size_t(p.rows())) return -std::numeric_limits<double>::infinity();
+  return p.objective_scale * lagrangian(p, y, true);
+}
+
+double farkas_rate(const LpProblem& p, const std::vector<double>& d) {
+  if (d.size() != size_t(p.rows())) return -std::numeric_limits<double>::infinity();
+  return lagrangian(p, d, false);
 }
 
 double objective_upper_bound(const LpProblem& p) {

@@ -215,7 +215,19 @@ LpResult PdhgSolver::solve(const LpProblem& problem, const SolverParams& params)
     if (params.stop_on_divergence && total >= window_end) {
       std::vector<double> xh, yh;
       backend->read(xh, yh);
-      if (watch.diverging(primal, gap, s.cx, dual_obj) && !window_y.empty()) {
+      const bool diverging = watch.diverging(primal, gap, s.cx, dual_obj);
+      if (!window_y.empty() && spdlog::should_log(spdlog::level::debug)) {
+        // The window's dual growth as a would-be Farkas ray (diagnostic: how far from a proof).
+        std::vector<double> ray(m);
+        double bd = 0.0;
+        for (int64_t i = 0; i < m; ++i) {
+          ray[i] = r[i] * (yh[i] - window_y[i]);
+          bd += problem.b[i] * ray[i];
+        }
+        spdlog::debug("{}: window to {} it: the dual's growth has bᵀd {:.4g}, Farkas rate {:.4g}{}", name(), total,
+                      bd, farkas_rate(problem, ray), diverging ? " (the watch stops it)" : "");
+      }
+      if (diverging && !window_y.empty()) {
         result.status = LpStatus::Diverging;
         result.y.resize(m);
         result.last_y.resize(m);

@@ -102,6 +102,11 @@ LpResult solve_lp(const LpProblem& problem, const std::string& solver, const Sol
 // a lower bound on the LP optimum for ANY y because 0 ≤ x ≤ 1. Evaluated in double precision.
 double certified_lower_bound(const LpProblem& problem, const std::vector<double>& y);
 
+// How L(y + t·d) grows with t → ∞: bᵀd + Σ_j min(0, −(Aᵀd)_j), costs aside. Positive proves the
+// LP infeasible (Farkas: any feasible x has bᵀd = xᵀAᵀd ≤ Σ_j max(0, (Aᵀd)_j)); a diverging
+// PDHG's dual growth is such a ray only where the LP is infeasible. In the problem's own units.
+double farkas_rate(const LpProblem& problem, const std::vector<double>& d);
+
 // An upper bound on cᵀx over every feasible x (0 ≤ x ≤ 1, A x = b), in the problem's own units
 // (not times objective_scale). A row with only +1 entries and b_i ≥ 0 caps the sum of its
 // columns at b_i, so the columns assigned to it add at most b_i times their largest positive
