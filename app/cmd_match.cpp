@@ -63,6 +63,7 @@ struct MatchArgs {
   int max_propagation_widenings = CoarseToFineOptions{}.max_propagation_widenings;
   int recurring_margin = CoarseToFineOptions{}.recurring_margin;
   bool watch_resolve = CoarseToFineOptions{}.watch_resolve;
+  int max_suspected_widenings = CoarseToFineOptions{}.max_suspected_widenings;
   double second_start_budget = CoarseToFineOptions{}.second_start_budget;
   bool warm_widening = CoarseToFineOptions{}.warm_widening;
   bool carry_primal_weight = CoarseToFineOptions{}.carry_primal_weight;
@@ -141,6 +142,7 @@ int run_match(const MatchArgs& args) {
   co.max_propagation_widenings = args.max_propagation_widenings;
   co.recurring_margin = args.recurring_margin;
   co.watch_resolve = args.watch_resolve;
+  co.max_suspected_widenings = args.max_suspected_widenings;
   co.second_start_budget = args.second_start_budget;
   co.warm_widening = args.warm_widening;
   co.carry_primal_weight = args.carry_primal_weight;
@@ -393,6 +395,7 @@ int run_match(const MatchArgs& args) {
                               .set("max_propagation_widenings", args.max_propagation_widenings)
                               .set("recurring_margin", args.recurring_margin)
                               .set("watch_resolve", args.watch_resolve)
+                              .set("max_suspected_widenings", args.max_suspected_widenings)
                               .set("second_start_budget", args.second_start_budget)
                               .set("warm_widening", args.warm_widening)
                               .set("carry_primal_weight", args.carry_primal_weight)
@@ -614,6 +617,11 @@ Action add_match_command(CLI::App& app) {
   app.add_option("--max-local-widenings", a->max_local_widenings,
                  "local widenings per level before the ring widens everywhere (those where propagation found the "
                  "contradiction not counted)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  app.add_option("--max-suspected-widenings", a->max_suspected_widenings,
+                 "widenings in a row at a level on first LPs that the divergence watch stopped (no proof) before "
+                 "the level's next first LPs run unwatched, to an optimum or a proof (0: no limit)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   app.add_option("--max-propagation-widenings", a->max_propagation_widenings,

@@ -711,6 +711,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
   int local = 0;
   int ring = base_ring;
   bool trust_divergence = true;
+  int suspicions = 0;  // widenings in a row on a diverging first LP (no proof)
   bool regional_done = false;
   bool around_done = false;
   CarriedIterate warm;  // the last attempt's first LP, for the next
@@ -1042,7 +1043,20 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
         }
       }
       carried_ones.clear();  // the widenings below start afresh
-      if (!s && widen_at(m, proof, e.certified() ? "infeasible" : "probably infeasible (PDHG diverging)")) continue;
+      if (!s && widen_at(m, proof, e.certified() ? "infeasible" : "probably infeasible (PDHG diverging)")) {
+        // A suspicion that keeps coming back is checked: the next first LPs run to an optimum or
+        // a proof. A proof restores the watch.
+        suspicions = e.certified() ? 0 : suspicions + 1;
+        if (e.certified()) {
+          trust_divergence = true;
+        } else if (trust_divergence && options_.max_suspected_widenings > 0 &&
+                   suspicions >= options_.max_suspected_widenings) {
+          trust_divergence = false;
+          spdlog::info("level {}: {} widenings in a row on a diverging PDHG, none proved: the next first LPs run "
+                       "unwatched", l + 1, suspicions);
+        }
+        continue;
+      }
       if (!e.certified()) {  // nothing left to widen locally on a suspicion: solve for a proof
         trust_divergence = false;
         continue;

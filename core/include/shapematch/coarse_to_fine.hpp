@@ -95,6 +95,12 @@ struct CoarseToFineOptions {
   // session). Off: that re-solve starts at the optimum of a space it contains, and stops at the
   // cold first LP's iterations anyway (detail::watch_divergence says why).
   bool watch_resolve = false;
+  // Where this many widenings in a row at a level came from a first LP that the divergence watch
+  // stopped (a suspicion, no proof), the level's next first LPs run unwatched, to an optimum or a
+  // proof. 0: no limit. Measured, TOSCA_r horse0-5 and centaur0-2 at R = 0.05 on an H200: 24
+  // suspicions in a row each at their 1 414-face level (6.2 % → 21.6 % of the full space), and
+  // one such first LP, let run, was feasible (docs/results.md, thirty-fifth session).
+  int max_suspected_widenings = 3;
   // Start the first LP of a widened space from the previous attempt's iterate (its dual reset
   // where it diverged), by variable and row identity. Off: measured at full resolution (FAUST_r
   // 020-024) after a diverging attempt, the widened LP took 3 008 iterations warm against 2 048
