@@ -50,8 +50,8 @@ public:
       creeping_ = flat && bound > objective && gap > tolerance_ && gap > gap_ ? creeping_ + 1 : 0;
       stop = stop || creeping_ >= kCreepingWindows;
       // The bound pulling away from the objective for three windows in a row, whatever the
-      // residual does once near feasible: above it and further each window, at the last more than twice as far as
-      // at the first, the gap above the tolerance (FAUST_r 020-024's second infeasible finest
+      // residual does once near feasible: above it and further each window, at the last more than
+      // twice as far as at the first, the gap above the tolerance (FAUST_r 020-024's second infeasible finest
       // LPs: excess 0.17, 0.48, 0.98 at 512-1 536 iterations, stopped by the rules above at
       // 2 048, or at 3 584 with 0.15, 0.25, 0.26, 0.43, 0.54, …; the cat's at 2 560 instead of
       // 3 584). No LP that ended optimal in this session's full-resolution logs met it (155;
