@@ -1046,11 +1046,11 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
       if (!s && widen_at(m, proof, e.certified() ? "infeasible" : "probably infeasible (PDHG diverging)")) {
         // A suspicion that keeps coming back is checked: the next first LPs run to an optimum or
         // a proof. A proof restores the watch.
-        suspicions = e.certified() ? 0 : suspicions + 1;
         if (e.certified()) {
+          suspicions = 0;
           trust_divergence = true;
-        } else if (trust_divergence && options_.max_suspected_widenings > 0 &&
-                   suspicions >= options_.max_suspected_widenings) {
+        } else if (++suspicions >= options_.max_suspected_widenings && options_.max_suspected_widenings > 0 &&
+                   trust_divergence) {
           trust_divergence = false;
           spdlog::info("level {}: {} widenings in a row on a diverging PDHG, none proved: the next first LPs run "
                        "unwatched", l + 1, suspicions);

@@ -215,26 +215,24 @@ LpResult PdhgSolver::solve(const LpProblem& problem, const SolverParams& params)
     if (params.stop_on_divergence && total >= window_end) {
       std::vector<double> xh, yh;
       backend->read(xh, yh);
-      const bool diverging = watch.diverging(primal, gap, s.cx, dual_obj);
-      if (!window_y.empty() && spdlog::should_log(spdlog::level::debug)) {
-        // The window's dual growth as a would-be Farkas ray (diagnostic: how far from a proof).
-        std::vector<double> ray(m);
+      const bool diverging = watch.diverging(primal, gap, s.cx, dual_obj) && !window_y.empty();
+      const bool debug = !window_y.empty() && spdlog::should_log(spdlog::level::debug);
+      std::vector<double> ray;  // the window's dual growth: about a Farkas ray where the LP is infeasible
+      if (diverging || debug) {
+        ray.resize(m);
+        for (int64_t i = 0; i < m; ++i) ray[i] = r[i] * (yh[i] - window_y[i]);
+      }
+      if (debug) {  // how far from a proof (diagnostic)
         double bd = 0.0;
-        for (int64_t i = 0; i < m; ++i) {
-          ray[i] = r[i] * (yh[i] - window_y[i]);
-          bd += problem.b[i] * ray[i];
-        }
+        for (int64_t i = 0; i < m; ++i) bd += problem.b[i] * ray[i];
         spdlog::debug("{}: window to {} it: the dual's growth has bᵀd {:.4g}, Farkas rate {:.4g}{}", name(), total,
                       bd, farkas_rate(problem, ray), diverging ? " (the watch stops it)" : "");
       }
-      if (diverging && !window_y.empty()) {
+      if (diverging) {
         result.status = LpStatus::Diverging;
-        result.y.resize(m);
+        result.y = std::move(ray);
         result.last_y.resize(m);
-        for (int64_t i = 0; i < m; ++i) {
-          result.y[i] = r[i] * (yh[i] - window_y[i]);
-          result.last_y[i] = r[i] * yh[i];
-        }
+        for (int64_t i = 0; i < m; ++i) result.last_y[i] = r[i] * yh[i];
         result.x.resize(n);
         for (int64_t j = 0; j < n; ++j) result.x[j] = d[j] * xh[j];
         break;
