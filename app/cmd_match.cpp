@@ -67,6 +67,7 @@ struct MatchArgs {
   double second_start_budget = CoarseToFineOptions{}.second_start_budget;
   bool warm_widening = CoarseToFineOptions{}.warm_widening;
   bool carry_primal_weight = CoarseToFineOptions{}.carry_primal_weight;
+  std::string dump_first_lps;
   int inherit_widening = CoarseToFineOptions{}.inherit_widening;
   int price_dual_sweeps = CoarseToFineOptions{}.price_dual_sweeps;
   double stuck_after = CoarseToFineOptions{}.stuck_after;
@@ -146,6 +147,12 @@ int run_match(const MatchArgs& args) {
   co.second_start_budget = args.second_start_budget;
   co.warm_widening = args.warm_widening;
   co.carry_primal_weight = args.carry_primal_weight;
+  co.dump_first_lps = args.dump_first_lps;
+  if (!co.dump_first_lps.empty()) {
+    std::error_code ec;
+    fs::create_directories(co.dump_first_lps, ec);
+    if (ec) throw IoError(co.dump_first_lps + ": cannot create the directory (" + ec.message() + ")");
+  }
   co.inherit_widening = args.inherit_widening;
   co.price_dual_sweeps = args.price_dual_sweeps;
   co.stuck_after = args.stuck_after;
@@ -606,6 +613,9 @@ Action add_match_command(CLI::App& app) {
   app.add_flag("--carry-primal-weight,!--no-carry-primal-weight", a->carry_primal_weight,
                "warm starts (a pricing's re-solve, --warm-widening) also start from the primal weight their "
                "iterate's solve ended with (default off: measured no faster)");
+  app.add_option("--dump-first-lps", a->dump_first_lps,
+                 "write every first LP of a rounding to this directory (level<L>-<NNN>.smlp), to solve it again "
+                 "with `shapematch lp --from`");
   app.add_option("--price-dual-sweeps", a->price_dual_sweeps,
                  "with --price-widenings: the re-solve starts the new rows' duals where this many sweeps of "
                  "coordinate ascent on the Lagrangian bound put them, not at 0 (0: off)")

@@ -64,6 +64,21 @@ TEST_CASE("cli: lp on the bundled pair is positive, on an identity pair zero") {
   CHECK(json_number(r.out, "lower_bound") <= json_number(r.out, "objective") + 1e-12);
   CHECK(fs::file_size(mps) > 1000);
   fs::remove(mps);
+
+  // The same LP written out and solved again from the file: the same optimum.
+  const fs::path file = fs::temp_directory_path() / "shapematch_cli_test.smlp";
+  r = run("lp " + a + " " + b + " --faces 20 --solver clp-dual --export-lp " + file.string());
+  REQUIRE(r.code == 0);
+  const double objective = json_number(r.out, "objective");
+  Run again = run("lp --from " + file.string() + " --solver clp-dual");
+  REQUIRE(again.code == 0);
+  CHECK(json_number(again.out, "objective") == doctest::Approx(objective).epsilon(1e-9));
+  CHECK(json_number(again.out, "variables") == json_number(r.out, "variables"));
+  CHECK(json_string(again.out, "from") == file.string());
+  again = run("lp " + a + " " + b + " --from " + file.string());
+  CHECK(again.code == 1);
+  CHECK(again.err.find("not both") != std::string::npos);
+  fs::remove(file);
 }
 
 TEST_CASE("cli: malformed inputs give one clear line and a non-zero exit") {
@@ -94,6 +109,11 @@ TEST_CASE("cli: malformed inputs give one clear line and a non-zero exit") {
   const Run missing = run("lp /nonexistent/x.off " + good.string());
   CHECK(missing.code != 0);
   CHECK(missing.err.find("/nonexistent/x.off") != std::string::npos);
+  const Run not_lp = run("lp --from " + good.string());
+  CHECK(not_lp.code == 1);
+  CHECK(not_lp.out.empty());
+  CHECK(std::count(not_lp.err.begin(), not_lp.err.end(), '\n') == 1);
+  CHECK(not_lp.err.find(good.string() + ": not a shapematch LP file") != std::string::npos);
   const Run unknown = run("lp --solver magic");
   CHECK(unknown.code != 0);
 }

@@ -10,7 +10,9 @@
 
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <map>
 #include <random>
 #include <memory>
@@ -167,6 +169,37 @@ TEST_CASE("coarse to fine: a shape against itself is matched to the identity at 
   const VertexMaps maps = vertex_maps(r.finest.space, r.rounding.gamma);
   for (int v = 0; v < m.num_vertices(); ++v) CHECK(maps.x_to_y[v] == v);
   CHECK(check_graph_surface(r.finest.space, r.rounding.gamma).ok());
+}
+
+TEST_CASE("coarse to fine: every level's first LP can be written out and solved again on its own") {
+  const Mesh m = lumpy_sphere(2, 5);
+  CoarseToFineOptions o;
+  o.hierarchy.levels = 2;
+  o.hierarchy.coarsest_faces = 20;
+  o.ring = 0;
+  o.second_start = false;
+  o.rounding.solver = "clp-dual";
+  o.rounding.alternative_thresholds = {};
+  o.price_widenings = 0;
+  const test::TempDir dir;
+  o.dump_first_lps = dir.path.string();
+  const CoarseToFineResult r = CoarseToFineMatcher(m, m, o).run();
+  REQUIRE(r.levels.size() == 2);
+  std::vector<std::string> names;
+  for (const auto& e : std::filesystem::directory_iterator(dir.path)) names.push_back(e.path().filename().string());
+  std::sort(names.begin(), names.end());
+  REQUIRE(names.size() == 2);  // one first LP per level: nothing widened
+  CHECK(names[0] == "level1-000.smlp");
+  CHECK(names[1] == "level2-001.smlp");
+  for (int l = 0; l < 2; ++l) {
+    CAPTURE(l);
+    const LpProblem lp = read_lp((dir.path / names[l]).string());
+    CHECK(lp.cols() > 0);
+    CHECK(lp.cols() <= r.levels[l].variables);  // what propagation left free
+    const LpResult again = solve_lp(lp, "clp-dual");
+    REQUIRE(again.status == LpStatus::Optimal);
+    CHECK(again.objective == doctest::Approx(0.0).epsilon(1e-9));  // a shape against itself
+  }
 }
 
 TEST_CASE("coarse to fine: a deformed pair with different triangulations ends verified") {
@@ -869,4 +902,32 @@ TEST_CASE("coarse to fine: the divergence watch stops first LPs with widenings l
   CHECK(watch_divergence(s));
   s.trusted = false;
   CHECK_FALSE(watch_divergence(s));
+}
+
+TEST_CASE("coarse to fine: after N suspicions in a row the watch is off until a proof") {
+  detail::SuspicionCount s(3);
+  CHECK(s.trusted());
+  CHECK_FALSE(s.suspicion());
+  CHECK_FALSE(s.suspicion());
+  CHECK(s.trusted());
+  CHECK(s.suspicion());  // the third ends the trust, and says so once
+  CHECK_FALSE(s.trusted());
+  CHECK_FALSE(s.suspicion());
+  CHECK_FALSE(s.trusted());
+  CHECK(s.count() == 4);
+  s.proof();  // a proof: trusted again, counted afresh
+  CHECK(s.trusted());
+  CHECK(s.count() == 0);
+  CHECK_FALSE(s.suspicion());
+  CHECK_FALSE(s.suspicion());
+  s.proof();  // not in a row: two, a proof, two more keep the trust
+  CHECK_FALSE(s.suspicion());
+  CHECK_FALSE(s.suspicion());
+  CHECK(s.trusted());
+  s.distrust();  // nothing left to widen on a suspicion
+  CHECK_FALSE(s.trusted());
+
+  detail::SuspicionCount unlimited(0);
+  for (int i = 0; i < 50; ++i) CHECK_FALSE(unlimited.suspicion());
+  CHECK(unlimited.trusted());
 }

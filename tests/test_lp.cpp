@@ -6,6 +6,7 @@
 
 #include <doctest/doctest.h>
 
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <numeric>
@@ -173,4 +174,52 @@ TEST_CASE("lp: MPS export and problem checks") {
   p.c.pop_back();
   CHECK_THROWS_AS(p.check(), InvalidInputError);
   CHECK_THROWS_AS(make_solver("simplex-magic"), InvalidInputError);
+}
+
+TEST_CASE("lp: the binary LP file holds the problem bit for bit; a damaged file is an error naming it") {
+  const Mesh x = shapes::octahedron();
+  const Mesh y = test::deformed(x, [](const Eigen::Vector3d& p) { return Eigen::Vector3d(1.2 * p.x(), p.y(), 0.9 * p.z()); });
+  const Geometry gx = compute_geometry(x), gy = compute_geometry(y);
+  const LpProblem lp = build_matching_lp(x, gx, y, gy).lp;
+  const test::TempDir dir;
+  const std::string path = (dir.path / "octahedron.smlp").string();
+  write_lp(lp, path);
+  const LpProblem back = read_lp(path);
+  CHECK(back.a.rows == lp.a.rows);
+  CHECK(back.a.cols == lp.a.cols);
+  CHECK(back.a.row_ptr == lp.a.row_ptr);
+  CHECK(back.a.entry == lp.a.entry);
+  CHECK(back.at.row_ptr == lp.at.row_ptr);  // rebuilt, the same
+  CHECK(back.at.entry == lp.at.entry);
+  CHECK(back.b == lp.b);
+  CHECK(back.c == lp.c);
+  CHECK(back.objective_scale == lp.objective_scale);
+  // Solved from the file, the same optimum.
+  CHECK(solve_lp(back, "clp-dual").objective == doctest::Approx(solve_lp(lp, "clp-dual").objective).epsilon(1e-12));
+
+  std::string bytes;
+  {
+    std::ifstream in(path, std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(in), {});
+  }
+  auto message = [&](const std::string& content) {
+    const std::string p = dir.file("bad.smlp", content);
+    try {
+      read_lp(p);
+    } catch (const InvalidInputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  CHECK(message(bytes.substr(0, bytes.size() - 8)).find("bad.smlp: sizes") != std::string::npos);
+  CHECK(message(bytes.substr(0, 10)).find("bad.smlp: truncated") != std::string::npos);
+  CHECK(message("OFF\n3 1 0\n").find("not a shapematch LP file") != std::string::npos);
+  std::string corrupt = bytes;
+  const size_t entries = 4 + 4 + 3 * 8 + 8 + 4 * size_t(lp.rows() + 1);
+  corrupt[entries + 1] = char(0x7f);  // a column index far out of range
+  CHECK(message(corrupt).find("out of range") != std::string::npos);
+  std::string nan = bytes;
+  std::memset(nan.data() + nan.size() - 8, 0xff, 8);  // the last cost: NaN
+  CHECK(message(nan).find("not finite") != std::string::npos);
+  CHECK_THROWS_AS(read_lp((dir.path / "missing.smlp").string()), IoError);
 }

@@ -685,6 +685,12 @@ int CoarseToFineMatcher::ring_at(int l) const {
 RoundingOptions CoarseToFineMatcher::rounding_for(int l) const {
   RoundingOptions ro = options_.rounding;
   if (l + 1 < hx_.size() && options_.coarse_tolerance > 0.0) ro.lp.tolerance = options_.coarse_tolerance;
+  if (!options_.dump_first_lps.empty())
+    ro.first_lp = [dir = options_.dump_first_lps, l, count = dumped_](const LpProblem& lp) {
+      const std::string path = fmt::format("{}/level{}-{:03d}.smlp", dir, l + 1, (*count)++);
+      write_lp(lp, path);
+      spdlog::info("level {}: wrote its first LP ({} x {}) to {}", l + 1, lp.rows(), lp.cols(), path);
+    };
   return ro;
 }
 
@@ -710,8 +716,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
   std::vector<int> last_widened;
   int local = 0;
   int ring = base_ring;
-  bool trust_divergence = true;
-  int suspicions = 0;  // widenings in a row on a diverging first LP (no proof)
+  detail::SuspicionCount suspicions(options_.max_suspected_widenings);
   bool regional_done = false;
   bool around_done = false;
   CarriedIterate warm;  // the last attempt's first LP, for the next
@@ -887,7 +892,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
       ro.lp.stop_on_divergence = detail::watch_divergence(
           {.refined = l > 0,
            .widenings_left = options_.local_widening && local < options_.max_local_widenings,
-           .trusted = trust_divergence,
+           .trusted = suspicions.trusted(),
            .warm_resolve = warm_resolve,
            .watch_resolve = options_.watch_resolve});
       if (l > 0 && options_.warm_widening && !carrying) {
@@ -1046,19 +1051,15 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
       if (!s && widen_at(m, proof, e.certified() ? "infeasible" : "probably infeasible (PDHG diverging)")) {
         // A suspicion that keeps coming back is checked: the next first LPs run to an optimum or
         // a proof. A proof restores the watch.
-        if (e.certified()) {
-          suspicions = 0;
-          trust_divergence = true;
-        } else if (++suspicions >= options_.max_suspected_widenings && options_.max_suspected_widenings > 0 &&
-                   trust_divergence) {
-          trust_divergence = false;
+        if (e.certified())
+          suspicions.proof();
+        else if (suspicions.suspicion())
           spdlog::info("level {}: {} widenings in a row on a diverging PDHG, none proved: the next first LPs run "
-                       "unwatched", l + 1, suspicions);
-        }
+                       "unwatched", l + 1, suspicions.count());
         continue;
       }
       if (!e.certified()) {  // nothing left to widen locally on a suspicion: solve for a proof
-        trust_divergence = false;
+        suspicions.distrust();
         continue;
       }
       // Out of local widenings, or stuck: once per level, every X face within kRegionRings of a

@@ -1,6 +1,6 @@
 #pragma once
 // Which first LP of a refined level may stop as diverging (SolverParams::stop_on_divergence),
-// kept apart from the level loop so that the rule is tested on its own.
+// kept apart from the level loop so that the rules are tested on their own.
 
 namespace shapematch::detail {
 
@@ -22,5 +22,35 @@ inline bool watch_divergence(const FirstLpState& s) {
   if (!s.refined || !s.widenings_left || !s.trusted) return false;
   return !s.warm_resolve || s.watch_resolve;
 }
+
+// Whether a level still trusts the watch: after `limit` widenings in a row on suspicions
+// (first LPs the watch stopped, no proof) it does not, until a proof of infeasibility. Measured
+// (thirty-fifth session): at the curvature radius 0.05, TOSCA_r horse0-5's 1 414-face level
+// widened 24 times in a row on suspicions, and one of those LPs, let run, was feasible.
+class SuspicionCount {
+public:
+  explicit SuspicionCount(int limit) : limit_(limit) {}
+  bool trusted() const { return trusted_; }
+  int count() const { return count_; }
+  // A widening on a certified proof: the watch is trusted again.
+  void proof() {
+    count_ = 0;
+    trusted_ = true;
+  }
+  // A widening on a suspicion. True where it is the one that ends the trust (to say so once).
+  bool suspicion() {
+    ++count_;
+    if (limit_ <= 0 || !trusted_ || count_ < limit_) return false;
+    trusted_ = false;
+    return true;
+  }
+  // A suspicion with nothing left to widen locally: the next first LP waits for a proof.
+  void distrust() { trusted_ = false; }
+
+private:
+  int limit_;  // 0: no limit
+  int count_ = 0;
+  bool trusted_ = true;
+};
 
 }  // namespace shapematch::detail

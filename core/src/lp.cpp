@@ -2,8 +2,12 @@
 
 #include "parallel.hpp"
 #include "shapematch/errors.hpp"
+#include "shapematch/files.hpp"
 
+#include <cerrno>
 #include <cmath>
+#include <cstring>
+#include <fstream>
 #include <numeric>
 
 namespace shapematch {
@@ -118,6 +122,86 @@ void evaluate_solution(const LpProblem& p, LpResult& r) {
 
 LpResult solve_lp(const LpProblem& problem, const std::string& solver, const SolverParams& params) {
   return make_solver(solver)->solve(problem, params);
+}
+
+namespace {
+
+// "SMLP", format version, then little-endian fields as laid out in write_lp.
+constexpr char kLpMagic[4] = {'S', 'M', 'L', 'P'};
+constexpr uint32_t kLpVersion = 1;
+
+template <class T>
+void put(std::ostream& out, const T* data, size_t count) {
+  out.write(reinterpret_cast<const char*>(data), static_cast<std::streamsize>(count * sizeof(T)));
+}
+
+}  // namespace
+
+void write_lp(const LpProblem& p, const std::string& path) {
+  p.check();
+  write_file_atomic(path, [&](std::ostream& out) {
+    const int64_t sizes[3] = {p.rows(), p.cols(), p.nonzeros()};
+    put(out, kLpMagic, 4);
+    put(out, &kLpVersion, 1);
+    put(out, sizes, 3);
+    put(out, &p.objective_scale, 1);
+    put(out, p.a.row_ptr.data(), p.a.row_ptr.size());
+    put(out, p.a.entry.data(), p.a.entry.size());
+    put(out, p.b.data(), p.b.size());
+    put(out, p.c.data(), p.c.size());
+  });
+}
+
+LpProblem read_lp(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw IoError(path + ": cannot read (" + std::strerror(errno) + ")");
+  auto bad = [&](const std::string& what) { throw InvalidInputError(path + ": " + what); };
+  auto get = [&](auto* data, size_t count) {
+    in.read(reinterpret_cast<char*>(data), static_cast<std::streamsize>(count * sizeof(*data)));
+    if (!in) bad("truncated");
+  };
+  in.seekg(0, std::ios::end);
+  const auto length = static_cast<uint64_t>(in.tellg());
+  in.seekg(0);
+  char magic[4];
+  uint32_t version = 0;
+  int64_t sizes[3];
+  get(magic, 4);
+  if (std::memcmp(magic, kLpMagic, 4) != 0) bad("not a shapematch LP file");
+  get(&version, 1);
+  if (version != kLpVersion) bad("LP file version " + std::to_string(version) + ", expected " + std::to_string(kLpVersion));
+  get(sizes, 3);
+  const auto [m, n, nnz] = sizes;
+  // Check the sizes against the file's length before allocating anything.
+  const uint64_t header = 4 + 4 + 3 * 8 + 8;
+  if (m < 0 || n < 0 || nnz < 0 || nnz > int64_t(UINT32_MAX) || n > int64_t(SignedCsr::kNegative) ||
+      length != header + 4 * uint64_t(m + 1) + 4 * uint64_t(nnz) + 8 * uint64_t(m) + 8 * uint64_t(n))
+    bad("sizes " + std::to_string(m) + " x " + std::to_string(n) + " (" + std::to_string(nnz) +
+        " nonzeros) do not match the file's length");
+  LpProblem p;
+  get(&p.objective_scale, 1);
+  p.a.rows = m;
+  p.a.cols = n;
+  p.a.row_ptr.resize(size_t(m) + 1);
+  p.a.entry.resize(size_t(nnz));
+  p.b.resize(size_t(m));
+  p.c.resize(size_t(n));
+  get(p.a.row_ptr.data(), p.a.row_ptr.size());
+  get(p.a.entry.data(), p.a.entry.size());
+  get(p.b.data(), p.b.size());
+  get(p.c.data(), p.c.size());
+  if (p.a.row_ptr[0] != 0 || p.a.row_ptr[size_t(m)] != uint32_t(nnz)) bad("bad row pointers");
+  for (int64_t i = 0; i < m; ++i)
+    if (p.a.row_ptr[size_t(i) + 1] < p.a.row_ptr[size_t(i)]) bad("bad row pointers");
+  for (uint32_t e : p.a.entry)
+    if (int64_t(col_of(e)) >= n) bad("a column index out of range");
+  p.at = transpose(p.a);
+  try {
+    p.check();
+  } catch (const InvalidInputError& e) {
+    bad(e.what());
+  }
+  return p;
 }
 
 }  // namespace shapematch

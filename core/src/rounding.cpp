@@ -1191,6 +1191,7 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
     };
     JoinedSolve joined;
     if (!after_fixing) {
+      if (options.first_lp) options.first_lp(red.lp);
       if (options.probe && options.probe_tolerance > params.tolerance) {
         SolverParams loose = params;
         loose.tolerance = options.probe_tolerance;

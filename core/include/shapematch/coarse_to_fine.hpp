@@ -5,8 +5,11 @@
 #include "shapematch/matching.hpp"
 #include "shapematch/rounding.hpp"
 
+#include <atomic>
 #include <functional>
+#include <memory>
 #include <limits>
+#include <string>
 
 namespace shapematch {
 
@@ -216,6 +219,10 @@ struct CoarseToFineOptions {
   // one won, and the finest energy went 16.51 → 13.07, the error 0.035 → 0.028. 0: decide at the
   // second level by its energy.
   int lookahead_levels = 2;
+  // A directory: every first LP that a rounding solves is written there (write_lp) as
+  // level<L>-<NNN>.smlp, NNN counting all first LPs of the run, for solving it again on its own
+  // (`shapematch lp --from`). Empty: none.
+  std::string dump_first_lps;
 };
 
 // Pricing: the reduced costs c_j − A_jᵀy of `other`'s columns, in energy units, against a dual
@@ -318,6 +325,7 @@ private:
   MeshHierarchy hx_, hy_;
   bool second_level_ = false;  // level 1 is HierarchyOptions::second_faces on both shapes
   Eigen::MatrixXd fx_, fy_;
+  std::shared_ptr<std::atomic<int>> dumped_ = std::make_shared<std::atomic<int>>(0);  // dump_first_lps
 };
 
 }  // namespace shapematch

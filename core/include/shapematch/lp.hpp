@@ -120,4 +120,12 @@ void evaluate_solution(const LpProblem& problem, LpResult& result);
 // Writes the LP in free MPS format (through a temporary file renamed into place).
 void write_mps(const LpProblem& problem, const std::string& path);
 
+// The LP in shapematch's own binary format (docs/formats.md), exactly as solved: A, b, the
+// scaled c and objective_scale. For reproducing one LP of a long run on its own (`match
+// --dump-first-lps`, `lp --from`). Written through a temporary file renamed into place.
+void write_lp(const LpProblem& problem, const std::string& path);
+// Throws IoError if the file cannot be read, InvalidInputError (naming the file) if it is not such
+// a file or is truncated or inconsistent. Aᵀ is rebuilt.
+LpProblem read_lp(const std::string& path);
+
 }  // namespace shapematch

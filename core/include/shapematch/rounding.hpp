@@ -146,6 +146,9 @@ struct RoundingOptions {
   // Not called after a proven infeasible LP (no iterate).
   // `primal_weight`: the solver's ω where it stopped (LpResult::primal_weight; NaN if none).
   std::function<void(const std::vector<double>& x, const std::vector<double>& y, double primal_weight)> first_iterate;
+  // Called with round 1's LP (what propagation left free, as solved; not its warm start) just
+  // before it is solved, where round 1 is a first LP (not one from carried fixings).
+  std::function<void(const LpProblem& lp)> first_lp;
   // Where probe_tolerance is above lp.tolerance and `probe` is set, round 1's LP is solved first
   // to probe_tolerance and `probe` gets that iterate (over the whole LP, as first_iterate's) if it
   // was optimal there; it may throw to abandon the rounding (coarse to fine prices a wider space
