@@ -4,6 +4,7 @@
 #include "shapematch/errors.hpp"
 #include "shapematch/json.hpp"
 #include "shapematch/matching.hpp"
+#include "shapematch/pdhg.hpp"
 #include "shapematch/system.hpp"
 
 #include <spdlog/spdlog.h>
@@ -18,6 +19,7 @@ struct LpArgs {
   std::string solver = "clp-dual";
   std::string json_path, mps_path, lp_path, from;
   SolverParams params;
+  PdhgOptions pdhg;
 };
 
 int run_lp(const LpArgs& args) {
@@ -44,7 +46,13 @@ int run_lp(const LpArgs& args) {
   if (!args.mps_path.empty()) write_mps(lp, args.mps_path);
   if (!args.lp_path.empty()) write_lp(lp, args.lp_path);
 
-  const LpResult r = solve_lp(lp, args.solver, args.params);
+  // PDHG with its options from the command line; the others as make_solver makes them.
+  std::unique_ptr<LpSolver> solver;
+  if (args.solver == "pdhg-cpu") solver = std::make_unique<PdhgSolver>(PdhgBackendKind::Cpu, args.pdhg);
+  else if (args.solver == "pdhg-cpu-f32") solver = std::make_unique<PdhgSolver>(PdhgBackendKind::CpuF32, args.pdhg);
+  else if (args.solver == "pdhg-vulkan") solver = std::make_unique<PdhgSolver>(PdhgBackendKind::Vulkan, args.pdhg);
+  else solver = make_solver(args.solver);
+  const LpResult r = solver->solve(lp, args.params);
   spdlog::info("{}: {} after {} iterations, objective {:.9g} ({:.2f} s)", r.solver, to_string(r.status),
                r.iterations, r.objective, r.seconds);
 
@@ -84,6 +92,10 @@ Action add_lp_command(CLI::App& app) {
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   app.add_option("--threads", args->params.threads, "CPU threads (0: all)")->check(CLI::NonNegativeNumber);
+  app.add_option("--primal-weight-smoothing", args->pdhg.primal_weight_smoothing,
+                 "PDHG: at a restart log ω moves this fraction of the way to log(Δy/Δx)")
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str();
   app.add_flag("--stop-on-divergence", args->params.stop_on_divergence,
                "stop PDHG where the divergence watch says the LP behaves like an infeasible one");
   return [args] { return run_lp(*args); };
