@@ -49,7 +49,7 @@ struct MatchArgs {
   double tolerance = 1e-4;
   double coarse_tolerance = CoarseToFineOptions{}.coarse_tolerance;
   double time_limit = std::numeric_limits<double>::infinity();
-  double initial_primal_weight = 0.0;
+  double cold_primal_weight = 0.0;
   int device = -1;
   HierarchyOptions hierarchy;
   int ring = 1, max_ring = 3;
@@ -181,7 +181,7 @@ int run_match(const MatchArgs& args) {
   ro.release_after_trims = args.release_after_trims;
   ro.lp.tolerance = args.tolerance;
   ro.lp.time_limit = args.time_limit;
-  ro.lp.initial_primal_weight = args.initial_primal_weight;
+  ro.lp.cold_primal_weight = args.cold_primal_weight;
   ro.lp.device = args.device;
   const CoarseToFineMatcher matcher(p.x, p.y, co);
   seconds.set("load", stage.seconds());
@@ -380,7 +380,7 @@ int run_match(const MatchArgs& args) {
                               .set("release_after_trims", args.release_after_trims)
                               .set("split_parts", !args.whole_lp)
                               .set("tolerance", args.tolerance)
-                              .set("initial_primal_weight", args.initial_primal_weight)
+                              .set("cold_primal_weight", args.cold_primal_weight)
                               .set("coarse_tolerance", co.coarse_tolerance)
                               .set("faces", args.pair.faces)
                               .set("keep_scale", args.pair.keep_scale)
@@ -564,8 +564,8 @@ Action add_match_command(CLI::App& app) {
       ->check(CLI::Range(0.0, 0.5))
       ->capture_default_str();
   app.add_option("--time-limit", a->time_limit, "time limit of each LP solve, seconds");
-  app.add_option("--initial-primal-weight", a->initial_primal_weight,
-                 "PDHG's primal weight ω to start every LP from where no warm start gives one (0: PDHG's own)")
+  app.add_option("--cold-primal-weight", a->cold_primal_weight,
+                 "PDHG's primal weight ω for LPs solved from a cold start (0: PDHG's own)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   app.add_option("--levels", a->hierarchy.levels, "coarse-to-fine levels including the finest (0: from --coarsest-faces)")

@@ -214,6 +214,28 @@ TEST_CASE("pdhg-cpu: a warm start goes on with the primal weight its solve ended
   CHECK(carried.iterations < cold.iterations);
 }
 
+TEST_CASE("pdhg-cpu: the cold primal weight starts cold solves only; an explicit ω wins") {
+  const Mesh x = shapes::octahedron();
+  const Mesh y = test::deformed(x, [](const Eigen::Vector3d& p) { return Eigen::Vector3d(1.2 * p.x(), p.y(), 0.9 * p.z()); });
+  const MatchingLp m = build_matching_lp(x, compute_geometry(x), y, compute_geometry(y));
+  // One check interval, no restart yet: ω where it stopped is the ω it started from.
+  SolverParams params;
+  params.max_iterations = 64;
+  params.threads = 1;
+  params.cold_primal_weight = 7.0;
+  CHECK(solve_lp(m.lp, "pdhg-cpu", params).primal_weight == 7.0);
+  params.initial_primal_weight = 3.0;
+  CHECK(solve_lp(m.lp, "pdhg-cpu", params).primal_weight == 3.0);
+  params.initial_primal_weight = 0.0;
+  params.initial_x.assign(size_t(m.lp.cols()), 0.5);  // a warm start: PDHG's own ω (1)
+  params.initial_y.assign(size_t(m.lp.rows()), 0.0);
+  CHECK(solve_lp(m.lp, "pdhg-cpu", params).primal_weight == 1.0);
+  params.initial_x.clear();
+  params.initial_y.clear();
+  params.cold_primal_weight = 0.0;
+  CHECK(solve_lp(m.lp, "pdhg-cpu", params).primal_weight == 1.0);
+}
+
 TEST_CASE("thread pool: every chunk runs exactly once, loop after loop") {
   for (const int threads : {1, 2, 3, 5}) {
     detail::ThreadPool pool(threads);

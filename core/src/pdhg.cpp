@@ -130,8 +130,9 @@ LpResult PdhgSolver::solve(const LpProblem& problem, const SolverParams& params)
   cnorm = std::sqrt(cnorm);
   bnorm = std::sqrt(bnorm);
   bnorm_orig = std::sqrt(bnorm_orig);
-  double omega = params.initial_primal_weight > 0 ? params.initial_primal_weight
-                 : options_.initial_primal_weight > 0 ? options_.initial_primal_weight
+  double omega = params.initial_primal_weight > 0                            ? params.initial_primal_weight
+                 : params.cold_primal_weight > 0 && params.initial_x.empty() ? params.cold_primal_weight
+                 : options_.initial_primal_weight > 0                        ? options_.initial_primal_weight
                  : (cnorm > 1e-10 && bnorm > 1e-10) ? cnorm / bnorm
                                                     : 1.0;
 

@@ -58,6 +58,10 @@ struct SolverParams {
   // from the optimum it was given before ω came back (FAUST_r 026-029's finest LP after pricing:
   // the primal residual went 2.5e-3 → 0.21 in 64 iterations, and took 768 to come back).
   double initial_primal_weight = 0.0;
+  // … and the one for a cold start (no initial_x), where initial_primal_weight is 0 (0: the
+  // solver's own). Warm starts keep theirs: started at a high ω, a re-solve from an optimum
+  // hit its iteration cap (FAUST_r 020-024 at 2 000 faces, ω 30).
+  double cold_primal_weight = 0.0;
 };
 
 struct LpResult {
