@@ -96,6 +96,10 @@ Action add_lp_command(CLI::App& app) {
                  "PDHG: at a restart log ω moves this fraction of the way to log(Δy/Δx)")
       ->check(CLI::Range(0.0, 1.0))
       ->capture_default_str();
+  app.add_option("--restart-artificial", args->pdhg.restart_artificial,
+                 "PDHG: restart when this fraction of all iterations passed since the last restart")
+      ->check(CLI::Range(0.01, 1.0))
+      ->capture_default_str();
   app.add_flag("--stop-on-divergence", args->params.stop_on_divergence,
                "stop PDHG where the divergence watch says the LP behaves like an infeasible one");
   return [args] { return run_lp(*args); };
