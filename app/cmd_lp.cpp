@@ -46,13 +46,7 @@ int run_lp(const LpArgs& args) {
   if (!args.mps_path.empty()) write_mps(lp, args.mps_path);
   if (!args.lp_path.empty()) write_lp(lp, args.lp_path);
 
-  // PDHG with its options from the command line; the others as make_solver makes them.
-  std::unique_ptr<LpSolver> solver;
-  if (args.solver == "pdhg-cpu") solver = std::make_unique<PdhgSolver>(PdhgBackendKind::Cpu, args.pdhg);
-  else if (args.solver == "pdhg-cpu-f32") solver = std::make_unique<PdhgSolver>(PdhgBackendKind::CpuF32, args.pdhg);
-  else if (args.solver == "pdhg-vulkan") solver = std::make_unique<PdhgSolver>(PdhgBackendKind::Vulkan, args.pdhg);
-  else solver = make_solver(args.solver);
-  const LpResult r = solver->solve(lp, args.params);
+  const LpResult r = make_solver(args.solver, args.pdhg)->solve(lp, args.params);
   spdlog::info("{}: {} after {} iterations, objective {:.9g} ({:.2f} s)", r.solver, to_string(r.status),
                r.iterations, r.objective, r.seconds);
 

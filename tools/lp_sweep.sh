@@ -21,12 +21,12 @@ printf '\n|---|---|'
 for _ in $omegas; do printf -- '---|'; done
 printf '\n'
 for f in "$dir"/*.smlp; do
-  row="| $(basename "$f" .smlp) |"
+  columns=? cells=
   for w in $omegas; do
     json=$("$bin" lp --from "$f" --initial-primal-weight "$w" "${args[@]}" 2>/dev/null) || true
-    [ -n "$json" ] || { row="$row failed |"; continue; }
-    [ "$row" != "| $(basename "$f" .smlp) |" ] || row="$row $(field variables <<<"$json") |"
-    row="$row $(field iterations <<<"$json") $(field status <<<"$json") ($(printf '%.1f' "$(field seconds <<<"$json")") s) |"
+    [ -n "$json" ] || { cells="$cells failed |"; continue; }
+    columns=$(field variables <<<"$json")
+    cells="$cells $(field iterations <<<"$json") $(field status <<<"$json") ($(printf '%.1f' "$(field seconds <<<"$json")") s) |"
   done
-  echo "$row"
+  echo "| $(basename "$f" .smlp) | $columns |$cells"
 done

@@ -41,6 +41,9 @@ private:
   PdhgOptions options_;
 };
 
+// make_solver (lp.hpp) with these options for the PDHG backends; other solvers ignore them.
+std::unique_ptr<LpSolver> make_solver(const std::string& name, const PdhgOptions& pdhg);
+
 // Memory traffic of one PDHG iteration in the data layout of pdhg_backend.hpp, counting every
 // array element touched once (gathers as 8 bytes, no write-allocate): the primal kernel reads
 // Aᵀ's row_ptr and entries (4 bytes each), gathers yr per nonzero and reads c, d, x, x⁰ and writes
