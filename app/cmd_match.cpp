@@ -50,6 +50,7 @@ struct MatchArgs {
   double coarse_tolerance = CoarseToFineOptions{}.coarse_tolerance;
   double time_limit = std::numeric_limits<double>::infinity();
   double cold_primal_weight = 0.0;
+  double cold_restart_artificial = 0.0;
   int device = -1;
   HierarchyOptions hierarchy;
   int ring = 1, max_ring = 3;
@@ -182,6 +183,7 @@ int run_match(const MatchArgs& args) {
   ro.lp.tolerance = args.tolerance;
   ro.lp.time_limit = args.time_limit;
   ro.lp.cold_primal_weight = args.cold_primal_weight;
+  ro.lp.cold_restart_artificial = args.cold_restart_artificial;
   ro.lp.device = args.device;
   const CoarseToFineMatcher matcher(p.x, p.y, co);
   seconds.set("load", stage.seconds());
@@ -381,6 +383,7 @@ int run_match(const MatchArgs& args) {
                               .set("split_parts", !args.whole_lp)
                               .set("tolerance", args.tolerance)
                               .set("cold_primal_weight", args.cold_primal_weight)
+                              .set("cold_restart_artificial", args.cold_restart_artificial)
                               .set("coarse_tolerance", co.coarse_tolerance)
                               .set("faces", args.pair.faces)
                               .set("keep_scale", args.pair.keep_scale)
@@ -567,6 +570,11 @@ Action add_match_command(CLI::App& app) {
   app.add_option("--cold-primal-weight", a->cold_primal_weight,
                  "PDHG's primal weight ω for LPs solved from a cold start (0: PDHG's own)")
       ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  app.add_option("--cold-restart-artificial", a->cold_restart_artificial,
+                 "PDHG restarts at the latest after this fraction of all iterations, in LPs solved from a cold start "
+                 "(0: PDHG's own, 0.36)")
+      ->check(CLI::Range(0.0, 1.0))
       ->capture_default_str();
   app.add_option("--levels", a->hierarchy.levels, "coarse-to-fine levels including the finest (0: from --coarsest-faces)")
       ->check(CLI::NonNegativeNumber)

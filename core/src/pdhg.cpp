@@ -153,6 +153,9 @@ LpResult PdhgSolver::solve(const LpProblem& problem, const SolverParams& params)
   spdlog::debug("{}: {} x {}, ‖Ã‖ ≈ {:.4g}, step {:.4g}, primal weight {:.4g}, on {}", name(), m, n, norm, eta,
                 omega, result.device);
 
+  const double restart_artificial = params.cold_restart_artificial > 0 && params.initial_x.empty()
+                                        ? params.cold_restart_artificial
+                                        : options_.restart_artificial;
   int64_t total = 0, k = 0;
   double restart_base = -1.0, previous = std::numeric_limits<double>::infinity();
   // Divergence watch (params.stop_on_divergence); the dual at the start of each window gives
@@ -248,7 +251,7 @@ LpResult PdhgSolver::solve(const LpProblem& problem, const SolverParams& params)
       restart_base = fixed_point;
     } else if (fixed_point <= options_.restart_sufficient * restart_base ||
                (fixed_point <= options_.restart_necessary * restart_base && fixed_point > previous) ||
-               k >= options_.restart_artificial * total) {
+               k >= restart_artificial * total) {
       const auto [dx2, dy2] = backend->restart();
       const double dx = std::sqrt(dx2), dy = std::sqrt(dy2);
       if (dx > 1e-10 && dy > 1e-10) {
