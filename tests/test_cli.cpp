@@ -259,6 +259,52 @@ TEST_CASE("cli: match writes each coarser level's map and eval scores it") {
   CHECK(r.err.find("level_1.txt: line") != std::string::npos);
 }
 
+// tools/pdhg_work.sh reads what PDHG logs at debug level: on a written log its sums are checked
+// by hand, on a real `-v match` log it must find the solves (else the log's format moved).
+TEST_CASE("cli: tools/pdhg_work.sh sums PDHG's solves in a -v log") {
+  shapematch::test::TempDir tmp;
+  const fs::path script = fs::path(SHAPEMATCH_ASSETS_DIR).parent_path() / "tools" / "pdhg_work.sh";
+  auto work = [&](const fs::path& log) {
+    const std::string cmd = "bash " + script.string() + " " + log.string() + " 2>&1";
+    std::string out;
+    FILE* p = popen(cmd.c_str(), "r");
+    REQUIRE(p != nullptr);
+    std::array<char, 4096> buf{};
+    for (size_t k; (k = fread(buf.data(), 1, buf.size(), p)) > 0;) out.append(buf.data(), k);
+    CHECK(pclose(p) == 0);
+    // The last line is the log's row: | log | solves | iterations | column-iterations | seconds |
+    std::string row = out.substr(out.rfind("| " + log.string()));
+    std::vector<std::string> cells;
+    for (size_t at = row.find('|'), next; (next = row.find('|', at + 1)) != std::string::npos; at = next)
+      cells.push_back(row.substr(at + 1, next - at - 1));
+    REQUIRE(cells.size() == 5);
+    return std::array<double, 4>{std::atof(cells[1].c_str()), std::atof(cells[2].c_str()),
+                                 std::atof(cells[3].c_str()), std::atof(cells[4].c_str())};
+  };
+  const fs::path written = tmp.path / "written.log";
+  std::ofstream(written) << "[00:00:01.000] info level 1/2: 100 × 100 faces\n"
+                            "[00:00:01.100] debug pdhg-cpu: 40000 x 1000000, ‖Ã‖ ≈ 0.9, step 1.1, primal weight 1, on cpu\n"
+                            "[00:00:09.000] debug pdhg-cpu: optimal after 2000 iterations and 5 restarts (7.500 s)\n"
+                            "[00:00:09.100] info level 1 round  1: 1000000 variables, LP optimal in 2000 it\n"
+                            "[00:00:09.200] debug pdhg-vulkan: 90000 x 3000000, ‖Ã‖ ≈ 0.9, step 1.1, primal weight 1, on gpu\n"
+                            "[00:00:12.000] debug pdhg-vulkan: infeasible after 500 iterations and 1 restarts (2.500 s)\n";
+  const auto w = work(written);
+  CHECK(w[0] == 2);
+  CHECK(w[1] == 2500);
+  CHECK(w[2] == doctest::Approx(3.5));  // 1e6 × 2000 + 3e6 × 500, in 10⁹
+  CHECK(w[3] == 10);
+
+  const fs::path out = tmp.path / "m";
+  const Run r = run("-v match --faces 30 --backend cpu --threads 1 -o " + out.string());
+  REQUIRE_MESSAGE(r.code == 0, r.err);
+  const fs::path real = tmp.path / "match.log";
+  std::ofstream(real) << r.err;
+  const auto v = work(real);
+  CHECK(v[0] >= 1);
+  CHECK(v[1] >= 64 * v[0]);  // PDHG checks every 64 iterations
+  CHECK(v[2] > 0);
+}
+
 // The README's main command, checked for what its picture should show: the bundled dolphins
 // (identity ground truth) matched head to head and fin to fin. Measured: mean geodesic error
 // 0.089 at 100 faces, no inverted face; a twisted or end-swapped match scores above 0.25.
