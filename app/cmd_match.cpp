@@ -45,6 +45,7 @@ struct MatchArgs {
   int greedy_margin = RoundingOptions{}.greedy_margin;
   int64_t search_below = RoundingOptions{}.search_below;
   bool converged_first = RoundingOptions{}.converged_first;
+  double exact_pivots_per_column = RoundingOptions{}.exact_pivots_per_column;
   int release_after_trims = RoundingOptions{}.release_after_trims;
   double tolerance = 1e-4;
   double coarse_tolerance = CoarseToFineOptions{}.coarse_tolerance;
@@ -179,6 +180,7 @@ int run_match(const MatchArgs& args) {
   ro.search_below = args.search_below;
   ro.stuck_stalled = args.stuck_stalled;
   ro.converged_first = args.converged_first;
+  ro.exact_pivots_per_column = args.exact_pivots_per_column;
   ro.release_after_trims = args.release_after_trims;
   ro.lp.tolerance = args.tolerance;
   ro.lp.time_limit = args.time_limit;
@@ -379,6 +381,7 @@ int run_match(const MatchArgs& args) {
                               .set("greedy_margin", args.greedy_margin)
                               .set("search_below", args.search_below)
                               .set("converged_first", args.converged_first)
+                              .set("exact_pivots_per_column", args.exact_pivots_per_column)
                               .set("release_after_trims", args.release_after_trims)
                               .set("split_parts", !args.whole_lp)
                               .set("tolerance", args.tolerance)
@@ -535,6 +538,11 @@ Action add_match_command(CLI::App& app) {
   app.add_flag("--converged-first", a->converged_first,
                "in a later round whose LP stopped at its iteration cap in some parts, fix only from the parts that "
                "converged; the others go on from their iterate one round more");
+  app.add_option("--exact-pivots-per-column", a->exact_pivots_per_column,
+                 "stop Clp after this many pivots per column of a later round's part (at least 1 000 columns' worth) "
+                 "and give the part to PDHG (0: no cap)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
   app.add_option("--release-after-trims", a->release_after_trims,
                  "where a part's LP has failed after this many trims of the last fixing in a row, release the "
                  "fixings around the part instead of trimming again (0: never)")

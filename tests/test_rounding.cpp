@@ -1054,6 +1054,35 @@ TEST_CASE("rounding: a part one solver gives up on goes to the other") {
   CHECK(quitter.calls == 4);
 }
 
+TEST_CASE("rounding: a part that reaches the exact solver's pivot cap goes to the first-order one") {
+  const MatchingLp& m = dolphins_60();
+  const LpResult exact = solve_lp(m.lp, "clp-dual");
+  REQUIRE(exact.status == LpStatus::Optimal);
+  REQUIRE(exact.iterations > 2);  // else a cap of one pivot would not bite
+  SolverParams params;
+  params.tolerance = 1e-6;
+  const auto pdhg = make_solver("pdhg-cpu");
+  const auto clp = make_solver("clp-dual");
+  const int64_t n = m.lp.cols();
+  // No cap: Clp solves the whole LP.
+  const detail::JoinedSolve a = detail::solve_in_parts(m.lp, params, *pdhg, clp.get(), n + 1, params, false);
+  CHECK(a.exact_parts == 1);
+  CHECK(a.r.objective == doctest::Approx(exact.objective).epsilon(1e-9));
+  // A cap Clp's solve stays under: still Clp's vertex.
+  const double roomy = 2.0 * double(exact.iterations) / double(std::max<int64_t>(n, 1000));
+  const detail::JoinedSolve b = detail::solve_in_parts(m.lp, params, *pdhg, clp.get(), n + 1, params, false, roomy);
+  CHECK(b.exact_parts == 1);
+  CHECK(b.r.status == LpStatus::Optimal);
+  CHECK(b.r.objective == doctest::Approx(exact.objective).epsilon(1e-9));
+  // One pivot: Clp stops at its cap and PDHG solves the part to its tolerance instead.
+  const double one = 1.0 / double(std::max<int64_t>(n, 1000));
+  const detail::JoinedSolve c = detail::solve_in_parts(m.lp, params, *pdhg, clp.get(), n + 1, params, false, one);
+  CHECK(c.exact_parts == 0);
+  CHECK(c.r.status == LpStatus::Optimal);
+  CHECK(c.r.objective == doctest::Approx(exact.objective).epsilon(1e-4));
+  CHECK(c.r.objective != exact.objective);  // not Clp's vertex
+}
+
 TEST_CASE("rounding: trims in a row count only while the same part fails after each") {
   // The count behind release_after_trims: a failure continues the streak where it shares a row
   // with the failure just before it and that one trimmed the last fixing.

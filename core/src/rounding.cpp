@@ -284,7 +284,8 @@ bool looks_infeasible(const LpResult& r) {
 }  // namespace
 
 JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpSolver& solver, LpSolver* exact,
-                                   int64_t exact_below, const SolverParams& exact_params, bool split) {
+                                   int64_t exact_below, const SolverParams& exact_params, bool split,
+                                   double exact_pivots_per_column) {
   JoinedSolve out;
   std::vector<Part> parts;
   if (split) parts = split_into_parts(lp);
@@ -327,13 +328,22 @@ JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpS
       return own;
     };
     exactly += use_exact;
-    LpResult s = use_exact ? exact->solve(plp, exact_params) : solver.solve(plp, first_order());
+    // The exact solver's parameters: with a pivot cap where asked (its iterations are pivots).
+    SolverParams capped_exact;
+    const bool pivot_cap = use_exact && exact_pivots_per_column > 0.0;
+    if (pivot_cap) {
+      capped_exact = exact_params;
+      const double cap = exact_pivots_per_column * double(std::max<int64_t>(plp.cols(), 1000));
+      capped_exact.max_iterations = std::min<int64_t>(exact_params.max_iterations, std::max<int64_t>(int64_t(cap), 1));
+    }
+    LpResult s = use_exact ? exact->solve(plp, pivot_cap ? capped_exact : exact_params) : solver.solve(plp, first_order());
     // One solver's numerical trouble on a part is the other's to try: measured, Clp gave up on a
     // part of FAUST_r 043-063's finest rounding (round 19 of a 24-minute run), which ended it.
     // (The exact solver only where a part is not far above its size: Clp on millions of columns
     // takes hours.)
-    const bool failed =
-        s.status == LpStatus::NumericalTrouble || (s.status != LpStatus::Infeasible && s.x.size() != size_t(plp.cols()));
+    const bool failed = s.status == LpStatus::NumericalTrouble ||
+                        (s.status != LpStatus::Infeasible && s.x.size() != size_t(plp.cols())) ||
+                        (pivot_cap && s.status == LpStatus::IterationLimit);
     if (failed && (use_exact || (exact && plp.cols() <= 10 * std::max<int64_t>(exact_below, 1)))) {
       spdlog::warn("rounding: {} failed on a part of {} variables ({}); trying {}", use_exact ? exact->name() : solver.name(),
                    plp.cols(), to_string(s.status), use_exact ? solver.name() : exact->name());
@@ -1217,7 +1227,8 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
       if (joined.r.status == LpStatus::Infeasible) joined.proof = joined.r.y;
     } else {
       joined = detail::solve_in_parts(red.lp, std::move(params), *solver, exact ? exact_solver.get() : nullptr,
-                              options.exact_below, exact_params, options.split_parts);
+                              options.exact_below, exact_params, options.split_parts,
+                              options.exact_pivots_per_column);
     }
     const LpResult& r = joined.r;
     // Round 1's iterate over the whole LP, for first_iterate and (an optimum) for the alternatives.

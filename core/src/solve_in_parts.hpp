@@ -14,7 +14,9 @@ namespace shapematch::detail {
 // is) that behave like it at their cap (`suspect`: certified bound far above the objective),
 // zero elsewhere, so that the blame stays with them. A part that one solver gives up on
 // (numerical trouble) goes to the other (`exact` up to 10 × exact_below columns); where both
-// fail, so does the join.
+// fail, so does the join. With `exact_pivots_per_column` > 0 the exact solver stops after that
+// many pivots per column of the part (at least 1 000 columns' worth), and the part goes to
+// `solver` as where it gives up.
 struct JoinedSolve {
   LpResult r;
   std::vector<double> proof;
@@ -27,7 +29,8 @@ struct JoinedSolve {
   std::vector<char> capped_cols;
 };
 JoinedSolve solve_in_parts(const LpProblem& lp, SolverParams params, LpSolver& solver, LpSolver* exact,
-                           int64_t exact_below, const SolverParams& exact_params, bool split);
+                           int64_t exact_below, const SolverParams& exact_params, bool split,
+                           double exact_pivots_per_column = 0.0);
 
 }  // namespace shapematch::detail
 

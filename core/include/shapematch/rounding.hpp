@@ -17,6 +17,13 @@ struct RoundingOptions {
   // and a vertex, so most of it is already 0/1 (0: never). The first-order solver's approximate
   // solutions made the last few thousand variables of FAUST at 4000 faces thrash for 50 rounds.
   int64_t exact_below = 30000;
+  // Caps the exact solver's pivots on a part at this many per column (at least 1 000 columns'
+  // worth); a part that reaches the cap goes to the first-order solver, as where Clp gives up
+  // (0: no cap). Clp's dual simplex took 147 000 pivots (7.5 minutes) to prove a part of fewer
+  // than 30 000 columns infeasible in FAUST_r 021-024's finest rounding, and 55 000 (10.5 minutes)
+  // in deformation-transfer cat 0002-0009's; the optimal parts of those runs took at most 0.2
+  // pivots per column of their round, the infeasible ones 0.7. Not measured over whole runs: off.
+  double exact_pivots_per_column = 0.0;
   // Where no variable exceeds the threshold (a fractional LP), DESIGN.md fixes the single
   // largest. On fractional levels that cost one full LP solve per face (TOSCA cat, 200 faces:
   // 9 rounds of 20–150 s fixed 36 variables to 1). Instead fix the largest variables of up to
