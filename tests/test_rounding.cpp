@@ -1083,6 +1083,57 @@ TEST_CASE("rounding: a part that reaches the exact solver's pivot cap goes to th
   CHECK(c.r.objective != exact.objective);  // not Clp's vertex
 }
 
+namespace {
+// Clp, counting its solves.
+class CountingClp final : public LpSolver {
+public:
+  std::string name() const override { return "counting-clp"; }
+  LpResult solve(const LpProblem& lp, const SolverParams& params) override {
+    ++calls;
+    return clp->solve(lp, params);
+  }
+  std::unique_ptr<LpSolver> clp = make_solver("clp-dual");
+  int calls = 0;
+};
+}  // namespace
+
+TEST_CASE("rounding: a part unchanged since the last round takes its exact result again") {
+  const MatchingLp& m = dolphins_60();
+  SolverParams params;
+  params.tolerance = 1e-6;
+  const auto pdhg = make_solver("pdhg-cpu");
+  CountingClp clp;
+  detail::ExactCache cache;
+  const int64_t n = m.lp.cols();
+  const detail::JoinedSolve a = detail::solve_in_parts(m.lp, params, *pdhg, &clp, n + 1, params, false, 0.0, &cache);
+  REQUIRE(a.r.status == LpStatus::Optimal);
+  CHECK(clp.calls == 1);
+  // The same LP: no solve, the same result to the last bit.
+  const detail::JoinedSolve b = detail::solve_in_parts(m.lp, params, *pdhg, &clp, n + 1, params, false, 0.0, &cache);
+  CHECK(clp.calls == 1);
+  CHECK(cache.reused == 1);
+  CHECK(b.r.objective == a.r.objective);
+  CHECK(b.r.x == a.r.x);
+  CHECK(b.r.y == a.r.y);
+  CHECK(b.exact_parts == 1);
+  // One cost changed: solved again.
+  LpProblem other = m.lp;
+  other.c[0] += 1.0;
+  const detail::JoinedSolve c = detail::solve_in_parts(other, params, *pdhg, &clp, n + 1, params, false, 0.0, &cache);
+  CHECK(clp.calls == 2);
+  CHECK(cache.reused == 1);
+  // The cache holds the last call's parts only: the first LP, two calls back, is solved again.
+  const detail::JoinedSolve d = detail::solve_in_parts(m.lp, params, *pdhg, &clp, n + 1, params, false, 0.0, &cache);
+  CHECK(clp.calls == 3);
+  CHECK(d.r.objective == a.r.objective);
+  // Another pivot cap (one Clp's solve stays under) is another solve.
+  const double roomy = 2.0 * double(a.r.iterations) / double(std::max<int64_t>(n, 1000));
+  REQUIRE(roomy * double(std::max<int64_t>(n, 1000)) < double(params.max_iterations));
+  const detail::JoinedSolve e = detail::solve_in_parts(m.lp, params, *pdhg, &clp, n + 1, params, false, roomy, &cache);
+  CHECK(clp.calls == 4);
+  CHECK(e.r.objective == a.r.objective);
+}
+
 TEST_CASE("rounding: trims in a row count only while the same part fails after each") {
   // The count behind release_after_trims: a failure continues the streak where it shares a row
   // with the failure just before it and that one trimmed the last fixing.

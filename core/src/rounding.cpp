@@ -275,6 +275,12 @@ std::vector<Part> split_into_parts(const LpProblem& lp) {
   return parts;
 }
 
+// The same LP, entry for entry (the exact solver's result on one is its result on the other).
+bool same_lp(const LpProblem& p, const LpProblem& q) {
+  return p.a.rows == q.a.rows && p.a.cols == q.a.cols && p.objective_scale == q.objective_scale && p.b == q.b &&
+         p.c == q.c && p.a.row_ptr == q.a.row_ptr && p.a.entry == q.a.entry;
+}
+
 bool looks_infeasible(const LpResult& r) {
   // Far above: those LPs' bounds were 3-60x their objectives; at 5 % above, feasible LPs that had
   // not converged by the cap (bound 5.34, objective 5.01) were undone round after round.
@@ -285,7 +291,7 @@ bool looks_infeasible(const LpResult& r) {
 
 JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpSolver& solver, LpSolver* exact,
                                    int64_t exact_below, const SolverParams& exact_params, bool split,
-                                   double exact_pivots_per_column) {
+                                   double exact_pivots_per_column, ExactCache* cache) {
   JoinedSolve out;
   std::vector<Part> parts;
   if (split) parts = split_into_parts(lp);
@@ -301,7 +307,8 @@ JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpS
   out.proof.assign(lp.rows(), 0.0);
   std::vector<double> suspect_proof(lp.rows(), 0.0);
   bool infeasible = false;
-  int64_t exactly = 0, largest = 0;
+  int64_t exactly = 0, largest = 0, reused = 0;
+  std::vector<ExactCache::Entry> kept;  // this call's exact results, for the next (cache)
   // A part's parameters: `params` with its own slice of the whole LP's warm start, which is
   // moved out first so that copying `params` per part does not copy it.
   std::vector<double> warm_x, warm_y;
@@ -336,7 +343,16 @@ JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpS
       const double cap = exact_pivots_per_column * double(std::max<int64_t>(plp.cols(), 1000));
       capped_exact.max_iterations = std::min<int64_t>(exact_params.max_iterations, std::max<int64_t>(int64_t(cap), 1));
     }
-    LpResult s = use_exact ? exact->solve(plp, pivot_cap ? capped_exact : exact_params) : solver.solve(plp, first_order());
+    const SolverParams& exact_own = pivot_cap ? capped_exact : exact_params;
+    const ExactCache::Entry* same = nullptr;
+    if (use_exact && cache)
+      for (const ExactCache::Entry& e : cache->last)
+        if (e.max_iterations == exact_own.max_iterations && same_lp(e.lp, plp)) {
+          same = &e;
+          break;
+        }
+    LpResult s = same ? same->r : use_exact ? exact->solve(plp, exact_own) : solver.solve(plp, first_order());
+    reused += same != nullptr;
     // One solver's numerical trouble on a part is the other's to try: measured, Clp gave up on a
     // part of FAUST_r 043-063's finest rounding (round 19 of a 24-minute run), which ended it.
     // (The exact solver only where a part is not far above its size: Clp on millions of columns
@@ -351,6 +367,8 @@ JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpS
       s = use_exact ? solver.solve(plp, first_order()) : exact->solve(plp, exact_params);
       s.iterations = std::max(s.iterations, before);
       exactly += use_exact ? -1 : 1;
+    } else if (use_exact && cache) {
+      kept.push_back({plp, exact_own.max_iterations, s});
     }
     r.iterations = std::max(r.iterations, s.iterations);
     if (s.status == LpStatus::NumericalTrouble) {
@@ -386,6 +404,11 @@ JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpS
     r.lower_bound += s.lower_bound;
   }
   out.exact_parts = exactly;
+  if (cache) {
+    cache->last = std::move(kept);
+    cache->reused += reused;
+    if (reused > 0) spdlog::debug("rounding: {} unchanged part(s) took their exact result of the last round", reused);
+  }
   if (parts.size() > 1)
     spdlog::debug("LP in {} independent parts, largest {} variables, {} solved exactly", parts.size(), largest,
                   exactly);
@@ -883,6 +906,7 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
                           FirstOptimum* keep) {
   auto solver = make_solver(options.solver);
   std::unique_ptr<LpSolver> exact_solver;  // for the small last rounds (exact_below)
+  detail::ExactCache exact_cache;           // its results on the last round's parts
   RoundingResult result;
   Fixer fixer(lp);
   if (!fixer.propagate_all())
@@ -1228,7 +1252,7 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
     } else {
       joined = detail::solve_in_parts(red.lp, std::move(params), *solver, exact ? exact_solver.get() : nullptr,
                               options.exact_below, exact_params, options.split_parts,
-                              options.exact_pivots_per_column);
+                              options.exact_pivots_per_column, &exact_cache);
     }
     const LpResult& r = joined.r;
     // Round 1's iterate over the whole LP, for first_iterate and (an optimum) for the alternatives.

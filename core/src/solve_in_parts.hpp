@@ -28,9 +28,24 @@ struct JoinedSolve {
   // 1 for the columns of parts that stopped at their iteration (or time) limit; empty where none did.
   std::vector<char> capped_cols;
 };
+// The exact solver's results on the parts of the last call, for the next one: a part whose LP has
+// not changed since (no fixing reached it) gets its result again instead of a new solve. The
+// solver is deterministic, so the result is the same, not an approximation of it. Measured:
+// FAUST_r 021-024's finest rounding solved one unchanged part of fewer than 30 000 columns with
+// Clp four times, 146 697 pivots and 5-7.5 minutes each.
+struct ExactCache {
+  struct Entry {
+    LpProblem lp;
+    int64_t max_iterations = 0;
+    LpResult r;
+  };
+  std::vector<Entry> last;  // the parts of the last call
+  int64_t reused = 0;       // over all calls
+};
+
 JoinedSolve solve_in_parts(const LpProblem& lp, SolverParams params, LpSolver& solver, LpSolver* exact,
                            int64_t exact_below, const SolverParams& exact_params, bool split,
-                           double exact_pivots_per_column = 0.0);
+                           double exact_pivots_per_column = 0.0, ExactCache* cache = nullptr);
 
 }  // namespace shapematch::detail
 
