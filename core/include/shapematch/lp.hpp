@@ -62,9 +62,10 @@ struct SolverParams {
   // solver's own). Warm starts keep theirs: started at a high ω, a re-solve from an optimum
   // hit its iteration cap (FAUST_r 020-024 at 2 000 faces, ω 30).
   double cold_primal_weight = 0.0;
-  // PDHG's artificial restart fraction for a cold start (0: the solver's own). Restarting sooner
-  // helped first LPs (six dumped from horse0-horse5 and FAUST_r at 2 000 faces: -21 % iterations
-  // at 0.2 against 0.36) but not the warm re-solves of the later rounds.
+  // PDHG's artificial restart fraction for a cold start (0: the solver's own); warm starts keep
+  // theirs. At 0.2 against 0.36: six first LPs dumped from horse0-horse5, -21 % iterations; three
+  // FAUST_r pairs at 2 000 faces, -10 to -26 % of PDHG's work; FAUST_r 021-024 at full resolution
+  // took another path to a harder finest LP and more work. Hence not the default.
   double cold_restart_artificial = 0.0;
 };
 
