@@ -308,7 +308,7 @@ JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpS
   std::vector<double> suspect_proof(lp.rows(), 0.0);
   bool infeasible = false;
   int64_t exactly = 0, largest = 0, reused = 0;
-  std::vector<ExactCache::Entry> kept;  // this call's exact results, for the next (cache)
+  std::vector<ExactCache::Entry> kept;  // this call's new exact results, for the next calls (cache)
   // A part's parameters: `params` with its own slice of the whole LP's warm start, which is
   // moved out first so that copying `params` per part does not copy it.
   std::vector<double> warm_x, warm_y;
@@ -344,15 +344,18 @@ JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpS
       capped_exact.max_iterations = std::min<int64_t>(exact_params.max_iterations, std::max<int64_t>(int64_t(cap), 1));
     }
     const SolverParams& exact_own = pivot_cap ? capped_exact : exact_params;
-    const ExactCache::Entry* same = nullptr;
+    ExactCache::Entry* same = nullptr;
     if (use_exact && cache)
-      for (const ExactCache::Entry& e : cache->last)
+      for (ExactCache::Entry& e : cache->entries)
         if (e.max_iterations == exact_own.max_iterations && same_lp(e.lp, plp)) {
           same = &e;
           break;
         }
     LpResult s = same ? same->r : use_exact ? exact->solve(plp, exact_own) : solver.solve(plp, first_order());
-    reused += same != nullptr;
+    if (same) {
+      same->unused = -1;  // seen in this call (0 after the call's ageing below)
+      ++reused;
+    }
     // One solver's numerical trouble on a part is the other's to try: measured, Clp gave up on a
     // part of FAUST_r 043-063's finest rounding (round 19 of a 24-minute run), which ended it.
     // (The exact solver only where a part is not far above its size: Clp on millions of columns
@@ -367,8 +370,8 @@ JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpS
       s = use_exact ? solver.solve(plp, first_order()) : exact->solve(plp, exact_params);
       s.iterations = std::max(s.iterations, before);
       exactly += use_exact ? -1 : 1;
-    } else if (use_exact && cache) {
-      kept.push_back({plp, exact_own.max_iterations, s});
+    } else if (use_exact && cache && !same) {
+      kept.push_back({plp, exact_own.max_iterations, s, -1});
     }
     r.iterations = std::max(r.iterations, s.iterations);
     if (s.status == LpStatus::NumericalTrouble) {
@@ -405,7 +408,8 @@ JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpS
   }
   out.exact_parts = exactly;
   if (cache) {
-    cache->last = std::move(kept);
+    for (ExactCache::Entry& e : kept) cache->entries.push_back(std::move(e));
+    std::erase_if(cache->entries, [](ExactCache::Entry& e) { return ++e.unused >= ExactCache::kKeepCalls; });
     cache->reused += reused;
     if (reused > 0) spdlog::debug("rounding: {} unchanged part(s) took their exact result of the last round", reused);
   }

@@ -32,15 +32,18 @@ struct JoinedSolve {
 // not changed since (no fixing reached it) gets its result again instead of a new solve. The
 // solver is deterministic, so the result is the same, not an approximation of it. Measured:
 // FAUST_r 021-024's finest rounding solved one unchanged part of fewer than 30 000 columns with
-// Clp four times, 146 697 pivots and 5-7.5 minutes each.
+// Clp six times, 146 697 pivots and 5-7.5 minutes each, once with a round between that lacked it.
+// So a result is kept until kKeepCalls calls in a row have not had its part.
 struct ExactCache {
+  static constexpr int kKeepCalls = 4;
   struct Entry {
     LpProblem lp;
     int64_t max_iterations = 0;
     LpResult r;
+    int unused = 0;  // calls since its part was last seen
   };
-  std::vector<Entry> last;  // the parts of the last call
-  int64_t reused = 0;       // over all calls
+  std::vector<Entry> entries;
+  int64_t reused = 0;  // over all calls
 };
 
 JoinedSolve solve_in_parts(const LpProblem& lp, SolverParams params, LpSolver& solver, LpSolver* exact,
