@@ -265,13 +265,9 @@ TEST_CASE("cli: tools/pdhg_work.sh sums PDHG's solves in a -v log") {
   shapematch::test::TempDir tmp;
   const fs::path script = fs::path(SHAPEMATCH_ASSETS_DIR).parent_path() / "tools" / "pdhg_work.sh";
   auto work = [&](const fs::path& log) {
-    const std::string cmd = "bash " + script.string() + " " + log.string() + " 2>&1";
-    std::string out;
-    FILE* p = popen(cmd.c_str(), "r");
-    REQUIRE(p != nullptr);
-    std::array<char, 4096> buf{};
-    for (size_t k; (k = fread(buf.data(), 1, buf.size(), p)) > 0;) out.append(buf.data(), k);
-    CHECK(pclose(p) == 0);
+    const Run script_run = shapematch::test::run_command("bash " + script.string() + " " + log.string());
+    CHECK(script_run.code == 0);
+    const std::string& out = script_run.out;
     // The last line is the log's row: | log | solves | iterations | column-iterations | seconds |
     std::string row = out.substr(out.rfind("| " + log.string()));
     std::vector<std::string> cells;

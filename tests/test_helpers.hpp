@@ -106,13 +106,13 @@ struct CliRun {
   std::string err;  // stderr
 };
 
-// Runs the built `shapematch` with `args`; stderr goes through a file in `dir` (a fresh
-// temporary directory when empty, so that tests running in parallel never share it).
-inline CliRun run_cli(const std::string& args, const std::filesystem::path& dir = {}) {
+// Runs a shell command; stderr goes through a file in `dir` (a fresh temporary directory when
+// empty, so that tests running in parallel never share it).
+inline CliRun run_command(const std::string& command, const std::filesystem::path& dir = {}) {
   std::optional<TempDir> own;
   if (dir.empty()) own.emplace();
   const std::filesystem::path err = (dir.empty() ? own->path : dir) / "stderr.txt";
-  const std::string cmd = std::string(SHAPEMATCH_CLI) + " " + args + " 2>" + err.string();
+  const std::string cmd = command + " 2>" + err.string();
   CliRun r;
   FILE* p = popen(cmd.c_str(), "r");
   REQUIRE(p != nullptr);
@@ -124,6 +124,11 @@ inline CliRun run_cli(const std::string& args, const std::filesystem::path& dir 
   std::ifstream f(err);
   r.err.assign(std::istreambuf_iterator<char>(f), {});
   return r;
+}
+
+// Runs the built `shapematch` with `args` (run_command).
+inline CliRun run_cli(const std::string& args, const std::filesystem::path& dir = {}) {
+  return run_command(std::string(SHAPEMATCH_CLI) + " " + args, dir);
 }
 
 // The number after "key": in a JSON text (the CLI's flat outputs).
