@@ -19,11 +19,11 @@ struct PairArgs {
   // The feature term (DESIGN.md §5): user descriptors, or the Wave Kernel Signature.
   std::string features_x, features_y;
   std::string wks = "auto";  // on, off, auto (on unless user features are given)
-  // On by default since measured (docs/results.md, "The feature term with the whole chain"):
+  // On by default since measured (docs/results-log.md, "The feature term with the whole chain"):
   // FAUST_r at 1000 faces 0.098 → 0.051 mean error over 8 pairs, TOSCA_r at 500 no worse.
   double feature_weight = 1.0;
   double degenerate_penalty = 0.0;
-  // 0.05 since measured at full resolution (docs/results.md, thirty-fourth session): FAUST_r
+  // 0.05 since measured at full resolution (docs/results-log.md, thirty-fourth session): FAUST_r
   // 021-029's error 0.0319 -> 0.0170 (the one above issue 6's 0.03), 020-024 0.0169 -> 0.0177,
   // TOSCA_r dog0-dog3 0.0276 -> 0.0287. The library keeps the paper's per-vertex H (EnergyOptions).
   double curvature_radius = 0.05;

@@ -535,7 +535,7 @@ TEST_CASE("pdhg-cpu: feasible LPs never stop as diverging") {
 
 TEST_CASE("pdhg: the divergence watch on the windows of measured full-resolution LPs") {
   // (primal residual, gap, objective, bound) at the end of each 512-iteration window, tolerance
-  // 3e-3, from the logs of the FAUST_r and TOSCA_r runs in docs/results.md.
+  // 3e-3, from the logs of the FAUST_r and TOSCA_r runs in docs/results-log.md.
   struct Window {
     double primal, gap, objective, bound;
   };

@@ -69,7 +69,7 @@ struct CoarseToFineOptions {
   // error 0.0377; with ring 2 at the 200- to 3 760-face levels, energy 13.12, error 0.0194, in
   // 18 minutes against 9 (ring 2 only up to 1 414 faces: level 4 as good, 5.36 against 6.18, but
   // the finest level's LP at 15.3 and its rounding thrashing; stopped after 21 minutes).
-  // docs/results.md, twenty-second session.
+  // docs/results-log.md, twenty-second session.
   int coarse_ring = 2;
   int coarse_ring_faces = 4000;
   // First widen only near the proof of infeasibility (the places where propagation finds a
@@ -92,7 +92,7 @@ struct CoarseToFineOptions {
   // 1 + recurring_margin·k fine rings of the proof (and those that map next to its Y side)
   // at once to max_ring + 3, instead of one ring at a time. 0: off. Measured, FAUST_r 065-069 at
   // full resolution: 27 of level 6's 52 propagation widenings were Y face 6 939's π row (639
-  // variables every time), in 4-step series per place (docs/results.md, twenty-fifth session).
+  // variables every time), in 4-step series per place (docs/results-log.md, twenty-fifth session).
   int recurring_margin = 2;
   // Let the divergence watch stop the re-solve after pricing too (as before the twenty-sixth
   // session). Off: that re-solve starts at the optimum of a space it contains, and stops at the
@@ -102,7 +102,7 @@ struct CoarseToFineOptions {
   // stopped (a suspicion, no proof), the level's next first LPs run unwatched, to an optimum or a
   // proof. 0: no limit. Measured, TOSCA_r horse0-5 and centaur0-2 at R = 0.05 on an H200: 24
   // suspicions in a row each at their 1 414-face level (6.2 % → 21.6 % of the full space), and
-  // one such first LP, let run, was feasible (docs/results.md, thirty-fifth session).
+  // one such first LP, let run, was feasible (docs/results-log.md, thirty-fifth session).
   int max_suspected_widenings = 3;
   // Start the first LP of a widened space from the previous attempt's iterate (its dual reset
   // where it diverged), by variable and row identity. Off: measured at full resolution (FAUST_r
@@ -206,7 +206,7 @@ struct CoarseToFineOptions {
   // Beside a refined Γ, the second start's rounding gives up once its rounds after the first have
   // done this many times its first LP's work (RoundingOptions::give_up_after), and the
   // alternative thresholds still try (RoundingOptions::alternatives_after_failure). Measured at
-  // 500 faces on 13 pairs (docs/results.md, twenty-sixth session): it gave up in two. FAUST_r
+  // 500 faces on 13 pairs (docs/results-log.md, twenty-sixth session): it gave up in two. FAUST_r
   // 020-024: the same Γ in 93 s instead of 176. The galloping horse: the refined Γ went on,
   // energy 5.675 and error 0.108 against 6.399 and 0.500 (its second start's Γ was lower at 200
   // faces and ended higher). In the others, and at full resolution, the later rounds did at most

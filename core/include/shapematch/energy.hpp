@@ -15,7 +15,7 @@ struct EnergyOptions {
   MembraneModel membrane = MembraneModel::Compressive;  // measured: docs/architecture.md
   double lame_lambda = 1.0;   // Lamé λ of the membrane (St. Venant–Kirchhoff)
   double lame_mu = 1.0;       // Lamé μ
-  // Measured (docs/results.md): at 1 the bending term pushes Γ towards folds at finer levels
+  // Measured (docs/results-log.md): at 1 the bending term pushes Γ towards folds at finer levels
   // (FAUST 020–024, 316 faces: error 0.27 against 0.086) and the bundled pair rounds worse.
   double bending_weight = 0.1;
   double feature_weight = 0.0;

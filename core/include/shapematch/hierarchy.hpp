@@ -10,7 +10,7 @@ namespace shapematch {
 
 struct HierarchyOptions {
   int levels = 0;            // including the input itself; 0 = as many as `ratio` needs
-  // Faces of the coarsest level (about). Measured (docs/results.md): at 100 the thin-shell
+  // Faces of the coarsest level (about). Measured (docs/results-log.md): at 100 the thin-shell
   // energy misses the global structure of some humans and animals, at 200 of others; the
   // defaults solve both and keep the better (CoarseToFineOptions::second_start).
   int coarsest_faces = 100;

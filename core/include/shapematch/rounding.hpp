@@ -49,7 +49,7 @@ struct RoundingOptions {
   // the others go on from their iterate next round, and are fixed from an unconverged iterate
   // only after one round more with nothing else left. Off: measured on FAUST_r 020-024 at full
   // resolution it cost a round (47 s) and 0.24 % energy (24.626 against 24.568), and FAUST_r
-  // 020-021 did not complete with it either (docs/results.md, eleventh session).
+  // 020-021 did not complete with it either (docs/results-log.md, eleventh session).
   // (Always on, with or without this option: a part that fails where no fixing of the last round
   // touches it goes on from its iterate with twice the cap where it only looks infeasible at its
   // cap, and releases the fixings of every round around it where it is proved infeasible or
@@ -68,7 +68,7 @@ struct RoundingOptions {
   // greedy_margin − 1 closedness steps of one (0: fix every candidate). Where under a quarter of
   // the batch qualifies, only values in (0.3, 0.7) count; where none does then, the whole batch.
   // Measured at full resolution: without it the LPs after greedy rounds were infeasible round
-  // after round; with it, none of rounds 2-5 (docs/results.md, seventh session).
+  // after round; with it, none of rounds 2-5 (docs/results-log.md, seventh session).
   double greedy_unsure = 0.1;
   int greedy_margin = 1;
   // Rounds after the first solve each connected component of their LP (rows joined through a
@@ -85,7 +85,7 @@ struct RoundingOptions {
   // horse0-5 at full resolution: 150 rounds fixed and undid the same few variables of a
   // 1 082-variable remainder in 2 parts, each solved exactly with a fractional vertex, until
   // max_rounds; with the search, a 2 272-variable remainder (10 parts) was finished in 16 nodes
-  // and one release of 447 fixings, and the pair verified (docs/results.md). 0: never.
+  // and one release of 447 fixings, and the pair verified (docs/results-log.md). 0: never.
   int64_t search_below = 20000;
   int search_stall = 3;
   int64_t search_nodes = 2000;
@@ -98,7 +98,7 @@ struct RoundingOptions {
   // times before the run's 8.5-minute limit; with 1 (2 cores), the releases took the rounding on without a stuck widening for 31
   // rounds, but the rounds after a release fixed 15-40 variables each from capped LPs, and the
   // stall rule gave up into a widening of 4 730 faces, after which the level finished (verified,
-  // the pair's first completed run; docs/results.md, thirtieth session).
+  // the pair's first completed run; docs/results-log.md, thirtieth session).
   int release_after_trims = 0;
   int max_backtracks = 200;    // fixings undone after an infeasible LP (each one more, smaller LP
                                // solve), then fail with InfeasibleError naming the open rows
@@ -125,7 +125,7 @@ struct RoundingOptions {
   // made so far, so that the caller can widen the space there and solve again, afresh or from
   // them (coarse to fine does). Measured, FAUST_r 020-021 at full resolution: trimming the last
   // fixing, and releasing the fixings around the failed part, both ran for 15+ minutes
-  // (docs/results.md). Running out of rounds (max_rounds) then ends in a StuckError too. 0: never
+  // (docs/results-log.md). Running out of rounds (max_rounds) then ends in a StuckError too. 0: never
   // (rounding goes on as before).
   double stuck_after = 0.0;
   int stuck_rounds = 4;
@@ -170,7 +170,7 @@ struct RoundingOptions {
   // and which variables cross it first decides where a coarse level lands: on FAUST_r 020-024 at
   // 200 faces, 0.5 ended at 2.851 and 0.7 at 2.741 (LP bound 2.628), and two full-resolution runs
   // that differed at their 200-face level by 2.906 against 2.958 ended at 15.1 against 19.9
-  // (docs/results.md). An alternative that fails (no Γ, stuck, an LP that gives up) is dropped.
+  // (docs/results-log.md). An alternative that fails (no Γ, stuck, an LP that gives up) is dropped.
   // Not with start_ones. Empty: one rounding.
   std::vector<double> alternative_thresholds = {0.7};
   int64_t alternatives_below = 1'500'000;
