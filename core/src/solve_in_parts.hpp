@@ -33,7 +33,11 @@ struct JoinedSolve {
 // solver is deterministic, so the result is the same, not an approximation of it. Measured:
 // FAUST_r 021-024's finest rounding solved one unchanged part of fewer than 30 000 columns with
 // Clp six times, 146 697 pivots and 5-7.5 minutes each, once with a round between that lacked it.
-// So a result is kept until kKeepCalls calls in a row have not had its part.
+// So a result is kept until kKeepCalls calls in a row have not had its part. A run's path can
+// still change with it: the stuck rule (stuck_after) counts failing rounds' seconds, and a reused
+// result costs none. Measured on that pair (docs/results-log.md, thirty-eighth session): the five
+// repeats took 32 s instead of 1 554, the rounding went on past the round where it had given up,
+// and the run ended at a lower energy by another path.
 struct ExactCache {
   static constexpr int kKeepCalls = 4;
   struct Entry {
