@@ -2,7 +2,8 @@
 # PDHG's work in `match -v` logs: one Markdown row per log with the number of PDHG solves, their
 # iterations, their column-iterations (Σ columns × iterations, in 10⁹; bytes moved per iteration
 # grow with the columns) and their seconds. Iteration totals taken from the info lines mix in
-# Clp's simplex pivots (parts under RoundingOptions::exact_below, 30 000 columns), which cost next to nothing: compare these.
+# Clp's simplex pivots (parts under RoundingOptions::exact_below, 30 000 columns), a pivot costing
+# far less than a PDHG iteration (though 146 697 of them once took 5 minutes): compare these.
 #   tools/pdhg_work.sh LOG...
 set -euo pipefail
 [ $# -gt 0 ] || { echo "usage: tools/pdhg_work.sh LOG..." >&2; exit 2; }
