@@ -4,6 +4,7 @@
 // growing sizes (time and memory scaling) or over a list of pairs with their evaluation.
 #include "commands.hpp"
 #include "json_read.hpp"
+#include "shapematch/coarse_to_fine.hpp"
 #include "shapematch/errors.hpp"
 #include "shapematch/json.hpp"
 #include "shapematch/matching.hpp"
@@ -34,6 +35,7 @@
 #include <exception>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iostream>
 #include <iterator>
 #include <limits>
@@ -563,15 +565,21 @@ std::vector<std::string> match_command(const BenchMatchArgs& args, const std::st
   return cmd;
 }
 
-// `match X Y` into `dir` (kept for inspection, its log beside it as dir.match.log).
+// `match X Y` into `dir` (kept for inspection, its log beside it as dir.match.log). With a
+// `checkpoint` file the run goes on from it where it exists and saves its levels there;
+// `started` is called once the previous run's outputs are gone, before this one starts.
 void run_match_child(const BenchMatchArgs& args, const std::string& x, const std::string& y, const std::string& faces,
-                     const fs::path& dir, MatchRow& row) {
+                     const fs::path& dir, MatchRow& row, const fs::path& checkpoint = {},
+                     const std::function<void()>& started = {}) {
   // A failed run must not leave the previous benchmark's output looking like its own, nor the
   // record that --resume trusts.
   fs::remove_all(dir);
   for (const char* suffix : {".run.json", ".eval.json"}) fs::remove(dir.string() + suffix);
+  if (started) started();
   std::vector<std::string> cmd = match_command(args, x, y, faces);
   cmd.insert(cmd.end(), {"-o", dir.string()});
+  // (Not part of the command --resume compares: it changes where a run starts, not its Γ's options.)
+  if (!checkpoint.empty()) cmd.insert(cmd.end(), {"--checkpoint", checkpoint.string()});
   // Runs side by side share the CPUs (not part of the command --resume compares: the count
   // changes no Γ), unless the match options say how.
   if (args.jobs > 1 && std::find(cmd.begin(), cmd.end(), "--threads") == cmd.end())
@@ -841,34 +849,66 @@ std::vector<std::string> strings_of(const JsonNode* node) {
 
 // Beside each pair's run: what was asked and how it ended, written once its row is final. Full
 // resolution tables take hours per list on 2 cores; --resume picks such a list up where it stopped.
+// `checkpoint_before`: the levels the pair's checkpoint held when the run started (-1: none used).
 void write_run_record(const fs::path& dir, const std::vector<std::string>& match, const PairSpec& pair,
-                      double time_limit, const MatchRow& row) {
+                      double time_limit, const MatchRow& row, int checkpoint_before = -1) {
   Json record = Json::object();
   record.set("match", strings_json(match));
   record.set("truth", strings_json(pair.truth));
   record.set("time_limit", time_limit);
+  if (checkpoint_before >= 0) record.set("checkpoint_levels_before", checkpoint_before);
   record.set("status", row.run.status);
   record.set("seconds", row.run.seconds);
   record.set("peak_rss_mb", row.run.peak_rss_mb);
   write_file_atomic(dir.string() + ".run.json", record.dump() + "\n");
 }
 
+// The levels a pair's checkpoint holds (match --checkpoint); 0 where there is none, or one that
+// does not read back (the run then starts afresh and replaces it).
+int checkpoint_levels(const fs::path& checkpoint) {
+  if (!fs::exists(checkpoint)) return 0;
+  try {
+    return static_cast<int>(load_checkpoint(checkpoint.string()).levels.size());
+  } catch (const Error& e) {
+    spdlog::warn("{}; starting afresh", e.what());
+    fs::remove(checkpoint);
+    return 0;
+  }
+}
+
 // The row of an earlier run of the same command (and ground truth), if one finished; a run that
-// timed out counts only under a time limit no longer than its own. An evaluation that failed is
+// timed out counts only under a time limit no longer than its own, and only where it left its
+// checkpoint no further on than it found it (one that got further goes on from there: full
+// resolution's coarse levels take a quarter to a half of a run). An evaluation that failed is
 // run again (cheap). False: run the pair.
 bool resume_row(const BenchMatchArgs& args, const PairSpec& pair, const std::vector<std::string>& match,
                 const fs::path& dir, MatchRow& row) {
   const std::string path = dir.string() + ".run.json";
-  if (!fs::exists(path)) return false;
+  const fs::path checkpoint = dir.string() + ".ckpt";
+  if (!fs::exists(path)) {
+    fs::remove(checkpoint);  // (whatever made it is not on record)
+    return false;
+  }
   try {
     const JsonNode record = read_json_file(path);
     if (strings_of(record.get("match")) != match || strings_of(record.get("truth")) != pair.truth) {
       spdlog::info("{}: the recorded run had other options; running it again", row.name);
+      fs::remove(checkpoint);
       return false;
     }
     const JsonNode* status = record.get("status");
     if (!status || status->kind != JsonNode::Kind::String) return false;
-    if (status->text == "timed out" && !(record.number_or_nan("time_limit") >= args.time_limit)) return false;
+    if (status->text == "started") return false;  // the harness was stopped during the run
+    if (status->text == "timed out") {
+      if (!(record.number_or_nan("time_limit") >= args.time_limit)) return false;
+      const double recorded = record.number_or_nan("checkpoint_levels_before");
+      const int before = recorded >= 0 ? static_cast<int>(recorded) : 0;
+      if (const int now = checkpoint_levels(checkpoint); now > before) {
+        spdlog::info("{}: timed out after its checkpoint went from {} to {} levels; going on from it", row.name,
+                     before, now);
+        return false;
+      }
+    }
     row.run.status = status->text;
     row.run.seconds = record.number_or_nan("seconds");
     row.run.peak_rss_mb = record.number_or_nan("peak_rss_mb");
@@ -936,9 +976,22 @@ int run_bench_pairs(const BenchMatchArgs& asked) {
       spdlog::info("pair {} of {}: {} (resumed from {}.run.json)", i + 1, pairs.size(), row.name, dirs[i].string());
     } else {
       spdlog::info("pair {} of {}: {}", i + 1, pairs.size(), row.name);
-      run_match_child(args, pair.x, pair.y, faces, dirs[i], row);
-      if (row.run.status == "ok") evaluate(args, pair, dirs[i], row);
-      write_run_record(dirs[i], match, pair, args.time_limit, row);
+      if (args.resume) {  // with a checkpoint, so that a run stopped in a fine level loses only that level
+        const fs::path checkpoint = dirs[i].string() + ".ckpt";
+        const int before = checkpoint_levels(checkpoint);
+        run_match_child(args, pair.x, pair.y, faces, dirs[i], row, checkpoint, [&] {
+          MatchRow started = row;
+          started.run.status = "started";
+          write_run_record(dirs[i], match, pair, args.time_limit, started, before);
+        });
+        if (row.run.status == "ok") fs::remove(checkpoint);  // (a finished run needs none)
+        if (row.run.status == "ok") evaluate(args, pair, dirs[i], row);
+        write_run_record(dirs[i], match, pair, args.time_limit, row, before);
+      } else {
+        run_match_child(args, pair.x, pair.y, faces, dirs[i], row);
+        if (row.run.status == "ok") evaluate(args, pair, dirs[i], row);
+        write_run_record(dirs[i], match, pair, args.time_limit, row);
+      }
     }
     finish(i);
   };
@@ -1029,7 +1082,9 @@ Action add_bench_command(CLI::App& app) {
       ->capture_default_str();
   match->add_flag("--resume", m->resume,
                   "pairs: reuse each pair's row where this --out already holds a finished run of the same command and "
-                  "ground truth (runs/X-Y.run.json); a run that timed out is tried again under a longer --time-limit")
+                  "ground truth (runs/X-Y.run.json); runs keep a checkpoint (runs/X-Y.ckpt), and one that timed "
+                  "out is tried again, from its checkpoint, under a longer --time-limit or where its checkpoint "
+                  "got further")
       ->needs(match->get_option("--pairs"));
   match->add_option("--jobs", m->jobs,
                     "pairs: runs at once (a GPU machine with many cores); each match and eval gets its share of "

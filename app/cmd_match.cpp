@@ -18,6 +18,7 @@
 #include <filesystem>
 #include <fstream>
 #include <numeric>
+#include <optional>
 #include <random>
 #include <sstream>
 
@@ -71,6 +72,7 @@ struct MatchArgs {
   bool warm_widening = CoarseToFineOptions{}.warm_widening;
   bool carry_primal_weight = CoarseToFineOptions{}.carry_primal_weight;
   std::string dump_first_lps;
+  std::string checkpoint;
   int inherit_widening = CoarseToFineOptions{}.inherit_widening;
   int price_dual_sweeps = CoarseToFineOptions{}.price_dual_sweeps;
   double stuck_after = CoarseToFineOptions{}.stuck_after;
@@ -193,6 +195,20 @@ int run_match(const MatchArgs& args) {
   const Mesh& x = matcher.x_levels().levels.back().mesh;
   const Mesh& y = matcher.y_levels().levels.back().mesh;
 
+  // A checkpoint that exists is gone on from; every level below the finest then replaces it.
+  std::optional<LevelCheckpoint> resume;
+  if (!args.checkpoint.empty() && fs::exists(args.checkpoint)) {
+    resume = load_checkpoint(args.checkpoint);
+    if (resume->hierarchy != matcher.fingerprint())
+      throw InvalidInputError(args.checkpoint + ": the checkpoint was written for other meshes or another hierarchy");
+  }
+  CoarseToFineMatcher::Checkpointing checkpointing;
+  if (!args.checkpoint.empty())
+    checkpointing = [&](const LevelCheckpoint& c) {
+      save_checkpoint(args.checkpoint, c);
+      spdlog::info("checkpoint after level {}: {}", c.levels.size(), args.checkpoint);
+    };
+
   stage.reset();
   const CoarseToFineResult c2f = matcher.run([&](const LevelReport& level, const RoundingRound& r) {
     const std::string at = matcher.x_levels().size() > 1 ? fmt::format("level {} ", level.level + 1) : std::string();
@@ -218,7 +234,7 @@ int run_match(const MatchArgs& args) {
                        : std::string();
     spdlog::info("{}round {:>2}: {:>9} variables{}, LP {} in {} it, objective {:.6g}, {}{} ({:.2f} s)", at, r.round,
                  r.variables, parts, to_string(r.status), r.iterations, r.objective, fixed, undone, r.seconds);
-  });
+  }, resume ? &*resume : nullptr, checkpointing);
   const MatchingLp& m = c2f.finest;
   const RoundingResult& rr = c2f.rounding;
   seconds.set("solve_and_round", stage.seconds());
@@ -423,6 +439,8 @@ int run_match(const MatchArgs& args) {
                               .set("price_widenings", args.price_widenings)
                               .set("price_threshold", args.price_threshold)
                               .set("price_tolerance", args.price_tolerance));
+    // Levels taken from a checkpoint keep the seconds and memory of the run that solved them.
+    report.set("resumed_after_level", resume ? static_cast<int64_t>(resume->levels.size()) : int64_t(0));
     report.set("seconds", seconds);
     report.set("peak_rss_mb", peak_rss_mb());
     report.set("round_log", rounds);
@@ -636,6 +654,9 @@ Action add_match_command(CLI::App& app) {
   app.add_flag("--carry-primal-weight,!--no-carry-primal-weight", a->carry_primal_weight,
                "warm starts (a pricing's re-solve, --warm-widening) also start from the primal weight their "
                "iterate's solve ended with (default off: measured no faster)");
+  app.add_option("--checkpoint", a->checkpoint,
+                 "after every level below the finest, save the run's state to FILE; where FILE exists, go on "
+                 "after the levels it holds (solved with whatever options made them)");
   app.add_option("--dump-first-lps", a->dump_first_lps,
                  "write every first LP of a rounding to this directory (level<L>-<NNN>.smlp), to solve it again "
                  "with `shapematch lp --from`");

@@ -35,6 +35,14 @@ std::string read_text(const fs::path& path) {
   return std::string(std::istreambuf_iterator<char>(f), {});
 }
 
+// Replaces the value of `key` in a JSON file written one field per line (a run record).
+void edit_json_field(const fs::path& file, const std::string& key, const std::string& value) {
+  const std::string text = read_text(file);
+  const std::string edited = std::regex_replace(text, std::regex("\"" + key + "\": [^,\n]+"), "\"" + key + "\": " + value);
+  REQUIRE(edited != text);
+  std::ofstream(file) << edited;
+}
+
 // One CSV record; quoted fields may hold commas (the device "cpu (Clp, 1 thread)").
 std::vector<std::string> split_csv(const std::string& line) {
   std::vector<std::string> fields(1);
@@ -354,13 +362,7 @@ TEST_CASE("cli: bench match --pairs --resume reuses the rows of finished runs of
   const std::string bench = "bench match --pairs " + (dir / "pairs.txt").string() + " --out " + (dir / "out").string();
   const fs::path record = dir / "out" / "runs" / "finger_straight-finger_bent.run.json";
   // A recorded number that no run measures shows whether the row was reused or measured again.
-  auto edit_record = [&](const std::string& key, const std::string& value) {
-    const std::string text = read_text(record);
-    const std::regex field("\"" + key + "\": [^,\n]+");
-    const std::string edited = std::regex_replace(text, field, "\"" + key + "\": " + value);
-    REQUIRE(edited != text);
-    std::ofstream(record) << edited;
-  };
+  auto edit_record = [&](const std::string& key, const std::string& value) { edit_json_field(record, key, value); };
   auto row = [&] {
     const auto [header, rows] = read_csv(dir / "out" / "bench_pairs.csv");
     REQUIRE(rows.size() == 2);
@@ -411,6 +413,61 @@ TEST_CASE("cli: bench match --pairs --resume reuses the rows of finished runs of
     CHECK(row().at("status") == "ok");
     CHECK(row().at("energy") == first.at("energy"));
   }
+  fs::remove_all(dir);
+}
+
+TEST_CASE("cli: bench match --pairs --resume goes on from where a run that timed out left its checkpoint") {
+  const fs::path dir = fs::temp_directory_path() / "shapematch_bench_checkpoint_test";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const fs::path err = dir.string() + "_stderr.txt";
+  const std::string x = kAssets + "/dolphin_straight.off", y = kAssets + "/dolphin_swimming.off";
+  std::ofstream(dir / "pairs.txt") << x << " " << y << " identity\n";
+  const std::string options = " --backend cpu --levels 3";
+  const std::string bench =
+      "bench match --pairs " + (dir / "pairs.txt").string() + " --out " + (dir / "out").string() + " --faces 200 --resume --" + options;
+  const fs::path runs = dir / "out" / "runs";
+  const fs::path record = runs / "dolphin_straight-dolphin_swimming.run.json";
+  const fs::path checkpoint = runs / "dolphin_straight-dolphin_swimming.ckpt";
+  const fs::path log = runs / "dolphin_straight-dolphin_swimming.match.log";
+  auto edit_record = [&](const std::string& key, const std::string& value) { edit_json_field(record, key, value); };
+  auto row = [&] { return read_csv(dir / "out" / "bench_pairs.csv").rows.at(0); };
+
+  REQUIRE(run_cli(bench, err) == 0);
+  const auto first = row();
+  REQUIRE(first.at("status") == "ok");
+  CHECK_FALSE(fs::exists(checkpoint));  // a finished run keeps none
+  CHECK(read_text(record).find("\"checkpoint_levels_before\": 0") != std::string::npos);
+
+  // As if the run had been stopped in its finest level: the record says timed out, the checkpoint
+  // holds the coarse level (written by the same match, as the killed run would have).
+  REQUIRE(run_cli("match " + x + " " + y + " --faces 200" + options + " --checkpoint " + checkpoint.string() + " -o " +
+                      (dir / "direct").string(),
+                  err) == 0);
+  REQUIRE(fs::exists(checkpoint));
+  fs::copy_file(checkpoint, dir / "saved.ckpt");
+  edit_record("status", "\"timed out\"");
+  REQUIRE(run_cli(bench, err) == 0);  // the same limit, but the checkpoint got further: it goes on
+  CHECK(read_text(err).find("going on from it") != std::string::npos);
+  CHECK(read_text(log).find("going on from a checkpoint after level 2 of 3") != std::string::npos);
+  CHECK(row().at("status") == "ok");
+  CHECK(row().at("energy") == first.at("energy"));
+  CHECK_FALSE(fs::exists(checkpoint));
+
+  // One that timed out without getting past the checkpoint it started from keeps its row.
+  fs::copy_file(dir / "saved.ckpt", checkpoint);
+  CHECK(read_text(record).find("\"checkpoint_levels_before\": 2") != std::string::npos);  // it started from it
+  edit_record("status", "\"timed out\"");
+  REQUIRE(run_cli(bench, err) == 0);
+  CHECK(row().at("status") == "timed out");
+  CHECK(fs::exists(checkpoint));
+  // Other options: the checkpoint goes with the record.
+  REQUIRE(run_cli("bench match --pairs " + (dir / "pairs.txt").string() + " --out " + (dir / "out").string() +
+                      " --faces 200 --resume --" + options + " --ring 1",
+                  err) == 0);
+  CHECK(row().at("status") == "ok");
+  CHECK(read_text(log).find("going on from a checkpoint") == std::string::npos);
+  CHECK_FALSE(fs::exists(checkpoint));
   fs::remove_all(dir);
 }
 

@@ -39,6 +39,14 @@ fs::path write_temp(const std::string& name, const std::string& text) {
   return p;
 }
 
+std::string read_file(const fs::path& p) {
+  std::ifstream in(p);
+  REQUIRE_MESSAGE(in.good(), p.string());
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
 const std::string kTetra = "OFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n";
 
 }  // namespace
@@ -257,6 +265,32 @@ TEST_CASE("cli: match writes each coarser level's map and eval scores it") {
   r = run("eval " + out.string() + " --gt identity");
   CHECK(r.code != 0);
   CHECK(r.err.find("level_1.txt: line") != std::string::npos);
+}
+
+TEST_CASE("cli: match --checkpoint goes on after the levels a stopped run finished") {
+  shapematch::test::TempDir tmp;
+  const std::string dolphin = std::string(SHAPEMATCH_ASSETS_DIR) + "/dolphin_straight.off";
+  const std::string swimming = std::string(SHAPEMATCH_ASSETS_DIR) + "/dolphin_swimming.off";
+  const std::string ckpt = (tmp.path / "pair.ckpt").string();
+  const std::string args = " --faces 200 --levels 3 --backend cpu --checkpoint " + ckpt + " -o ";
+  Run r = run("match " + dolphin + " " + swimming + args + (tmp.path / "a").string());
+  REQUIRE_MESSAGE(r.code == 0, r.err);
+  REQUIRE(fs::exists(ckpt));  // after level 2 of 3
+  const std::string first = read_file(tmp.path / "a" / "report.json");
+  CHECK(json_number(first, "resumed_after_level") == 0);
+  // Going on from it solves only the finest level again, to the same Γ.
+  r = run("match " + dolphin + " " + swimming + args + (tmp.path / "b").string());
+  REQUIRE_MESSAGE(r.code == 0, r.err);
+  CHECK(r.err.find("going on from a checkpoint after level 2 of 3") != std::string::npos);
+  const std::string second = read_file(tmp.path / "b" / "report.json");
+  CHECK(json_number(second, "resumed_after_level") == 2);
+  CHECK(json_number(second, "energy") == json_number(first, "energy"));
+  CHECK(read_file(tmp.path / "b" / "map_x_to_y.txt") == read_file(tmp.path / "a" / "map_x_to_y.txt"));
+  // Another pair: one line naming the file, nothing written.
+  r = run("match " + swimming + " " + dolphin + args + (tmp.path / "c").string());
+  CHECK(r.code != 0);
+  CHECK(r.err.find(ckpt + ": the checkpoint was written for other meshes") != std::string::npos);
+  CHECK_FALSE(fs::exists(tmp.path / "c"));
 }
 
 // tools/pdhg_work.sh reads what PDHG logs at debug level: on a written log its sums are checked

@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <random>
 #include <memory>
@@ -930,4 +931,62 @@ TEST_CASE("coarse to fine: after N suspicions in a row the watch is off until a 
   detail::SuspicionCount unlimited(0);
   for (int i = 0; i < 50; ++i) CHECK_FALSE(unlimited.suspicion());
   CHECK(unlimited.trusted());
+}
+
+TEST_CASE("coarse to fine: a run gone on from a level's checkpoint ends as the whole run") {
+  CoarseToFineOptions o;
+  o.hierarchy.coarsest_faces = 12;
+  o.hierarchy.second_faces = 24;
+  o.hierarchy.ratio = 1.6;
+  o.rounding.solver = "pdhg-cpu";
+  o.lookahead_levels = 0;  // (with lookahead no level before the decision is a checkpoint)
+  const CoarseToFineMatcher matcher = finger_matcher(o);
+  const int levels = matcher.x_levels().size();
+  REQUIRE(levels >= 4);
+  std::vector<LevelCheckpoint> saved;
+  const CoarseToFineResult whole = matcher.run({}, nullptr, [&](const LevelCheckpoint& c) { saved.push_back(c); });
+  // One after every level but the finest, each holding the levels so far and their Γ.
+  REQUIRE(saved.size() == size_t(levels - 1));
+  for (size_t k = 0; k < saved.size(); ++k) {
+    CHECK(saved[k].hierarchy == matcher.fingerprint());
+    REQUIRE(saved[k].levels.size() == k + 1);
+    CHECK(saved[k].levels.back().gamma == whole.levels[k].gamma);
+  }
+
+  test::TempDir tmp;
+  const std::string file = (tmp.path / "after.ckpt").string();
+  for (const size_t k : {size_t(0), saved.size() - 1}) {  // after the coarsest (the second start still to come), and last
+    save_checkpoint(file, saved[k]);
+    const LevelCheckpoint loaded = load_checkpoint(file);
+    CHECK(loaded.hierarchy == saved[k].hierarchy);
+    CHECK(loaded.widened == saved[k].widened);
+    REQUIRE(loaded.levels.size() == saved[k].levels.size());
+    CHECK(loaded.levels.back().energy == saved[k].levels.back().energy);
+    CHECK(loaded.levels.back().second_start_kept == saved[k].levels.back().second_start_kept);
+    CHECK(loaded.levels.back().gamma == saved[k].levels.back().gamma);
+    int called = 0;
+    const CoarseToFineResult r = matcher.run({}, &loaded, [&](const LevelCheckpoint&) { ++called; });
+    CHECK(called == levels - 1 - int(k + 1));
+    REQUIRE(r.levels.size() == whole.levels.size());
+    for (int l = 0; l < levels; ++l) {
+      CHECK(r.levels[l].energy == doctest::Approx(whole.levels[l].energy).epsilon(1e-12));
+      CHECK(r.levels[l].gamma == whole.levels[l].gamma);
+    }
+    CHECK(r.rounding.energy == doctest::Approx(whole.rounding.energy).epsilon(1e-12));
+    CHECK(check_graph_surface(r.finest.space, r.rounding.gamma).ok());
+  }
+
+  // Another pair's checkpoint, one that holds every level, and broken files are refused.
+  const CoarseToFineMatcher other(decimate(shapes::bent_finger(10, 8, 8), 80), decimate(shapes::bent_finger(40, 8, 8), 90), o);
+  CHECK_THROWS_AS(other.run({}, &saved[0]), InvalidInputError);
+  LevelCheckpoint all = saved.back();
+  all.levels = whole.levels;
+  CHECK_THROWS_AS(matcher.run({}, &all), InvalidInputError);
+  save_checkpoint(file, saved[0]);
+  const auto size = std::filesystem::file_size(file);
+  std::filesystem::resize_file(file, size - 3);
+  CHECK_THROWS_AS(load_checkpoint(file), IoError);
+  std::ofstream(file) << "OFF\n3 1 0\n";
+  CHECK_THROWS_AS(load_checkpoint(file), IoError);
+  CHECK_THROWS_AS(load_checkpoint((tmp.path / "missing.ckpt").string()), IoError);
 }

@@ -82,7 +82,7 @@ run1() {
   [ $# -gt 3 ] && extra+=("${@:4}")
   local id=$n-$w${tag:+-$tag}
   mapfile -t margs < match_args.txt
-  ./shapematch bench match --pairs "pairs/$n.txt" --faces "$FACES" --time-limit "$LIMIT" --out "out/$id" -- \
+  ./shapematch bench match --pairs "pairs/$n.txt" --faces "$FACES" --time-limit "$LIMIT" --out "out/$id" --resume -- \
     "${margs[@]}" --backend "$BACKEND" --threads "$THREADS" "${extra[@]}" > "log/$id.bench.log" 2>&1
   echo "$id exit $? at $(date +%T)" >> log/done.txt
 }

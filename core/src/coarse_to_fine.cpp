@@ -13,6 +13,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <bit>
 #include <cmath>
 #include <exception>
 #include <limits>
@@ -453,7 +454,8 @@ void CoarseToFineMatcher::set_features(Eigen::MatrixXd fx, Eigen::MatrixXd fy) {
   fy_ = std::move(fy);
 }
 
-CoarseToFineResult CoarseToFineMatcher::run(const Progress& progress) const {
+CoarseToFineResult CoarseToFineMatcher::run(const Progress& progress, const LevelCheckpoint* resume,
+                                            const Checkpointing& checkpoint) const {
   CoarseToFineResult result;
   // The Γ that goes on, or with lookahead from the second level two: the refined one and the
   // second start's, the lower energy first ("leading"), refined side by side up to `decide_at`,
@@ -467,7 +469,21 @@ CoarseToFineResult CoarseToFineMatcher::run(const Progress& progress) const {
   std::vector<Chain> chains(1);
   const int levels = hx_.size();
   int decide_at = -1;
-  for (int l = 0; l < levels; ++l) {
+  int start = 0;
+  if (resume) {
+    if (resume->hierarchy != fingerprint())
+      throw InvalidInputError("checkpoint: written for other meshes or another hierarchy");
+    if (resume->levels.empty() || int(resume->levels.size()) >= levels)
+      throw InvalidInputError("checkpoint: holds " + std::to_string(resume->levels.size()) + " levels of " +
+                              std::to_string(levels) + "; it can go on only below the finest");
+    result.levels = resume->levels;
+    chains[0].gamma = resume->levels.back().gamma;
+    chains[0].widened = resume->widened;
+    start = static_cast<int>(resume->levels.size());
+    spdlog::info("going on from a checkpoint after level {} of {} (energy {:.6g})", start, levels,
+                 resume->levels.back().energy);
+  }
+  for (int l = start; l < levels; ++l) {
     const MeshLevel& lx = hx_.levels[l];
     const MeshLevel& ly = hy_.levels[l];
     Stopwatch clock;
@@ -561,9 +577,31 @@ CoarseToFineResult CoarseToFineMatcher::run(const Progress& progress) const {
       if (c.pending.size() > 1) c.pending.back().lookahead_switched = !c.leading;  // reports held since a split
       for (LevelReport& r : c.pending) result.levels.push_back(r);
       c.pending.clear();
+      if (checkpoint && l + 1 < levels) checkpoint(LevelCheckpoint{fingerprint(), result.levels, c.widened});
     }
   }
   return result;
+}
+
+uint64_t CoarseToFineMatcher::fingerprint() const {
+  uint64_t h = 1469598103934665603ull;  // FNV-1a over the words below
+  auto mix = [&h](uint64_t v) {
+    for (int i = 0; i < 8; ++i, v >>= 8) h = (h ^ (v & 0xff)) * 1099511628211ull;
+  };
+  for (const MeshHierarchy* hier : {&hx_, &hy_}) {
+    mix(hier->levels.size());
+    for (const MeshLevel& lv : hier->levels) {
+      mix(lv.mesh.vertices.size());
+      for (const Eigen::Vector3d& p : lv.mesh.vertices)
+        for (int k = 0; k < 3; ++k) mix(std::bit_cast<uint64_t>(p[k]));
+      mix(lv.mesh.faces.size());
+      for (const auto& f : lv.mesh.faces)
+        for (int v : f) mix(uint64_t(uint32_t(v)));
+      for (int v : lv.input_vertex) mix(uint64_t(uint32_t(v)));
+      for (int v : lv.parent_face) mix(uint64_t(uint32_t(v)));
+    }
+  }
+  return h;
 }
 
 void CarriedIterate::keep(const MatchingLp& m, const std::vector<double>& x, const std::vector<double>& y,

@@ -6,6 +6,7 @@
 #include "shapematch/rounding.hpp"
 
 #include <atomic>
+#include <cstdint>
 #include <functional>
 #include <memory>
 #include <limits>
@@ -291,6 +292,20 @@ struct CoarseToFineResult {
   RoundingResult rounding;  // the finest level's rounding
 };
 
+// The state between two levels, so that a run can stop after a level and another go on from it
+// (match --checkpoint): the reports of the levels done, the last one's Γ being what the next
+// refines, and that level's extra rings per X face (inherit_widening). Only a level after which
+// a single chain goes on is a checkpoint (not inside lookahead), and never the finest.
+struct LevelCheckpoint {
+  uint64_t hierarchy = 0;          // CoarseToFineMatcher::fingerprint() of the run that wrote it
+  std::vector<LevelReport> levels; // levels 0 … levels.size() - 1, done
+  std::vector<int> widened;
+};
+// Binary, versioned. save: atomically (files.hpp); load: IoError naming the file where it is
+// missing, not a checkpoint, or cut short.
+void save_checkpoint(const std::string& path, const LevelCheckpoint& checkpoint);
+LevelCheckpoint load_checkpoint(const std::string& path);
+
 // Stateful: owns both hierarchies, so the result's space stays valid while the matcher lives.
 class CoarseToFineMatcher {
 public:
@@ -302,7 +317,16 @@ public:
   const MeshHierarchy& y_levels() const { return hy_; }
 
   using Progress = std::function<void(const LevelReport& level, const RoundingRound& round)>;
-  CoarseToFineResult run(const Progress& progress = {}) const;
+  using Checkpointing = std::function<void(const LevelCheckpoint&)>;
+  // `resume`: go on after its levels instead of starting at the coarsest; they are taken as they
+  // are, whatever options made them (so a finer level's options can be tried without solving the
+  // coarse ones again). InvalidInputError where it was written for other hierarchies.
+  // `checkpoint`: called after every level that can be a checkpoint.
+  CoarseToFineResult run(const Progress& progress = {}, const LevelCheckpoint* resume = nullptr,
+                         const Checkpointing& checkpoint = {}) const;
+  // A hash of both hierarchies (every level's faces and input vertices): equal for equal inputs
+  // and hierarchy options.
+  uint64_t fingerprint() const;
 
 private:
   // Level l's rounding options: the coarse tolerance below the finest level.

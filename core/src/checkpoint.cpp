@@ -1,0 +1,128 @@
+// LevelCheckpoint files: the state between two levels of a coarse-to-fine run (match --checkpoint).
+// Raw values in the host's byte order: a checkpoint goes on on the kind of machine that wrote it.
+#include "shapematch/coarse_to_fine.hpp"
+#include "shapematch/errors.hpp"
+#include "shapematch/files.hpp"
+
+#include <cstring>
+#include <fstream>
+#include <iterator>
+#include <type_traits>
+
+namespace shapematch {
+namespace {
+
+constexpr char kMagic[] = "shapematch level checkpoint\n";
+constexpr uint32_t kVersion = 1;
+
+// Every number of a report, in the file's order (the Γ follows on its own). A field added to
+// LevelReport goes here too, with kVersion one higher; the size check below is the reminder.
+template <class R, class F>
+void each_field(R& r, F&& f) {
+  f(r.level), f(r.faces_x), f(r.faces_y), f(r.variables), f(r.full_variables), f(r.constraints), f(r.ring);
+  f(r.widenings), f(r.local_widenings), f(r.margin_widenings), f(r.widened_faces), f(r.stuck_widenings);
+  f(r.price_widenings), f(r.propagation_widenings), f(r.recurring_widenings), f(r.inherited_faces);
+  f(r.carried_fixings), f(r.iterations_bound), f(r.rounds), f(r.iterations), f(r.lower_bound), f(r.energy);
+  f(r.gap), f(r.threshold), f(r.roundings), f(r.seconds), f(r.peak_rss_mb), f(r.second_start_energy);
+  f(r.second_start_kept), f(r.lookahead_other_energy), f(r.lookahead_switched);
+}
+static_assert(sizeof(LevelReport) == 208 + sizeof(std::vector<ProductTriangle>),
+              "LevelReport changed: add the new field to each_field and raise kVersion");
+
+class Writer {
+public:
+  explicit Writer(std::ostream& out) : out_(out) {}
+  template <class T>
+  void operator()(const T& v) {
+    static_assert(std::is_arithmetic_v<T>);
+    out_.write(reinterpret_cast<const char*>(&v), sizeof v);
+  }
+  template <class T>
+  void array(const std::vector<T>& v) {
+    (*this)(uint64_t(v.size()));
+    out_.write(reinterpret_cast<const char*>(v.data()), std::streamsize(v.size() * sizeof(T)));
+  }
+
+private:
+  std::ostream& out_;
+};
+
+class Reader {
+public:
+  Reader(const std::string& path, std::string bytes) : path_(path), bytes_(std::move(bytes)) {}
+  template <class T>
+  void operator()(T& v) {
+    static_assert(std::is_arithmetic_v<T>);
+    take(&v, sizeof v);
+  }
+  template <class T>
+  void array(std::vector<T>& v) {
+    uint64_t n = 0;
+    (*this)(n);
+    if (n > (bytes_.size() - at_) / sizeof(T)) short_file();  // before allocating
+    v.resize(n);
+    take(v.data(), n * sizeof(T));
+  }
+  void take(void* to, size_t n) {
+    if (n > bytes_.size() - at_) short_file();
+    std::memcpy(to, bytes_.data() + at_, n);
+    at_ += n;
+  }
+  bool done() const { return at_ == bytes_.size(); }
+  [[noreturn]] void short_file() const { throw IoError(path_ + ": the checkpoint is cut short"); }
+
+private:
+  std::string path_;
+  std::string bytes_;
+  size_t at_ = 0;
+};
+
+static_assert(std::is_trivially_copyable_v<ProductTriangle> && sizeof(ProductTriangle) == 8 * sizeof(int));
+
+}  // namespace
+
+void save_checkpoint(const std::string& path, const LevelCheckpoint& c) {
+  write_file_atomic(path, [&](std::ostream& out) {
+    Writer w(out);
+    out.write(kMagic, sizeof kMagic - 1);
+    w(kVersion);
+    w(c.hierarchy);
+    w(uint64_t(c.levels.size()));
+    for (const LevelReport& r : c.levels) {
+      each_field(r, w);
+      w.array(r.gamma);
+    }
+    w.array(c.widened);
+  });
+}
+
+LevelCheckpoint load_checkpoint(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw IoError(path + ": cannot open the checkpoint");
+  std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (in.bad()) throw IoError(path + ": cannot read the checkpoint");
+  if (bytes.compare(0, sizeof kMagic - 1, kMagic) != 0) throw IoError(path + ": not a shapematch checkpoint");
+  Reader r(path, std::move(bytes));
+  std::string magic(sizeof kMagic - 1, '\0');
+  r.take(magic.data(), magic.size());
+  uint32_t version = 0;
+  r(version);
+  if (version != kVersion)
+    throw IoError(path + ": checkpoint version " + std::to_string(version) + ", this build reads " +
+                  std::to_string(kVersion));
+  LevelCheckpoint c;
+  r(c.hierarchy);
+  uint64_t n = 0;
+  r(n);
+  if (n > 64) throw IoError(path + ": the checkpoint claims " + std::to_string(n) + " levels");
+  c.levels.resize(n);
+  for (LevelReport& rep : c.levels) {
+    each_field(rep, r);
+    r.array(rep.gamma);
+  }
+  r.array(c.widened);
+  if (!r.done()) throw IoError(path + ": trailing bytes after the checkpoint");
+  return c;
+}
+
+}  // namespace shapematch
