@@ -57,9 +57,10 @@ cat > "$dir/q.sh" <<'EOF'
 #!/bin/bash
 # Runs the jobs of jobs.txt (or $JOBS), P at once, each `bench match` of one pair with the options
 # of match_args.txt and --backend $BACKEND (vulkan; cpu where no NVIDIA device shows) at FACES faces
-# (full), THREADS threads each (default nproc / P), killed at LIMIT seconds; then packs logs,
-# tables and results (no meshes) into $OUT/q.txz. Run it from a folder outside the checkout (a
-# later call would replace an ignored folder it does not carry).
+# (full), THREADS threads each (default nproc / P), stopped LIMIT seconds after the queue starts;
+# then packs logs, tables, results and checkpoints (no meshes) into $OUT/q.txz. Run it from a
+# folder outside the checkout (a later call would replace an ignored folder it does not carry).
+# Runs go on where an earlier call stopped (bench match --resume): unpack its q.txz here first.
 LIMIT=${LIMIT:-515}; P=${P:-8}; BACKEND=${BACKEND:-vulkan}; FACES=${FACES:-full}
 # Each run's share of the cores: P runs of all threads each leave the host oversubscribed and the
 # GPU waiting (thirty-third session: one thread each was 6.5 % faster than sixteen, 11 at once).
@@ -81,13 +82,18 @@ run1() {
   [ "$w" = off ] && extra=(--wks off)
   [ $# -gt 3 ] && extra+=("${@:4}")
   local id=$n-$w${tag:+-$tag}
+  # A job that starts late (a slot freed by a short one) gets what is left of LIMIT, so that it
+  # still ends as "timed out" with its record and checkpoint, not killed with the queue.
+  local left=$((DEADLINE - $(date +%s)))
+  if [ "$left" -lt 30 ]; then echo "$id not started (${left} s left)" >> log/done.txt; return; fi
   mapfile -t margs < match_args.txt
-  ./shapematch bench match --pairs "pairs/$n.txt" --faces "$FACES" --time-limit "$LIMIT" --out "out/$id" --resume -- \
+  ./shapematch bench match --pairs "pairs/$n.txt" --faces "$FACES" --time-limit "$left" --out "out/$id" --resume -- \
     "${margs[@]}" --backend "$BACKEND" --threads "$THREADS" "${extra[@]}" > "log/$id.bench.log" 2>&1
   echo "$id exit $? at $(date +%T)" >> log/done.txt
 }
 export -f run1
-export LIMIT BACKEND FACES THREADS
+DEADLINE=$(($(date +%s) + LIMIT))
+export LIMIT DEADLINE BACKEND FACES THREADS
 timeout $((LIMIT + 45)) xargs -P "$P" -L 1 bash -c 'run1 "$@"' _ < "${JOBS:-jobs.txt}"
 kill $SMI
 cat out/*/bench_pairs.md > log/tables.md 2>/dev/null
