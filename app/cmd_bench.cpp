@@ -525,6 +525,7 @@ struct MatchRow {
   double max_level_gap = kNaN;  // the largest of the levels' gaps (issue 5 asks for each level's)
   double mean_error = kNaN, median_error = kNaN, symmetric_mean_error = kNaN, flips = kNaN;
   double point_mean_error = kNaN, point_flips = kNaN;  // the point map's (eval's `point_map`)
+  double resumed_after_level = kNaN;  // levels taken from a checkpoint (their time is not in `run`)
   ChildRun run;
 };
 
@@ -550,6 +551,7 @@ void read_report(const fs::path& dir, MatchRow& row) {
   }
   row.energy = report.number_or_nan("energy");
   row.lower_bound = report.number_or_nan("lower_bound");
+  row.resumed_after_level = report.number_or_nan("resumed_after_level");
   row.gap = report.number_or_nan("gap");
 }
 
@@ -575,6 +577,7 @@ void run_match_child(const BenchMatchArgs& args, const std::string& x, const std
   // record that --resume trusts.
   fs::remove_all(dir);
   for (const char* suffix : {".run.json", ".eval.json"}) fs::remove(dir.string() + suffix);
+  if (checkpoint.empty()) fs::remove(dir.string() + ".ckpt");  // (made with options not on record)
   if (started) started();
   std::vector<std::string> cmd = match_command(args, x, y, faces);
   cmd.insert(cmd.end(), {"-o", dir.string()});
@@ -764,7 +767,8 @@ const std::vector<std::string> kPairsHeader{"pair",        "faces_x", "faces_y",
                                             "peak_rss_mb", "energy",  "lower_bound", "gap", "max_level_gap",
                                             "rounds",      "mean_geodesic_error", "median_geodesic_error",
                                             "symmetric_mean_geodesic_error", "orientation_flips",
-                                            "point_mean_geodesic_error", "point_orientation_flips", "status"};
+                                            "point_mean_geodesic_error", "point_orientation_flips",
+                                            "resumed_after_level", "status"};
 
 // The rows plus a last one of medians; `csv` chooses full precision over readable widths.
 std::vector<std::vector<std::string>> pairs_cells(const std::vector<MatchRow>& rows, bool csv) {
@@ -777,7 +781,7 @@ std::vector<std::vector<std::string>> pairs_cells(const std::vector<MatchRow>& r
                      general(r.gap, 4), general(r.max_level_gap, 4), csv_int(r.rounds), num(r.mean_error, 6, 4),
                      num(r.median_error, 6, 4),
                      num(r.symmetric_mean_error, 6, 4), csv_int(r.flips), num(r.point_mean_error, 6, 4),
-                     csv_int(r.point_flips), r.run.status});
+                     csv_int(r.point_flips), csv_int(r.resumed_after_level), r.run.status});
   const auto ok = std::count_if(rows.begin(), rows.end(), [](const MatchRow& r) { return r.run.status == "ok"; });
   cells.push_back({csv ? "median" : "**median**", "", "",
                    num(median_ok(rows, [](const MatchRow& r) { return r.run.seconds; }), 6, 2),
@@ -787,7 +791,7 @@ std::vector<std::vector<std::string>> pairs_cells(const std::vector<MatchRow>& r
                    num(median_ok(rows, [](const MatchRow& r) { return r.mean_error; }), 6, 4),
                    num(median_ok(rows, [](const MatchRow& r) { return r.median_error; }), 6, 4),
                    num(median_ok(rows, [](const MatchRow& r) { return r.symmetric_mean_error; }), 6, 4), "",
-                   num(median_ok(rows, [](const MatchRow& r) { return r.point_mean_error; }), 6, 4), "",
+                   num(median_ok(rows, [](const MatchRow& r) { return r.point_mean_error; }), 6, 4), "", "",
                    fmt::format("{} of {} ok", ok, rows.size())});
   return cells;
 }
@@ -978,15 +982,25 @@ int run_bench_pairs(const BenchMatchArgs& asked) {
       spdlog::info("pair {} of {}: {}", i + 1, pairs.size(), row.name);
       if (args.resume) {  // with a checkpoint, so that a run stopped in a fine level loses only that level
         const fs::path checkpoint = dirs[i].string() + ".ckpt";
-        const int before = checkpoint_levels(checkpoint);
-        run_match_child(args, pair.x, pair.y, faces, dirs[i], row, checkpoint, [&] {
-          MatchRow started = row;
-          started.run.status = "started";
-          write_run_record(dirs[i], match, pair, args.time_limit, started, before);
-        });
-        if (row.run.status == "ok") fs::remove(checkpoint);  // (a finished run needs none)
+        int before = checkpoint_levels(checkpoint);
+        auto attempt = [&] {
+          run_match_child(args, pair.x, pair.y, faces, dirs[i], row, checkpoint, [&] {
+            MatchRow started = row;
+            started.run.status = "started";
+            write_run_record(dirs[i], match, pair, args.time_limit, started, before);
+          });
+        };
+        attempt();
+        if (before > 0 && row.run.status.rfind("failed", 0) == 0) {  // the checkpoint's fault, maybe (another build)
+          spdlog::warn("{}: failed going on from its checkpoint ({}); once more afresh", row.name, row.run.status);
+          fs::remove(checkpoint);
+          before = 0;
+          row = MatchRow{.name = row.name};
+          attempt();
+        }
         if (row.run.status == "ok") evaluate(args, pair, dirs[i], row);
         write_run_record(dirs[i], match, pair, args.time_limit, row, before);
+        if (row.run.status == "ok") fs::remove(checkpoint);  // (a finished run needs none; after its record)
       } else {
         run_match_child(args, pair.x, pair.y, faces, dirs[i], row);
         if (row.run.status == "ok") evaluate(args, pair, dirs[i], row);

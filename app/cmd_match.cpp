@@ -199,8 +199,11 @@ int run_match(const MatchArgs& args) {
   std::optional<LevelCheckpoint> resume;
   if (!args.checkpoint.empty() && fs::exists(args.checkpoint)) {
     resume = load_checkpoint(args.checkpoint);
-    if (resume->hierarchy != matcher.fingerprint())
-      throw InvalidInputError(args.checkpoint + ": the checkpoint was written for other meshes or another hierarchy");
+    try {
+      matcher.check(*resume);
+    } catch (const InvalidInputError& e) {
+      throw InvalidInputError(args.checkpoint + ": " + e.what());
+    }
   }
   CoarseToFineMatcher::Checkpointing checkpointing;
   if (!args.checkpoint.empty())

@@ -940,6 +940,7 @@ TEST_CASE("coarse to fine: a run gone on from a level's checkpoint ends as the w
   o.hierarchy.ratio = 1.6;
   o.rounding.solver = "pdhg-cpu";
   o.lookahead_levels = 0;  // (with lookahead no level before the decision is a checkpoint)
+  o.inherit_widening = 2;  // so that the extra rings a level widened by carry over too
   const CoarseToFineMatcher matcher = finger_matcher(o);
   const int levels = matcher.x_levels().size();
   REQUIRE(levels >= 4);
@@ -952,6 +953,8 @@ TEST_CASE("coarse to fine: a run gone on from a level's checkpoint ends as the w
     REQUIRE(saved[k].levels.size() == k + 1);
     CHECK(saved[k].levels.back().gamma == whole.levels[k].gamma);
   }
+  // (The test carries extra rings: the last checkpoint's faces were widened.)
+  CHECK(std::count_if(saved.back().widened.begin(), saved.back().widened.end(), [](int e) { return e > 0; }) > 0);
 
   test::TempDir tmp;
   const std::string file = (tmp.path / "after.ckpt").string();
@@ -971,6 +974,7 @@ TEST_CASE("coarse to fine: a run gone on from a level's checkpoint ends as the w
     for (int l = 0; l < levels; ++l) {
       CHECK(r.levels[l].energy == doctest::Approx(whole.levels[l].energy).epsilon(1e-12));
       CHECK(r.levels[l].gamma == whole.levels[l].gamma);
+      CHECK(r.levels[l].inherited_faces == whole.levels[l].inherited_faces);
     }
     CHECK(r.rounding.energy == doctest::Approx(whole.rounding.energy).epsilon(1e-12));
     CHECK(check_graph_surface(r.finest.space, r.rounding.gamma).ok());
@@ -979,6 +983,9 @@ TEST_CASE("coarse to fine: a run gone on from a level's checkpoint ends as the w
   // Another pair's checkpoint, one that holds every level, and broken files are refused.
   const CoarseToFineMatcher other(decimate(shapes::bent_finger(10, 8, 8), 80), decimate(shapes::bent_finger(40, 8, 8), 90), o);
   CHECK_THROWS_AS(other.run({}, &saved[0]), InvalidInputError);
+  LevelCheckpoint damaged = saved[0];  // (its fingerprint intact)
+  damaged.levels[0].gamma[0].a[0] = 1 << 20;
+  CHECK_THROWS_AS(matcher.run({}, &damaged), InvalidInputError);
   LevelCheckpoint all = saved.back();
   all.levels = whole.levels;
   CHECK_THROWS_AS(matcher.run({}, &all), InvalidInputError);

@@ -86,6 +86,8 @@ run1() {
   # still ends as "timed out" with its record and checkpoint, not killed with the queue.
   local left=$((DEADLINE - $(date +%s)))
   if [ "$left" -lt 30 ]; then echo "$id not started (${left} s left)" >> log/done.txt; return; fi
+  # (The jobs that start at once all get LIMIT: --resume goes on only under a limit no shorter.)
+  [ "$left" -ge $((LIMIT - 5)) ] && left=$LIMIT
   mapfile -t margs < match_args.txt
   ./shapematch bench match --pairs "pairs/$n.txt" --faces "$FACES" --time-limit "$left" --out "out/$id" --resume -- \
     "${margs[@]}" --backend "$BACKEND" --threads "$THREADS" "${extra[@]}" > "log/$id.bench.log" 2>&1

@@ -471,11 +471,7 @@ CoarseToFineResult CoarseToFineMatcher::run(const Progress& progress, const Leve
   int decide_at = -1;
   int start = 0;
   if (resume) {
-    if (resume->hierarchy != fingerprint())
-      throw InvalidInputError("checkpoint: written for other meshes or another hierarchy");
-    if (resume->levels.empty() || int(resume->levels.size()) >= levels)
-      throw InvalidInputError("checkpoint: holds " + std::to_string(resume->levels.size()) + " levels of " +
-                              std::to_string(levels) + "; it can go on only below the finest");
+    check(*resume);
     result.levels = resume->levels;
     chains[0].gamma = resume->levels.back().gamma;
     chains[0].widened = resume->widened;
@@ -581,6 +577,30 @@ CoarseToFineResult CoarseToFineMatcher::run(const Progress& progress, const Leve
     }
   }
   return result;
+}
+
+void CoarseToFineMatcher::check(const LevelCheckpoint& c) const {
+  if (c.hierarchy != fingerprint())
+    throw InvalidInputError("the checkpoint was written for other meshes or another hierarchy");
+  const size_t done = c.levels.size();
+  if (done == 0 || done >= size_t(hx_.size()))
+    throw InvalidInputError("the checkpoint holds " + std::to_string(done) + " levels of " + std::to_string(hx_.size()) +
+                            "; a run goes on from one only below the finest");
+  // (A file damaged in place still has its fingerprint: its Γ indexes the meshes.)
+  for (size_t l = 0; l < done; ++l) {
+    const LevelReport& r = c.levels[l];
+    const Mesh& x = hx_.levels[l].mesh;
+    const Mesh& y = hy_.levels[l].mesh;
+    bool fits = r.level == int(l) && r.faces_x == x.num_faces() && r.faces_y == y.num_faces() && !r.gamma.empty();
+    for (const ProductTriangle& t : r.gamma) {
+      for (int v : t.a) fits = fits && v >= 0 && v < x.num_vertices();
+      for (int v : t.b) fits = fits && v >= 0 && v < y.num_vertices();
+      fits = fits && t.fa >= -1 && t.fa < x.num_faces() && t.fb >= -1 && t.fb < y.num_faces();
+    }
+    if (!fits) throw InvalidInputError("the checkpoint's level " + std::to_string(l + 1) + " does not fit its meshes");
+  }
+  if (!c.widened.empty() && c.widened.size() != size_t(hx_.levels[done - 1].mesh.num_faces()))
+    throw InvalidInputError("the checkpoint's extra rings do not fit its last level");
 }
 
 uint64_t CoarseToFineMatcher::fingerprint() const {

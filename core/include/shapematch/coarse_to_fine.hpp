@@ -246,6 +246,7 @@ std::vector<ProductTriangle> reduced_product_space(const MeshLevel& fine_x, cons
                                                    Neighbourhood neighbourhood,
                                                    const std::vector<int>& extra_rings = {}, int y_margin = 0);
 
+// (A new field goes into checkpoint.cpp's each_field too, so that checkpoints keep it.)
 struct LevelReport {
   int level = 0;  // 0 = coarsest
   int faces_x = 0, faces_y = 0;
@@ -327,6 +328,9 @@ public:
   // A hash of both hierarchies (every level's faces and input vertices): equal for equal inputs
   // and hierarchy options.
   uint64_t fingerprint() const;
+  // Throws InvalidInputError (one line, no file name) where `checkpoint` does not fit these
+  // hierarchies: another fingerprint, no level or every level, a Γ out of the levels' meshes.
+  void check(const LevelCheckpoint& checkpoint) const;
 
 private:
   // Level l's rounding options: the coarse tolerance below the finest level.
