@@ -459,7 +459,7 @@ std::string failure_reason(const fs::path& err_path, int wstatus) {
 // `err_path`. posix_spawn (vfork underneath) rather than fork, so that the child does not start
 // as a copy of this process and the ru_maxrss that wait4 reports is its own peak.
 ChildRun run_child(const std::vector<std::string>& args, const std::string& out_path, const std::string& err_path,
-                   double time_limit) {
+                   double time_limit, bool append_err = false) {
   static const std::string exe = fs::read_symlink("/proc/self/exe").string();
   std::vector<std::string> words{exe};
   words.insert(words.end(), args.begin(), args.end());
@@ -469,7 +469,8 @@ ChildRun run_child(const std::vector<std::string>& args, const std::string& out_
 
   posix_spawn_file_actions_t files;
   posix_spawn_file_actions_init(&files);
-  posix_spawn_file_actions_addopen(&files, STDERR_FILENO, err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  posix_spawn_file_actions_addopen(&files, STDERR_FILENO, err_path.c_str(),
+                                   O_WRONLY | O_CREAT | (append_err ? O_APPEND : O_TRUNC), 0644);
   if (out_path.empty())
     posix_spawn_file_actions_adddup2(&files, STDERR_FILENO, STDOUT_FILENO);
   else
@@ -587,7 +588,9 @@ void run_match_child(const BenchMatchArgs& args, const std::string& x, const std
   // changes no Γ), unless the match options say how.
   if (args.jobs > 1 && std::find(cmd.begin(), cmd.end(), "--threads") == cmd.end())
     cmd.insert(cmd.end(), {"--threads", std::to_string(threads_per_job(args))});
-  row.run = run_child(cmd, "", dir.string() + ".match.log", args.time_limit);
+  // Going on from a checkpoint, the log goes on too: the levels it holds were logged before.
+  const bool going_on = !checkpoint.empty() && fs::exists(checkpoint);
+  row.run = run_child(cmd, "", dir.string() + ".match.log", args.time_limit, going_on);
   if (row.run.status != "ok") return;
   try {
     read_report(dir, row);

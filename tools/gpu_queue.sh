@@ -90,7 +90,7 @@ run1() {
   [ "$left" -ge $((LIMIT - 5)) ] && left=$LIMIT
   mapfile -t margs < match_args.txt
   ./shapematch bench match --pairs "pairs/$n.txt" --faces "$FACES" --time-limit "$left" --out "out/$id" --resume -- \
-    "${margs[@]}" --backend "$BACKEND" --threads "$THREADS" "${extra[@]}" > "log/$id.bench.log" 2>&1
+    "${margs[@]}" --backend "$BACKEND" --threads "$THREADS" "${extra[@]}" >> "log/$id.bench.log" 2>&1
   echo "$id exit $? at $(date +%T)" >> log/done.txt
 }
 export -f run1
