@@ -870,6 +870,16 @@ void write_run_record(const fs::path& dir, const std::vector<std::string>& match
   write_file_atomic(dir.string() + ".run.json", record.dump() + "\n");
 }
 
+// A match command less its `--threads N`: the count changes no Γ (the CPU kernels split their work
+// in fixed chunks), so a run goes on or keeps its row under another share of the CPUs.
+std::vector<std::string> without_threads(std::vector<std::string> cmd) {
+  for (size_t i = 0; i < cmd.size();)
+    if (cmd[i] == "--threads" && i + 1 < cmd.size()) cmd.erase(cmd.begin() + i, cmd.begin() + i + 2);
+    else if (cmd[i].rfind("--threads=", 0) == 0) cmd.erase(cmd.begin() + i);
+    else ++i;
+  return cmd;
+}
+
 // The levels a pair's checkpoint holds (match --checkpoint); 0 where there is none, or one that
 // does not read back (the run then starts afresh and replaces it).
 int checkpoint_levels(const fs::path& checkpoint) {
@@ -898,7 +908,8 @@ bool resume_row(const BenchMatchArgs& args, const PairSpec& pair, const std::vec
   }
   try {
     const JsonNode record = read_json_file(path);
-    if (strings_of(record.get("match")) != match || strings_of(record.get("truth")) != pair.truth) {
+    if (without_threads(strings_of(record.get("match"))) != without_threads(match) ||
+        strings_of(record.get("truth")) != pair.truth) {
       spdlog::info("{}: the recorded run had other options; running it again", row.name);
       fs::remove(checkpoint);
       return false;

@@ -386,6 +386,10 @@ TEST_CASE("cli: bench match --pairs --resume reuses the rows of finished runs of
     CHECK(again.at("point_orientation_flips") == first.at("point_orientation_flips"));
     CHECK(read_text(err).find("resumed") != std::string::npos);
   }
+  SUBCASE("another --threads: the recorded row (the count changes no Γ)") {
+    REQUIRE(run_cli(bench + " --faces 20 --resume -- --backend cpu --threads 2", err) == 0);
+    CHECK(std::stod(row().at("seconds")) == 12345);
+  }
   SUBCASE("a list that grew: the pair keeps its row wherever its line went") {
     std::ofstream(dir / "pairs.txt") << y << " " << x << " identity\n" << x << " " << y << " identity\n";
     REQUIRE(run_cli(bench + " --faces 20 --resume -- --backend cpu", err) == 0);
