@@ -994,32 +994,29 @@ int run_bench_pairs(const BenchMatchArgs& asked) {
       spdlog::info("pair {} of {}: {} (resumed from {}.run.json)", i + 1, pairs.size(), row.name, dirs[i].string());
     } else {
       spdlog::info("pair {} of {}: {}", i + 1, pairs.size(), row.name);
-      if (args.resume) {  // with a checkpoint, so that a run stopped in a fine level loses only that level
-        const fs::path checkpoint = dirs[i].string() + ".ckpt";
-        int before = checkpoint_levels(checkpoint);
-        auto attempt = [&] {
-          run_match_child(args, pair.x, pair.y, faces, dirs[i], row, checkpoint, [&] {
-            MatchRow started = row;
-            started.run.status = "started";
-            write_run_record(dirs[i], match, pair, args.time_limit, started, before);
-          });
-        };
+      // With --resume, a checkpoint, so that a run stopped in a fine level loses only that level.
+      const fs::path checkpoint = args.resume ? fs::path(dirs[i].string() + ".ckpt") : fs::path();
+      int before = args.resume ? checkpoint_levels(checkpoint) : -1;
+      auto attempt = [&] {
+        run_match_child(args, pair.x, pair.y, faces, dirs[i], row, checkpoint, [&] {
+          if (!args.resume) return;
+          MatchRow started = row;
+          started.run.status = "started";
+          write_run_record(dirs[i], match, pair, args.time_limit, started, before);
+        });
+      };
+      attempt();
+      if (before > 0 && row.run.status.rfind("failed", 0) == 0) {  // the checkpoint's fault, maybe (another build)
+        spdlog::warn("{}: failed going on from its checkpoint ({}); once more afresh", row.name, row.run.status);
+        fs::remove(checkpoint);
+        before = 0;
+        row = MatchRow{.name = row.name};
         attempt();
-        if (before > 0 && row.run.status.rfind("failed", 0) == 0) {  // the checkpoint's fault, maybe (another build)
-          spdlog::warn("{}: failed going on from its checkpoint ({}); once more afresh", row.name, row.run.status);
-          fs::remove(checkpoint);
-          before = 0;
-          row = MatchRow{.name = row.name};
-          attempt();
-        }
-        if (row.run.status == "ok") evaluate(args, pair, dirs[i], row);
-        write_run_record(dirs[i], match, pair, args.time_limit, row, before);
-        if (row.run.status == "ok") fs::remove(checkpoint);  // (a finished run needs none; after its record)
-      } else {
-        run_match_child(args, pair.x, pair.y, faces, dirs[i], row);
-        if (row.run.status == "ok") evaluate(args, pair, dirs[i], row);
-        write_run_record(dirs[i], match, pair, args.time_limit, row);
       }
+      if (row.run.status == "ok") evaluate(args, pair, dirs[i], row);
+      write_run_record(dirs[i], match, pair, args.time_limit, row, before);
+      // (A finished run needs no checkpoint; removed after its record.)
+      if (args.resume && row.run.status == "ok") fs::remove(checkpoint);
     }
     finish(i);
   };
