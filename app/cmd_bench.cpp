@@ -856,14 +856,25 @@ std::vector<std::string> strings_of(const JsonNode* node) {
 
 // Beside each pair's run: what was asked and how it ended, written once its row is final. Full
 // resolution tables take hours per list on 2 cores; --resume picks such a list up where it stopped.
-// `checkpoint_before`: the levels the pair's checkpoint held when the run started (-1: none used).
+// How far a pair's checkpoint had got: the levels it holds, then the widenings of the level in
+// progress (each started an attempt that a run gone on from it does not repeat). Levels -1: none
+// used.
+struct CheckpointProgress {
+  int levels = -1, widenings = 0;
+  auto operator<=>(const CheckpointProgress&) const = default;
+};
+
+// `checkpoint_before`: how far the pair's checkpoint had got when the run started.
 void write_run_record(const fs::path& dir, const std::vector<std::string>& match, const PairSpec& pair,
-                      double time_limit, const MatchRow& row, int checkpoint_before = -1) {
+                      double time_limit, const MatchRow& row, CheckpointProgress checkpoint_before = {}) {
   Json record = Json::object();
   record.set("match", strings_json(match));
   record.set("truth", strings_json(pair.truth));
   record.set("time_limit", time_limit);
-  if (checkpoint_before >= 0) record.set("checkpoint_levels_before", checkpoint_before);
+  if (checkpoint_before.levels >= 0) {
+    record.set("checkpoint_levels_before", checkpoint_before.levels);
+    record.set("checkpoint_widenings_before", checkpoint_before.widenings);
+  }
   record.set("status", row.run.status);
   record.set("seconds", row.run.seconds);
   record.set("peak_rss_mb", row.run.peak_rss_mb);
@@ -880,16 +891,18 @@ std::vector<std::string> without_threads(std::vector<std::string> cmd) {
   return cmd;
 }
 
-// The levels a pair's checkpoint holds (match --checkpoint); 0 where there is none, or one that
+// How far a pair's checkpoint (match --checkpoint) got; {0, 0} where there is none, or one that
 // does not read back (the run then starts afresh and replaces it).
-int checkpoint_levels(const fs::path& checkpoint) {
-  if (!fs::exists(checkpoint)) return 0;
+CheckpointProgress checkpoint_progress(const fs::path& checkpoint) {
+  if (!fs::exists(checkpoint)) return {0, 0};
   try {
-    return static_cast<int>(load_checkpoint(checkpoint.string()).levels.size());
+    const LevelCheckpoint c = load_checkpoint(checkpoint.string());
+    const LevelReport& a = c.attempt.report;
+    return {static_cast<int>(c.levels.size()), c.attempt.empty() ? 0 : a.widenings + a.local_widenings};
   } catch (const Error& e) {
     spdlog::warn("{}; starting afresh", e.what());
     fs::remove(checkpoint);
-    return 0;
+    return {0, 0};
   }
 }
 
@@ -919,11 +932,15 @@ bool resume_row(const BenchMatchArgs& args, const PairSpec& pair, const std::vec
     if (status->text == "started") return false;  // the harness was stopped during the run
     if (status->text == "timed out") {
       if (!(record.number_or_nan("time_limit") >= args.time_limit)) return false;
-      const double recorded = record.number_or_nan("checkpoint_levels_before");
-      const int before = recorded >= 0 ? static_cast<int>(recorded) : 0;
-      if (const int now = checkpoint_levels(checkpoint); now > before) {
-        spdlog::info("{}: timed out after its checkpoint went from {} to {} levels; going on from it", row.name,
-                     before, now);
+      auto recorded = [&](const char* key) {
+        const double v = record.number_or_nan(key);
+        return v >= 0 ? static_cast<int>(v) : 0;
+      };
+      const CheckpointProgress before{recorded("checkpoint_levels_before"), recorded("checkpoint_widenings_before")};
+      if (const CheckpointProgress now = checkpoint_progress(checkpoint); now > before) {
+        spdlog::info("{}: timed out after its checkpoint went from {} levels (and {} widenings of the next) to {} "
+                     "(and {}); going on from it",
+                     row.name, before.levels, before.widenings, now.levels, now.widenings);
         return false;
       }
     }
@@ -996,7 +1013,7 @@ int run_bench_pairs(const BenchMatchArgs& asked) {
       spdlog::info("pair {} of {}: {}", i + 1, pairs.size(), row.name);
       // With --resume, a checkpoint, so that a run stopped in a fine level loses only that level.
       const fs::path checkpoint = args.resume ? fs::path(dirs[i].string() + ".ckpt") : fs::path();
-      int before = args.resume ? checkpoint_levels(checkpoint) : -1;
+      CheckpointProgress before = args.resume ? checkpoint_progress(checkpoint) : CheckpointProgress{};
       auto attempt = [&] {
         run_match_child(args, pair.x, pair.y, faces, dirs[i], row, checkpoint, [&] {
           if (!args.resume) return;
@@ -1006,10 +1023,10 @@ int run_bench_pairs(const BenchMatchArgs& asked) {
         });
       };
       attempt();
-      if (before > 0 && row.run.status.rfind("failed", 0) == 0) {  // the checkpoint's fault, maybe (another build)
+      if (before.levels > 0 && row.run.status.rfind("failed", 0) == 0) {  // the checkpoint's fault, maybe (another build)
         spdlog::warn("{}: failed going on from its checkpoint ({}); once more afresh", row.name, row.run.status);
         fs::remove(checkpoint);
-        before = 0;
+        before = {0, 0};
         row = MatchRow{.name = row.name};
         attempt();
       }

@@ -209,7 +209,13 @@ int run_match(const MatchArgs& args) {
   if (!args.checkpoint.empty())
     checkpointing = [&](const LevelCheckpoint& c) {
       save_checkpoint(args.checkpoint, c);
-      spdlog::info("checkpoint after level {}: {}", c.levels.size(), args.checkpoint);
+      if (c.attempt.empty())
+        spdlog::info("checkpoint after level {}: {}", c.levels.size(), args.checkpoint);
+      else
+        spdlog::info("checkpoint in level {}, before its next attempt (ring {}, {} faces with extra rings): {}",
+                     c.levels.size() + 1, c.attempt.ring,
+                     std::count_if(c.attempt.extra.begin(), c.attempt.extra.end(), [](int e) { return e > 0; }),
+                     args.checkpoint);
     };
 
   stage.reset();

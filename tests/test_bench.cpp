@@ -1,6 +1,7 @@
 // End-to-end tests of `shapematch bench`. bench lp: the CSV has its columns and one row per solver
 // and size, the solvers agree, and the plot is made where Debian's Python has matplotlib. bench
 // match: whole match runs per size or per pair of a pairs file, where a failed pair is a row.
+#include "shapematch/coarse_to_fine.hpp"
 #include "shapematch/mesh.hpp"
 #include "shapematch/system.hpp"
 #include "test_helpers.hpp"
@@ -477,6 +478,30 @@ TEST_CASE("cli: bench match --pairs --resume goes on from where a run that timed
   REQUIRE(run_cli(bench, err) == 0);
   CHECK(row().at("status") == "timed out");
   CHECK(fs::exists(checkpoint));
+  // Nor a level further, but a widening further into the finest level: it goes on, from the
+  // attempt that widening started (one more extra ring on one face, as if it had been written).
+  int had = 0;
+  {
+    shapematch::LevelCheckpoint c = shapematch::load_checkpoint(checkpoint.string());
+    if (c.attempt.empty()) {  // (this pair's finest level widens at ring 1: the match left one)
+      c.attempt.ring = 1;
+      c.attempt.extra.assign(std::stoi(first.at("faces_x")), 0);
+      c.attempt.report.level = 2;
+    }
+    had = c.attempt.report.local_widenings + c.attempt.report.widenings;
+    c.attempt.extra[0] += 1;
+    c.attempt.local += 1;
+    c.attempt.report.local_widenings += 1;
+    shapematch::save_checkpoint(checkpoint.string(), c);
+  }
+  CHECK(read_text(record).find("\"checkpoint_widenings_before\": " + std::to_string(had)) != std::string::npos);
+  REQUIRE(run_cli(bench, err) == 0);
+  CHECK(read_text(err).find("from 2 levels (and " + std::to_string(had) + " widenings of the next) to 2 (and " +
+                            std::to_string(had + 1) + ")") != std::string::npos);
+  CHECK(read_text(log).find("level 3's widenings " + std::to_string(had + 1)) != std::string::npos);
+  CHECK(row().at("status") == "ok");
+  CHECK(row().at("resumed_after_level") == "2");
+  CHECK_FALSE(fs::exists(checkpoint));
   // Without --resume (other options, say) a checkpoint left there goes: nothing on record made it.
   REQUIRE(run_cli("bench match --pairs " + (dir / "pairs.txt").string() + " --out " + (dir / "out").string() +
                       " --faces 200 --" + options + " --ring 1",

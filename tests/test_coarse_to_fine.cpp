@@ -945,7 +945,9 @@ TEST_CASE("coarse to fine: a run gone on from a level's checkpoint ends as the w
   const int levels = matcher.x_levels().size();
   REQUIRE(levels >= 4);
   std::vector<LevelCheckpoint> saved;
-  const CoarseToFineResult whole = matcher.run({}, nullptr, [&](const LevelCheckpoint& c) { saved.push_back(c); });
+  const CoarseToFineResult whole = matcher.run({}, nullptr, [&](const LevelCheckpoint& c) {
+    if (c.attempt.empty()) saved.push_back(c);  // (attempts: the next test case)
+  });
   // One after every level but the finest, each holding the levels so far and their Γ.
   REQUIRE(saved.size() == size_t(levels - 1));
   for (size_t k = 0; k < saved.size(); ++k) {
@@ -968,7 +970,7 @@ TEST_CASE("coarse to fine: a run gone on from a level's checkpoint ends as the w
     CHECK(loaded.levels.back().second_start_kept == saved[k].levels.back().second_start_kept);
     CHECK(loaded.levels.back().gamma == saved[k].levels.back().gamma);
     int called = 0;
-    const CoarseToFineResult r = matcher.run({}, &loaded, [&](const LevelCheckpoint&) { ++called; });
+    const CoarseToFineResult r = matcher.run({}, &loaded, [&](const LevelCheckpoint& c) { called += c.attempt.empty(); });
     CHECK(called == levels - 1 - int(k + 1));
     REQUIRE(r.levels.size() == whole.levels.size());
     for (int l = 0; l < levels; ++l) {
@@ -996,4 +998,83 @@ TEST_CASE("coarse to fine: a run gone on from a level's checkpoint ends as the w
   std::ofstream(file) << "OFF\n3 1 0\n";
   CHECK_THROWS_AS(load_checkpoint(file), IoError);
   CHECK_THROWS_AS(load_checkpoint((tmp.path / "missing.ckpt").string()), IoError);
+}
+
+TEST_CASE("coarse to fine: a run gone on from an attempt of a level in progress starts in its widened space") {
+  CoarseToFineOptions o;
+  o.hierarchy.coarsest_faces = 12;
+  o.hierarchy.second_faces = 24;
+  o.hierarchy.ratio = 1.6;
+  o.rounding.solver = "pdhg-cpu";
+  o.lookahead_levels = 0;
+  o.inherit_widening = 2;
+  o.ring = 0;  // so that the finest level widens
+  o.price_widenings = 0;  // (after a pricing the next LP starts warm, which a checkpoint does not keep)
+  const CoarseToFineMatcher matcher = finger_matcher(o);
+  const int levels = matcher.x_levels().size();
+  std::vector<LevelCheckpoint> attempts;
+  const CoarseToFineResult whole = matcher.run({}, nullptr, [&](const LevelCheckpoint& c) {
+    if (!c.attempt.empty()) attempts.push_back(c);
+  });
+  REQUIRE_FALSE(attempts.empty());
+  // The last attempt of the finest level, where it widened: every level below it done.
+  const LevelCheckpoint& last = attempts.back();
+  REQUIRE(last.levels.size() == size_t(levels - 1));
+  const LevelAttempt& a = last.attempt;
+  CHECK(a.report.level == levels - 1);
+  CHECK(a.report.local_widenings + a.report.widenings > 0);
+  CHECK(std::count_if(a.extra.begin(), a.extra.end(), [](int e) { return e > 0; }) > 0);
+
+  test::TempDir tmp;
+  const std::string file = (tmp.path / "attempt.ckpt").string();
+  save_checkpoint(file, last);
+  const LevelCheckpoint loaded = load_checkpoint(file);
+  CHECK(loaded.attempt.ring == a.ring);
+  CHECK(loaded.attempt.extra == a.extra);
+  CHECK(loaded.attempt.local == a.local);
+  CHECK(loaded.attempt.propagated == a.propagated);
+  CHECK(loaded.attempt.report.widened_faces == a.report.widened_faces);
+  int more = 0;
+  const CoarseToFineResult r = matcher.run({}, &loaded, [&](const LevelCheckpoint& c) { more += !c.attempt.empty(); });
+  CHECK(more == 0);  // the whole run's last attempt was the one that finished
+  REQUIRE(r.levels.size() == whole.levels.size());
+  const LevelReport& finest = r.levels.back();
+  CHECK(finest.variables == whole.levels.back().variables);  // straight into the widened space
+  CHECK(finest.local_widenings == whole.levels.back().local_widenings);
+  CHECK(finest.widened_faces == whole.levels.back().widened_faces);
+  CHECK(finest.energy == doctest::Approx(whole.levels.back().energy).epsilon(1e-12));
+  CHECK(finest.gamma == whole.levels.back().gamma);
+  CHECK(check_graph_surface(r.finest.space, r.rounding.gamma).ok());
+
+  // Without its attempt, the same checkpoint widens again from the coarser Γ.
+  LevelCheckpoint before = last;
+  before.attempt = {};
+  const CoarseToFineResult again = matcher.run({}, &before);
+  CHECK(again.levels.back().energy == doctest::Approx(whole.levels.back().energy).epsilon(1e-12));
+
+  // An attempt that does not fit its level is refused.
+  LevelCheckpoint wrong = last;
+  wrong.attempt.extra.pop_back();
+  CHECK_THROWS_AS(matcher.run({}, &wrong), InvalidInputError);
+  wrong = last;
+  wrong.attempt.report.level = 0;
+  CHECK_THROWS_AS(matcher.run({}, &wrong), InvalidInputError);
+  // A file of the first version (no attempt) still loads: written by hand from this one's bytes.
+  save_checkpoint(file, before);
+  std::string bytes;
+  {
+    std::ifstream in(file, std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  const size_t at = std::string("shapematch level checkpoint\n").size();
+  REQUIRE(bytes[at] == 2);
+  bytes[at] = 1;
+  bytes.pop_back();  // the "no attempt" flag
+  std::ofstream(file, std::ios::binary) << bytes;
+  const LevelCheckpoint v1 = load_checkpoint(file);
+  CHECK(v1.attempt.empty());
+  CHECK(v1.levels.size() == before.levels.size());
+  bytes[at] = 3;
+  std::ofstream(file, std::ios::binary) << bytes;
+  CHECK_THROWS_AS(load_checkpoint(file), IoError);
 }

@@ -13,7 +13,8 @@ namespace shapematch {
 namespace {
 
 constexpr char kMagic[] = "shapematch level checkpoint\n";
-constexpr uint32_t kVersion = 1;
+// 2: the attempt of the level in progress (LevelAttempt) follows the extra rings; 1 is read too.
+constexpr uint32_t kVersion = 2;
 
 // Every number of a report, in the file's order (the Γ follows on its own). A field added to
 // LevelReport goes here too, with kVersion one higher; the size check below is the reminder.
@@ -105,6 +106,14 @@ void save_checkpoint(const std::string& path, const LevelCheckpoint& c) {
       w.array(r.gamma);
     }
     w.array(c.widened);
+    w(!c.attempt.empty());
+    if (!c.attempt.empty()) {
+      const LevelAttempt& a = c.attempt;
+      w(a.ring), w(a.local), w(a.propagated), w(a.priced), w(a.regional_done), w(a.around_done);
+      w(a.suspicions), w(a.trusted);
+      each_field(a.report, w);
+      w.array(a.extra);
+    }
   });
 }
 
@@ -119,8 +128,8 @@ LevelCheckpoint load_checkpoint(const std::string& path) {
   r.take(magic.data(), magic.size());
   uint32_t version = 0;
   r(version);
-  if (version != kVersion)
-    throw IoError(path + ": checkpoint version " + std::to_string(version) + ", this build reads " +
+  if (version < 1 || version > kVersion)
+    throw IoError(path + ": checkpoint version " + std::to_string(version) + ", this build reads 1 to " +
                   std::to_string(kVersion));
   LevelCheckpoint c;
   r(c.hierarchy);
@@ -133,6 +142,16 @@ LevelCheckpoint load_checkpoint(const std::string& path) {
     r.array(rep.gamma);
   }
   r.array(c.widened);
+  bool attempt = false;
+  if (version >= 2) r(attempt);
+  if (attempt) {
+    LevelAttempt& a = c.attempt;
+    r(a.ring), r(a.local), r(a.propagated), r(a.priced), r(a.regional_done), r(a.around_done);
+    r(a.suspicions), r(a.trusted);
+    each_field(a.report, r);
+    r.array(a.extra);
+    if (a.ring < 0) throw IoError(path + ": not a shapematch checkpoint (an attempt at ring " + std::to_string(a.ring) + ")");
+  }
   if (!r.done()) throw IoError(path + ": trailing bytes after the checkpoint");
   return c;
 }

@@ -476,8 +476,12 @@ CoarseToFineResult CoarseToFineMatcher::run(const Progress& progress, const Leve
     chains[0].gamma = resume->levels.back().gamma;
     chains[0].widened = resume->widened;
     start = static_cast<int>(resume->levels.size());
-    spdlog::info("going on from a checkpoint after level {} of {} (energy {:.6g})", start, levels,
-                 resume->levels.back().energy);
+    spdlog::info("going on from a checkpoint after level {} of {} (energy {:.6g}){}", start, levels,
+                 resume->levels.back().energy,
+                 resume->attempt.empty() ? std::string()
+                                         : fmt::format(", level {}'s widenings {}", start + 1,
+                                                       resume->attempt.report.local_widenings +
+                                                           resume->attempt.report.widenings));
   }
   for (int l = start; l < levels; ++l) {
     const MeshLevel& lx = hx_.levels[l];
@@ -497,10 +501,17 @@ CoarseToFineResult CoarseToFineMatcher::run(const Progress& progress, const Leve
     const bool second_start = l == 1 && second_level_;
     std::vector<Chain> next;
     std::exception_ptr failure;
+    // Each attempt of a level after the first is a checkpoint where a single chain goes on.
+    const LevelAttempt* attempt = resume && l == start && !resume->attempt.empty() ? &resume->attempt : nullptr;
+    std::function<void(const LevelAttempt&)> attempted;
+    if (checkpoint && chains.size() == 1)
+      attempted = [&](const LevelAttempt& a) {
+        checkpoint(LevelCheckpoint{fingerprint(), result.levels, chains.front().widened, a});
+      };
     for (Chain& c : chains) {
       LevelReport rep = header;
       try {
-        solve_refined(l, model, rep, c.gamma, result, progress, c.widened);
+        solve_refined(l, model, rep, c.gamma, result, progress, c.widened, attempt, attempted);
       } catch (const InfeasibleError& e) {
         if (!second_start && chains.size() == 1) throw;
         spdlog::warn("level {}: no Γ in the refined space ({}); {}", l + 1, e.what(),
@@ -601,6 +612,11 @@ void CoarseToFineMatcher::check(const LevelCheckpoint& c) const {
   }
   if (!c.widened.empty() && c.widened.size() != size_t(hx_.levels[done - 1].mesh.num_faces()))
     throw InvalidInputError("the checkpoint's extra rings do not fit its last level");
+  const LevelAttempt& a = c.attempt;
+  if (!a.empty() && (a.extra.size() != size_t(hx_.levels[done].mesh.num_faces()) || a.ring > 64 ||
+                     std::any_of(a.extra.begin(), a.extra.end(), [](int e) { return e < 0 || e > 64; }) ||
+                     a.report.level != int(done)))
+    throw InvalidInputError("the checkpoint's attempt of level " + std::to_string(done + 1) + " does not fit it");
 }
 
 uint64_t CoarseToFineMatcher::fingerprint() const {
@@ -754,13 +770,17 @@ RoundingOptions CoarseToFineMatcher::rounding_for(int l) const {
 
 void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelReport& rep,
                                         std::vector<ProductTriangle>& gamma, CoarseToFineResult& result,
-                                        const Progress& progress, std::vector<int>& widened) const {
+                                        const Progress& progress, std::vector<int>& widened,
+                                        const LevelAttempt* resume,
+                                        const std::function<void(const LevelAttempt&)>& attempted) const {
   const MeshLevel& lx = hx_.levels[l];
   const MeshLevel& ly = hy_.levels[l];
   const int base_ring = ring_at(l);
   std::vector<int> extra;  // local widening: more fine rings per fine X face
-  if (l > 0 && options_.inherit_widening > 0 && options_.local_widening &&
-      widened.size() == size_t(hx_.levels[l - 1].mesh.num_faces())) {
+  if (resume) {  // (its extra rings include those inherited)
+    extra = resume->extra;
+  } else if (l > 0 && options_.inherit_widening > 0 && options_.local_widening &&
+             widened.size() == size_t(hx_.levels[l - 1].mesh.num_faces())) {
     extra.assign(lx.mesh.num_faces(), 0);
     for (int f = 0; f < lx.mesh.num_faces(); ++f) {
       const int e = std::min({widened[lx.parent_face[f]], options_.inherit_widening,
@@ -777,6 +797,22 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
   detail::SuspicionCount suspicions(options_.max_suspected_widenings);
   bool regional_done = false;
   bool around_done = false;
+  int priced = 0;
+  // Widenings where propagation found the conflict have a budget of their own
+  // (max_propagation_widenings): they cost a rebuild, not an LP.
+  int propagated = 0;
+  if (resume) {
+    rep = resume->report;
+    ring = resume->ring;
+    local = resume->local;
+    propagated = resume->propagated;
+    priced = resume->priced;
+    regional_done = resume->regional_done;
+    around_done = resume->around_done;
+    suspicions.restore(resume->suspicions, resume->trusted);
+    spdlog::info("level {}: going on from its checkpointed attempt: ring {}, {} faces with extra rings", l + 1, ring,
+                 std::count_if(extra.begin(), extra.end(), [](int e) { return e > 0; }));
+  }
   CarriedIterate warm;  // the last attempt's first LP, for the next
   // With stuck_carry, where rounding got stuck (StuckError) and the space widened around it: its
   // fixings to 1 (by key), except those over the X faces just widened, go on in the widened
@@ -792,14 +828,10 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
   double cold_seconds = 0.0, reference_seconds = 0.0;
   // Pricing (price_widenings): the first LP's iterate, and after a widening it called for, the
   // same kept by identity to start the widened LP from (it was optimal, unlike after divergence).
-  int priced = 0;
   std::vector<double> first_x, first_y;
   double first_omega = 0.0;
   CarriedIterate priced_from;
   bool price_warm = false;
-  // Widenings where propagation found the conflict have a budget of their own
-  // (max_propagation_widenings): they cost a rebuild, not an LP.
-  int propagated = 0;
   bool propagating = false;
   detail::RecurringConflicts recurring;  // π rows where propagation failed, by face
   // One more fine ring on these faces (up to `cap` rings); false if none could grow. `last`: the
@@ -890,7 +922,23 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
                  l + 1, p.columns, p.below, p.threshold, p.lowest, p.noise, p.faces.size(), clock.seconds());
     return !p.faces.empty() && widen_locally(p.faces, "cutting off columns that price below zero", options_.max_ring);
   };
-  for (;;) {
+  for (bool first_attempt = true;; first_attempt = false) {
+    if (!first_attempt && attempted && l > 0) {
+      LevelAttempt a;
+      a.ring = ring;
+      a.extra = extra;
+      a.extra.resize(lx.mesh.num_faces(), 0);
+      a.local = local;
+      a.propagated = propagated;
+      a.priced = priced;
+      a.regional_done = regional_done;
+      a.around_done = around_done;
+      a.suspicions = suspicions.count();
+      a.trusted = suspicions.trusted();
+      a.report = rep;
+      a.report.gamma.clear();
+      attempted(a);
+    }
     MatchingLp m;
     if (l == 0) {
       m = build_matching_lp(ProductSpace::full(lx.mesh, ly.mesh), model, options_.matching.scale_costs);

@@ -46,6 +46,11 @@ public:
   }
   // A suspicion with nothing left to widen locally: the next first LP waits for a proof.
   void distrust() { trusted_ = false; }
+  // The state a checkpointed attempt left (LevelAttempt).
+  void restore(int count, bool trusted) {
+    count_ = count;
+    trusted_ = trusted;
+  }
 
 private:
   int limit_;  // 0: no limit

@@ -293,14 +293,31 @@ struct CoarseToFineResult {
   RoundingResult rounding;  // the finest level's rounding
 };
 
+// Where the level in progress had widened to when its last attempt started: a run gone on from
+// it starts that level in the same space with the same widening budgets left, instead of
+// widening again from the coarser Γ (measured, FAUST_r 065-069 at full resolution on the H200:
+// 275 of the finest level's 375 s went to attempts that widened and started again).
+struct LevelAttempt {
+  int ring = -1;                 // -1: no level in progress
+  std::vector<int> extra;        // extra fine rings per X face of the level in progress
+  int local = 0, propagated = 0, priced = 0;  // widenings spent of max_local_widenings, …
+  bool regional_done = false, around_done = false;
+  int suspicions = 0;            // diverging first LPs in a row, and whether the watch is trusted
+  bool trusted = true;
+  LevelReport report;            // its counts so far (widenings, widened faces, …); no Γ
+  bool empty() const { return ring < 0; }
+};
+
 // The state between two levels, so that a run can stop after a level and another go on from it
 // (match --checkpoint): the reports of the levels done, the last one's Γ being what the next
 // refines, and that level's extra rings per X face (inherit_widening). Only a level after which
-// a single chain goes on is a checkpoint (not inside lookahead), and never the finest.
+// a single chain goes on is a checkpoint (not inside lookahead), and never the finest. Each new
+// attempt of the next level (a widening) updates `attempt`, the finest level's too.
 struct LevelCheckpoint {
   uint64_t hierarchy = 0;          // CoarseToFineMatcher::fingerprint() of the run that wrote it
   std::vector<LevelReport> levels; // levels 0 … levels.size() - 1, done
   std::vector<int> widened;
+  LevelAttempt attempt;            // of level levels.size(), where one is in progress
 };
 // Binary, versioned. save: atomically (files.hpp); load: IoError naming the file where it is
 // missing, not a checkpoint, or cut short.
@@ -341,8 +358,12 @@ private:
   // infeasible; throws InfeasibleError when the largest ring is. Replaces `gamma` with level l's.
   // `widened`: on entry the coarser level's extra rings per X face (inherit_widening; empty:
   // none), on return this level's.
+  // `resume`: an attempt of this level to start from (null: none); `attempted`: called before
+  // every attempt after the first, with the state it starts from.
   void solve_refined(int l, const EnergyModel& model, LevelReport& rep, std::vector<ProductTriangle>& gamma,
-                     CoarseToFineResult& result, const Progress& progress, std::vector<int>& widened) const;
+                     CoarseToFineResult& result, const Progress& progress, std::vector<int>& widened,
+                     const LevelAttempt* resume = nullptr,
+                     const std::function<void(const LevelAttempt&)>& attempted = {}) const;
   // The second start at level l: the full product space, rounded. Fills `rep` (a copy of the
   // level's, with the second start's numbers), `gamma`, and at the finest level `finest`'s LP
   // and rounding; false where it found no Γ.
