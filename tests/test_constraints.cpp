@@ -161,3 +161,52 @@ TEST_CASE("constraints: the sorted index ranks every key as lower_bound does") {
   }
 }
 
+
+TEST_CASE("constraints: the key bitmap sorts, deduplicates and ranks as sort, unique and lower_bound do") {
+  std::mt19937_64 rng(5);
+  for (const int64_t universe : {int64_t(1), int64_t(63), int64_t(64), int64_t(65), int64_t(1000), int64_t(1) << 22}) {
+    for (const int64_t n : {0, 1, 5, 1000, 50000}) {
+      std::vector<int64_t> keys(n);
+      for (int64_t& k : keys) k = int64_t(rng() % uint64_t(universe));
+      if (n > 0) keys[0] = universe - 1;  // the last id in range
+      const detail::KeyBitmap bitmap(keys, universe);
+      std::vector<int64_t> want = keys;
+      std::sort(want.begin(), want.end());
+      want.erase(std::unique(want.begin(), want.end()), want.end());
+      CHECK(bitmap.size() == int64_t(want.size()));
+      CHECK(bitmap.sorted() == want);
+      for (int64_t k : keys)
+        if (bitmap.rank(k) != std::lower_bound(want.begin(), want.end(), k) - want.begin())
+          FAIL_CHECK("universe ", universe, " n ", n, " key ", k);
+    }
+  }
+}
+
+TEST_CASE("constraints: a reduced space gives the same rows by the bitmap as by sorting") {
+  // Both paths: a space of every third variable of the full one (bitmap: the universe is small
+  // against it) and one of a few variables (sorting).
+  const Mesh x = shapes::icosphere(1);
+  const Mesh y = test::deformed(x, [](const Eigen::Vector3d& p) { return Eigen::Vector3d(1.2 * p.x(), p.y(), p.z()); });
+  const ProductSpace full = ProductSpace::full(x, y);
+  for (const int64_t stride : {int64_t(3), int64_t(997)}) {
+    std::vector<ProductTriangle> some;
+    for (int64_t j = 0; j < full.size(); j += stride) some.push_back(full[j]);
+    const ConstraintSystem cs = build_constraints(ProductSpace::from_list(x, y, some));
+    // Every closedness row is a product edge touched, in id order, and every entry of Aᵀ names
+    // the row of its edge.
+    CHECK(std::is_sorted(cs.row_edge.begin(), cs.row_edge.end()));
+    CHECK(std::adjacent_find(cs.row_edge.begin(), cs.row_edge.end()) == cs.row_edge.end());
+    const ConstraintSystem whole = build_constraints(full);
+    for (int64_t j = 0; j < int64_t(some.size()); ++j) {
+      const int64_t jf = j * stride;
+      for (int i = 0; i < 3; ++i) {
+        const uint32_t e = cs.at.entry[cs.at.row_ptr[j] + i], ef = whole.at.entry[whole.at.row_ptr[jf] + i];
+        const int64_t row = col_of(e), row_full = col_of(ef);
+        REQUIRE(row < cs.closedness_rows);
+        CHECK(cs.row_edge[row] == whole.row_edge[row_full]);  // the same product edge
+        CHECK(is_negative(e) == is_negative(ef));
+      }
+    }
+    CHECK(cs.closedness_rows < whole.closedness_rows);
+  }
+}
