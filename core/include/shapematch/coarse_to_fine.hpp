@@ -346,7 +346,8 @@ public:
   // and hierarchy options.
   uint64_t fingerprint() const;
   // Throws InvalidInputError (one line, no file name) where `checkpoint` does not fit these
-  // hierarchies: another fingerprint, no level or every level, a Γ out of the levels' meshes.
+  // hierarchies: another fingerprint, no level or every level, a Γ out of the levels' meshes, an
+  // attempt whose extra rings or level are not those of the level after them.
   void check(const LevelCheckpoint& checkpoint) const;
 
 private:
