@@ -33,6 +33,16 @@ CoarseToFineOptions two_levels(int coarsest_faces) {
   return o;
 }
 
+// Levels of 12, 24, ~38 … faces up to the shapes' own (four or five on the test pairs), CPU PDHG.
+CoarseToFineOptions small_levels() {
+  CoarseToFineOptions o;
+  o.hierarchy.coarsest_faces = 12;
+  o.hierarchy.second_faces = 24;
+  o.hierarchy.ratio = 1.6;
+  o.rounding.solver = "pdhg-cpu";
+  return o;
+}
+
 // The finger straight and bent, decimated to different triangulations.
 CoarseToFineMatcher finger_matcher(const CoarseToFineOptions& o) {
   return CoarseToFineMatcher(decimate(shapes::bent_finger(10, 8, 8), 80), decimate(shapes::bent_finger(60, 8, 8), 90), o);
@@ -626,11 +636,7 @@ TEST_CASE("coarse to fine: lookahead refines both Γ of the second level and kee
   // the same Γ there and went on as one).
   const Mesh dx = decimate(shapes::dolphin(20, 0), 80), dy = decimate(shapes::dolphin(-20, 40), 90);
   auto dolphin_matcher = [&](const CoarseToFineOptions& options) { return CoarseToFineMatcher(dx, dy, options); };
-  CoarseToFineOptions o;
-  o.hierarchy.coarsest_faces = 12;
-  o.hierarchy.second_faces = 24;
-  o.hierarchy.ratio = 1.6;
-  o.rounding.solver = "pdhg-cpu";
+  CoarseToFineOptions o = small_levels();
   o.lookahead_levels = 0;
   const CoarseToFineMatcher plain_matcher = dolphin_matcher(o);  // decided at the second level
   REQUIRE(plain_matcher.x_levels().size() == 5);
@@ -670,11 +676,7 @@ TEST_CASE("coarse to fine: lookahead refines both Γ of the second level and kee
 TEST_CASE("coarse to fine: two lookahead chains that reach the same Γ go on as one, with the same result") {
   // A shape against itself: the second start and the refined chain both find the identity at the
   // second level, so lookahead has nothing to compare there or above.
-  CoarseToFineOptions o;
-  o.hierarchy.coarsest_faces = 12;
-  o.hierarchy.second_faces = 24;
-  o.hierarchy.ratio = 1.6;
-  o.rounding.solver = "pdhg-cpu";
+  CoarseToFineOptions o = small_levels();
   const Mesh finger = decimate(shapes::bent_finger(30, 8, 8), 80);
   o.lookahead_levels = 0;
   const CoarseToFineMatcher plain_matcher(finger, finger, o);
@@ -934,11 +936,7 @@ TEST_CASE("coarse to fine: after N suspicions in a row the watch is off until a 
 }
 
 TEST_CASE("coarse to fine: a run gone on from a level's checkpoint ends as the whole run") {
-  CoarseToFineOptions o;
-  o.hierarchy.coarsest_faces = 12;
-  o.hierarchy.second_faces = 24;
-  o.hierarchy.ratio = 1.6;
-  o.rounding.solver = "pdhg-cpu";
+  CoarseToFineOptions o = small_levels();
   o.lookahead_levels = 0;  // (with lookahead no level before the decision is a checkpoint)
   o.inherit_widening = 2;  // so that the extra rings a level widened by carry over too
   const CoarseToFineMatcher matcher = finger_matcher(o);
@@ -1001,11 +999,7 @@ TEST_CASE("coarse to fine: a run gone on from a level's checkpoint ends as the w
 }
 
 TEST_CASE("coarse to fine: a run gone on from an attempt of a level in progress starts in its widened space") {
-  CoarseToFineOptions o;
-  o.hierarchy.coarsest_faces = 12;
-  o.hierarchy.second_faces = 24;
-  o.hierarchy.ratio = 1.6;
-  o.rounding.solver = "pdhg-cpu";
+  CoarseToFineOptions o = small_levels();
   o.lookahead_levels = 0;
   o.inherit_widening = 2;
   o.ring = 0;  // so that the finest level widens
