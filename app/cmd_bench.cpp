@@ -1013,6 +1013,12 @@ int run_bench_pairs(const BenchMatchArgs& asked) {
       spdlog::info("pair {} of {}: {}", i + 1, pairs.size(), row.name);
       // With --resume, a checkpoint, so that a run stopped in a fine level loses only that level.
       const fs::path checkpoint = args.resume ? fs::path(dirs[i].string() + ".ckpt") : fs::path();
+      // A run killed while saving its checkpoint leaves the temporary file (files.hpp, one per
+      // process id): nothing reads it, so it goes before the next run.
+      if (std::error_code ec; fs::is_directory(dirs[i].parent_path(), ec))
+        for (const auto& entry : fs::directory_iterator(dirs[i].parent_path(), ec))
+          if (entry.path().filename().string().rfind(dirs[i].filename().string() + ".ckpt.tmp-", 0) == 0)
+            fs::remove(entry.path(), ec);
       CheckpointProgress before = args.resume ? checkpoint_progress(checkpoint) : CheckpointProgress{};
       auto attempt = [&] {
         run_match_child(args, pair.x, pair.y, faces, dirs[i], row, checkpoint, [&] {

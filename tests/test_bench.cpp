@@ -446,9 +446,13 @@ TEST_CASE("cli: bench match --pairs --resume goes on from where a run that timed
   CHECK(first.at("resumed_after_level") == "0");
 
   // The harness stopped during a run ("started"), its checkpoint unreadable: the pair runs afresh.
+  // (Killed while saving it, too: the temporary file it left goes.)
   edit_record("status", "\"started\"");
   std::ofstream(checkpoint) << "not a checkpoint";
+  const fs::path left = checkpoint.string() + ".tmp-12345";
+  std::ofstream(left) << "half a checkpoint";
   REQUIRE(run_cli(bench, err) == 0);
+  CHECK_FALSE(fs::exists(left));
   CHECK(read_text(err).find("not a shapematch checkpoint") != std::string::npos);
   CHECK(row().at("status") == "ok");
   CHECK(row().at("resumed_after_level") == "0");
