@@ -161,7 +161,6 @@ TEST_CASE("constraints: the sorted index ranks every key as lower_bound does") {
   }
 }
 
-
 TEST_CASE("constraints: the key bitmap sorts, deduplicates and ranks as sort, unique and lower_bound do") {
   std::mt19937_64 rng(5);
   for (const int64_t universe : {int64_t(1), int64_t(63), int64_t(64), int64_t(65), int64_t(1000), int64_t(1) << 22}) {
