@@ -897,8 +897,7 @@ CheckpointProgress checkpoint_progress(const fs::path& checkpoint) {
   if (!fs::exists(checkpoint)) return {0, 0};
   try {
     const LevelCheckpoint c = load_checkpoint(checkpoint.string());
-    const LevelReport& a = c.attempt.report;
-    return {static_cast<int>(c.levels.size()), c.attempt.empty() ? 0 : a.widenings + a.local_widenings};
+    return {static_cast<int>(c.levels.size()), c.attempt.empty() ? 0 : c.attempt.widenings()};
   } catch (const Error& e) {
     spdlog::warn("{}; starting afresh", e.what());
     fs::remove(checkpoint);

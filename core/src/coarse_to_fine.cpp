@@ -480,8 +480,7 @@ CoarseToFineResult CoarseToFineMatcher::run(const Progress& progress, const Leve
                  resume->levels.back().energy,
                  resume->attempt.empty() ? std::string()
                                          : fmt::format(", level {}'s widenings {}", start + 1,
-                                                       resume->attempt.report.local_widenings +
-                                                           resume->attempt.report.widenings));
+                                                       resume->attempt.widenings()));
   }
   for (int l = start; l < levels; ++l) {
     const MeshLevel& lx = hx_.levels[l];

@@ -80,21 +80,15 @@ ConstraintSystem build_constraints(const ProductSpace& space) {
   // Closedness rows: in the full space every product edge is touched, so ids are row numbers;
   // otherwise keep only the touched ones, in id order.
   std::vector<uint32_t> edge_row(3 * n);
-  auto check_rows = [&] {
-    const int64_t m = cs.closedness_rows + X.num_faces() + Y.num_faces();
-    if (m >= (int64_t(1) << 31)) throw InvalidInputError("too many constraints: " + std::to_string(m));
-  };
   const int64_t universe = full_product_edge_count(X, Y);
   if (space.is_full()) {
     cs.closedness_rows = universe;
-    check_rows();
     cs.row_edge.resize(cs.closedness_rows);
     for (int64_t r = 0; r < cs.closedness_rows; ++r) cs.row_edge[r] = r;
     for (int64_t k = 0; k < 3 * n; ++k) edge_row[k] = static_cast<uint32_t>(edge_id[k]);
   } else if (universe / 64 <= 3 * n) {  // a bitmap no larger than the list of ids
     const detail::KeyBitmap touched(edge_id, universe);
     cs.closedness_rows = touched.size();
-    check_rows();
     cs.row_edge = touched.sorted();
     detail::parallel_for(3 * n, 0, [&](int64_t k) { edge_row[k] = static_cast<uint32_t>(touched.rank(edge_id[k])); });
   } else {
@@ -102,11 +96,11 @@ ConstraintSystem build_constraints(const ProductSpace& space) {
     detail::parallel_sort(cs.row_edge.data(), static_cast<int64_t>(cs.row_edge.size()));
     cs.row_edge.erase(std::unique(cs.row_edge.begin(), cs.row_edge.end()), cs.row_edge.end());
     cs.closedness_rows = static_cast<int64_t>(cs.row_edge.size());
-    check_rows();
     const detail::SortedIndex index(cs.row_edge);
     detail::parallel_for(3 * n, 0, [&](int64_t k) { edge_row[k] = static_cast<uint32_t>(index.rank(edge_id[k])); });
   }
   const int64_t m = cs.closedness_rows + X.num_faces() + Y.num_faces();
+  if (m >= (int64_t(1) << 31)) throw InvalidInputError("too many constraints: " + std::to_string(m));
   std::vector<int64_t>().swap(edge_id);
 
   // Aᵀ: one row per variable with its 3 closedness entries and 1–2 projection entries.

@@ -61,7 +61,7 @@ public:
     before_.back() = static_cast<uint32_t>(count);
     size_ = static_cast<int64_t>(count);
   }
-  // How many distinct keys; fewer than 2^32 (counts are 32-bit: the caller checks its bound).
+  // How many distinct keys (exact; ranks are right only below 2^32: the caller checks its bound).
   int64_t size() const { return size_; }
   // The distinct keys, ascending.
   std::vector<int64_t> sorted() const {

@@ -306,6 +306,7 @@ struct LevelAttempt {
   bool trusted = true;
   LevelReport report;            // its counts so far (widenings, widened faces, …); no Γ
   bool empty() const { return ring < 0; }
+  int widenings() const { return report.widenings + report.local_widenings; }  // so far
 };
 
 // The state between two levels, so that a run can stop after a level and another go on from it
