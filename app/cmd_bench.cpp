@@ -23,6 +23,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <barrier>
 #include <cerrno>
@@ -44,6 +45,7 @@
 #include <mutex>
 #include <set>
 #include <sstream>
+#include <string_view>
 #include <thread>
 
 namespace shapematch::app {
@@ -881,14 +883,37 @@ void write_run_record(const fs::path& dir, const std::vector<std::string>& match
   write_file_atomic(dir.string() + ".run.json", record.dump() + "\n");
 }
 
-// A match command less its `--threads N`: the count changes no Γ (the CPU kernels split their work
-// in fixed chunks), so a run goes on or keeps its row under another share of the CPUs.
-std::vector<std::string> without_threads(std::vector<std::string> cmd) {
-  for (size_t i = 0; i < cmd.size();)
-    if (cmd[i] == "--threads" && i + 1 < cmd.size()) cmd.erase(cmd.begin() + i, cmd.begin() + i + 2);
-    else if (cmd[i].rfind("--threads=", 0) == 0) cmd.erase(cmd.begin() + i);
-    else ++i;
+// What a recorded command asked for, apart from where it ran: less `--threads N` (the count
+// changes no Γ: the CPU kernels split their work in fixed chunks), `--backend` and `--device`
+// (their LPs differ only in rounding error), and with its files by name only (a list moved to
+// another machine or folder, as the device queue's is, names the same meshes and ground truth).
+std::vector<std::string> what_asked(std::vector<std::string> cmd) {
+  static constexpr std::array<std::string_view, 3> kWhere{"--threads", "--backend", "--device"};
+  for (size_t i = 0; i < cmd.size();) {
+    const std::string_view word = cmd[i];
+    const auto is = [&](std::string_view flag) {
+      return word == flag || (word.starts_with(flag) && word.size() > flag.size() && word[flag.size()] == '=');
+    };
+    const auto where = std::find_if(kWhere.begin(), kWhere.end(), is);
+    if (where == kWhere.end()) ++i;
+    else if (word == *where && i + 1 < cmd.size()) cmd.erase(cmd.begin() + i, cmd.begin() + i + 2);
+    else cmd.erase(cmd.begin() + i);
+  }
+  // `match X Y …`: the meshes; a truth list: every value (a flag's is a path, or `identity`).
+  const bool is_match = !cmd.empty() && cmd[0] == "match";
+  for (size_t i = 0; i < cmd.size(); ++i)
+    if (is_match ? (i == 1 || i == 2) : !cmd[i].starts_with("--")) cmd[i] = fs::path(cmd[i]).filename().string();
   return cmd;
+}
+
+// `--backend` and `--device` as given (empty where not).
+std::vector<std::string> where_run(const std::vector<std::string>& cmd) {
+  std::vector<std::string> where;
+  for (size_t i = 0; i < cmd.size(); ++i)
+    for (const char* flag : {"--backend", "--device"})
+      if (cmd[i] == flag && i + 1 < cmd.size()) where.insert(where.end(), {cmd[i], cmd[i + 1]});
+      else if (cmd[i].starts_with(std::string(flag) + "=")) where.push_back(cmd[i]);
+  return where;
 }
 
 // How far a pair's checkpoint (match --checkpoint) got; {0, 0} where there is none, or one that
@@ -920,8 +945,9 @@ bool resume_row(const BenchMatchArgs& args, const PairSpec& pair, const std::vec
   }
   try {
     const JsonNode record = read_json_file(path);
-    if (without_threads(strings_of(record.get("match"))) != without_threads(match) ||
-        strings_of(record.get("truth")) != pair.truth) {
+    const std::vector<std::string> recorded_match = strings_of(record.get("match"));
+    if (what_asked(recorded_match) != what_asked(match) ||
+        what_asked(strings_of(record.get("truth"))) != what_asked(pair.truth)) {
       spdlog::info("{}: the recorded run had other options; running it again", row.name);
       fs::remove(checkpoint);
       return false;
@@ -929,6 +955,16 @@ bool resume_row(const BenchMatchArgs& args, const PairSpec& pair, const std::vec
     const JsonNode* status = record.get("status");
     if (!status || status->kind != JsonNode::Kind::String) return false;
     if (status->text == "started") return false;  // the harness was stopped during the run
+    // Another backend or device: its row is not this one's, but the levels it checkpointed are
+    // (a run that ran out of a GPU's time goes on from them on the CPU, or on another GPU).
+    if (const std::vector<std::string> was = where_run(recorded_match); was != where_run(match)) {
+      std::string elsewhere;
+      for (const std::string& word : was) elsewhere += (elsewhere.empty() ? "" : " ") + word;
+      spdlog::info("{}: the recorded run ran elsewhere ({}); running it again{}", row.name,
+                   elsewhere.empty() ? "the default backend" : elsewhere,
+                   fs::exists(checkpoint) ? ", from its checkpoint" : "");
+      return false;
+    }
     if (status->text == "timed out") {
       if (!(record.number_or_nan("time_limit") >= args.time_limit)) return false;
       auto recorded = [&](const char* key) {
@@ -1131,7 +1167,7 @@ Action add_bench_command(CLI::App& app) {
                   "pairs: reuse each pair's row where this --out already holds a finished run of the same command and "
                   "ground truth (runs/X-Y.run.json); runs keep a checkpoint (runs/X-Y.ckpt), and one that timed "
                   "out is tried again, from its checkpoint, under a longer --time-limit or where its checkpoint "
-                  "got further")
+                  "got further (or was made on another --backend or --device)")
       ->needs(match->get_option("--pairs"));
   match->add_option("--jobs", m->jobs,
                     "pairs: runs at once (a GPU machine with many cores); each match and eval gets its share of "

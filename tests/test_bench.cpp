@@ -44,6 +44,16 @@ void edit_json_field(const fs::path& file, const std::string& key, const std::st
   std::ofstream(file) << edited;
 }
 
+// Replaces every `from` in a file by `to` (a run record's paths or options).
+void replace_in_file(const fs::path& file, const std::string& from, const std::string& to) {
+  std::string text = read_text(file);
+  size_t replaced = 0;
+  for (size_t at = text.find(from); at != std::string::npos; at = text.find(from, at + to.size()), ++replaced)
+    text.replace(at, from.size(), to);
+  REQUIRE(replaced > 0);
+  std::ofstream(file) << text;
+}
+
 // One CSV record; quoted fields may hold commas (the device "cpu (Clp, 1 thread)").
 std::vector<std::string> split_csv(const std::string& line) {
   std::vector<std::string> fields(1);
@@ -391,6 +401,17 @@ TEST_CASE("cli: bench match --pairs --resume reuses the rows of finished runs of
     REQUIRE(run_cli(bench + " --faces 20 --resume -- --backend cpu --threads 2", err) == 0);
     CHECK(std::stod(row().at("seconds")) == 12345);
   }
+  SUBCASE("the same meshes and ground truth in another folder: the recorded row") {
+    replace_in_file(record, kAssets + "/", "/elsewhere/assets/");
+    REQUIRE(run_cli(bench + " --faces 20 --resume -- --backend cpu", err) == 0);
+    CHECK(std::stod(row().at("seconds")) == 12345);
+  }
+  SUBCASE("another backend: measured again (its row is not this one's)") {
+    replace_in_file(record, "\"cpu\"", "\"vulkan\"");
+    REQUIRE(run_cli(bench + " --faces 20 --resume -- --backend cpu", err) == 0);
+    CHECK(std::stod(row().at("seconds")) < 12345);
+    CHECK(read_text(err).find("ran elsewhere (--backend vulkan); running it again") != std::string::npos);
+  }
   SUBCASE("a list that grew: the pair keeps its row wherever its line went") {
     std::ofstream(dir / "pairs.txt") << y << " " << x << " identity\n" << x << " " << y << " identity\n";
     REQUIRE(run_cli(bench + " --faces 20 --resume -- --backend cpu", err) == 0);
@@ -505,6 +526,28 @@ TEST_CASE("cli: bench match --pairs --resume goes on from where a run that timed
   CHECK(read_text(log).find("level 3's widenings " + std::to_string(had + 1)) != std::string::npos);
   CHECK(row().at("status") == "ok");
   CHECK(row().at("resumed_after_level") == "2");
+  CHECK_FALSE(fs::exists(checkpoint));
+  // Stopped on another backend, in another folder (a GPU machine's queue): its checkpoint goes on
+  // here, whatever the limit.
+  fs::copy_file(dir / "saved.ckpt", checkpoint);
+  edit_record("status", "\"timed out\"");
+  edit_record("time_limit", "99999");
+  replace_in_file(record, "\"cpu\"", "\"vulkan\"");
+  replace_in_file(record, kAssets + "/", "/root/q/data/");
+  auto went_on = [&] {  // (the log goes on with the run: count)
+    const std::string text = read_text(log), line = "going on from a checkpoint after level 2 of 3";
+    int n = 0;
+    for (size_t at = text.find(line); at != std::string::npos; at = text.find(line, at + 1)) ++n;
+    return n;
+  };
+  const int went_on_before = went_on();
+  REQUIRE(run_cli(bench, err) == 0);
+  CHECK(read_text(err).find("ran elsewhere (--backend vulkan); running it again, from its checkpoint") !=
+        std::string::npos);
+  CHECK(went_on() == went_on_before + 1);
+  CHECK(row().at("status") == "ok");
+  CHECK(row().at("resumed_after_level") == "2");
+  CHECK(row().at("energy") == first.at("energy"));
   CHECK_FALSE(fs::exists(checkpoint));
   // Without --resume (other options, say) a checkpoint left there goes: nothing on record made it.
   REQUIRE(run_cli("bench match --pairs " + (dir / "pairs.txt").string() + " --out " + (dir / "out").string() +
