@@ -859,10 +859,10 @@ std::vector<std::string> strings_of(const JsonNode* node) {
 // Beside each pair's run: what was asked and how it ended, written once its row is final. Full
 // resolution tables take hours per list on 2 cores; --resume picks such a list up where it stopped.
 // How far a pair's checkpoint had got: the levels it holds, then the widenings of the level in
-// progress (each started an attempt that a run gone on from it does not repeat). Levels -1: none
-// used.
+// progress (each started an attempt that a run gone on from it does not repeat), then the rounds
+// of that attempt's rounding. Levels -1: none used.
 struct CheckpointProgress {
-  int levels = -1, widenings = 0;
+  int levels = -1, widenings = 0, rounds = 0;
   auto operator<=>(const CheckpointProgress&) const = default;
 };
 
@@ -876,6 +876,7 @@ void write_run_record(const fs::path& dir, const std::vector<std::string>& match
   if (checkpoint_before.levels >= 0) {
     record.set("checkpoint_levels_before", checkpoint_before.levels);
     record.set("checkpoint_widenings_before", checkpoint_before.widenings);
+    record.set("checkpoint_rounds_before", checkpoint_before.rounds);
   }
   record.set("status", row.run.status);
   record.set("seconds", row.run.seconds);
@@ -922,7 +923,7 @@ CheckpointProgress checkpoint_progress(const fs::path& checkpoint) {
   if (!fs::exists(checkpoint)) return {0, 0};
   try {
     const LevelCheckpoint c = load_checkpoint(checkpoint.string());
-    return {static_cast<int>(c.levels.size()), c.attempt.empty() ? 0 : c.attempt.widenings()};
+    return {static_cast<int>(c.levels.size()), c.attempt.empty() ? 0 : c.attempt.widenings(), c.attempt.rounding.rounds};
   } catch (const Error& e) {
     spdlog::warn("{}; starting afresh", e.what());
     fs::remove(checkpoint);
@@ -971,11 +972,12 @@ bool resume_row(const BenchMatchArgs& args, const PairSpec& pair, const std::vec
         const double v = record.number_or_nan(key);
         return v >= 0 ? static_cast<int>(v) : 0;
       };
-      const CheckpointProgress before{recorded("checkpoint_levels_before"), recorded("checkpoint_widenings_before")};
+      const CheckpointProgress before{recorded("checkpoint_levels_before"), recorded("checkpoint_widenings_before"),
+                                      recorded("checkpoint_rounds_before")};
       if (const CheckpointProgress now = checkpoint_progress(checkpoint); now > before) {
-        spdlog::info("{}: timed out after its checkpoint went from {} levels (and {} widenings of the next) to {} "
-                     "(and {}); going on from it",
-                     row.name, before.levels, before.widenings, now.levels, now.widenings);
+        spdlog::info("{}: timed out after its checkpoint went from {} levels (and {} widenings of the next, {} rounds "
+                     "of its rounding) to {} (and {}, {}); going on from it",
+                     row.name, before.levels, before.widenings, before.rounds, now.levels, now.widenings, now.rounds);
         return false;
       }
     }

@@ -211,6 +211,9 @@ int run_match(const MatchArgs& args) {
       save_checkpoint(args.checkpoint, c);
       if (c.attempt.empty())
         spdlog::info("checkpoint after level {}: {}", c.levels.size(), args.checkpoint);
+      else if (!c.attempt.rounding.empty())
+        spdlog::info("checkpoint in level {}'s rounding, after round {} ({} fixings to 1): {}", c.levels.size() + 1,
+                     c.attempt.rounding.rounds, c.attempt.rounding.ones.size(), args.checkpoint);
       else
         spdlog::info("checkpoint in level {}, before its next attempt (ring {}, {} faces with extra rings): {}",
                      c.levels.size() + 1, c.attempt.ring,

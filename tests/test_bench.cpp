@@ -518,14 +518,26 @@ TEST_CASE("cli: bench match --pairs --resume goes on from where a run that timed
     c.attempt.local += 1;
     c.attempt.report.local_widenings += 1;
     shapematch::save_checkpoint(checkpoint.string(), c);
+    // (Below: the same attempt a round of its rounding further, as of an LP of another size.)
+    c.attempt.rounding = {.columns = 1, .rows = 1, .rounds = 1};
+    shapematch::save_checkpoint((dir / "rounded.ckpt").string(), c);
   }
   CHECK(read_text(record).find("\"checkpoint_widenings_before\": " + std::to_string(had)) != std::string::npos);
   REQUIRE(run_cli(bench, err) == 0);
-  CHECK(read_text(err).find("from 2 levels (and " + std::to_string(had) + " widenings of the next) to 2 (and " +
-                            std::to_string(had + 1) + ")") != std::string::npos);
+  CHECK(read_text(err).find("from 2 levels (and " + std::to_string(had) + " widenings of the next, 0 rounds of its "
+                            "rounding) to 2 (and " + std::to_string(had + 1) + ", 0)") != std::string::npos);
   CHECK(read_text(log).find("level 3's widenings " + std::to_string(had + 1)) != std::string::npos);
   CHECK(row().at("status") == "ok");
   CHECK(row().at("resumed_after_level") == "2");
+  CHECK_FALSE(fs::exists(checkpoint));
+  // Nor a widening further, but a round of that attempt's rounding: it goes on (here rounding
+  // afresh: the LP it was of had another size).
+  edit_record("status", "\"timed out\"");
+  fs::copy_file(dir / "rounded.ckpt", checkpoint);
+  REQUIRE(run_cli(bench, err) == 0);
+  CHECK(read_text(err).find("to 2 (and " + std::to_string(had + 1) + ", 1); going on from it") != std::string::npos);
+  CHECK(read_text(log).find("the checkpointed rounding was of an LP of 1 × 1") != std::string::npos);
+  CHECK(row().at("status") == "ok");
   CHECK_FALSE(fs::exists(checkpoint));
   // Stopped on another backend, in another folder (a GPU machine's queue): its checkpoint goes on
   // here, whatever the limit.

@@ -1061,14 +1061,105 @@ TEST_CASE("coarse to fine: a run gone on from an attempt of a level in progress 
     bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
   }
   const size_t at = std::string("shapematch level checkpoint\n").size();
-  REQUIRE(bytes[at] == 2);
+  REQUIRE(bytes[at] == 3);
   bytes[at] = 1;
   bytes.pop_back();  // the "no attempt" flag
   std::ofstream(file, std::ios::binary) << bytes;
   const LevelCheckpoint v1 = load_checkpoint(file);
   CHECK(v1.attempt.empty());
   CHECK(v1.levels.size() == before.levels.size());
-  bytes[at] = 3;
+  bytes[at] = 4;
   std::ofstream(file, std::ios::binary) << bytes;
   CHECK_THROWS_AS(load_checkpoint(file), IoError);
+  // One of the second version (an attempt, no rounding) too: this one's less the rounds count.
+  save_checkpoint(file, last);
+  {
+    std::ifstream in(file, std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  REQUIRE(bytes.substr(bytes.size() - 4) == std::string(4, '\0'));
+  bytes.resize(bytes.size() - 4);
+  bytes[at] = 2;
+  std::ofstream(file, std::ios::binary) << bytes;
+  const LevelCheckpoint v2 = load_checkpoint(file);
+  CHECK(v2.attempt.extra == a.extra);
+  CHECK(v2.attempt.rounding.empty());
+}
+
+TEST_CASE("coarse to fine: a run gone on from a checkpoint inside a rounding fixes its decisions and keeps its bound") {
+  CoarseToFineOptions o = slow_finest_rounding();  // (a finest rounding of several rounds)
+  o.lookahead_levels = 0;
+  o.rounding.alternative_thresholds = {};  // (with them a level's rounding is not saved)
+  o.rounding_checkpoint_seconds = 0.0;     // after every round
+  const CoarseToFineMatcher matcher(fine_fingers().first, fine_fingers().second, o);
+  const int levels = matcher.x_levels().size();
+  std::vector<LevelCheckpoint> inside;
+  const CoarseToFineResult whole = matcher.run({}, nullptr, [&](const LevelCheckpoint& c) {
+    if (!c.attempt.rounding.empty() && int(c.levels.size()) == levels - 1) inside.push_back(c);
+  });
+  REQUIRE_FALSE(inside.empty());
+  const LevelReport& finest = whole.levels.back();
+  // The finest level's last attempt (the one that finished): a checkpoint after each of its rounds.
+  std::vector<LevelCheckpoint> last;
+  for (const LevelCheckpoint& c : inside)
+    if (c.attempt.widenings() == inside.back().attempt.widenings()) last.push_back(c);
+  REQUIRE(int(last.size()) == finest.rounds);
+  REQUIRE(finest.rounds >= 2);
+  for (size_t k = 0; k < last.size(); ++k) {
+    const LevelAttempt::Rounding& g = last[k].attempt.rounding;
+    CHECK(g.rounds == int(k) + 1);
+    CHECK(g.columns == finest.variables);
+    CHECK(g.rows == finest.constraints);
+    CHECK(g.lower_bound == finest.lower_bound);
+    CHECK(std::is_sorted(g.ones.begin(), g.ones.end()));
+    if (k > 0) CHECK(g.iterations > last[k - 1].attempt.rounding.iterations);
+  }
+  CHECK(last.back().attempt.rounding.iterations == finest.iterations);
+
+  // Gone on from after round 1: the same LP and bound, a Γ that keeps Theorem 1, with every
+  // decision of round 1 in it, and the rounds counted on.
+  test::TempDir tmp;
+  const std::string file = (tmp.path / "rounding.ckpt").string();
+  save_checkpoint(file, last.front());
+  const LevelCheckpoint loaded = load_checkpoint(file);
+  const LevelAttempt::Rounding& g = loaded.attempt.rounding;
+  CHECK(g.ones == last.front().attempt.rounding.ones);
+  CHECK(g.rounds == 1);
+  CHECK(g.columns == finest.variables);
+  CHECK(g.lower_bound == finest.lower_bound);
+  CHECK(g.iterations == last.front().attempt.rounding.iterations);
+  CHECK(g.reference_iterations == last.front().attempt.rounding.reference_iterations);
+  REQUIRE_FALSE(g.ones.empty());
+  int saved_again = 0;
+  const CoarseToFineResult r = matcher.run({}, &loaded, [&](const LevelCheckpoint& c) {
+    if (!c.attempt.rounding.empty()) {
+      ++saved_again;
+      CHECK(c.attempt.rounding.rounds >= 2);  // counted on from the checkpoint's
+    }
+  });
+  REQUIRE(r.levels.size() == whole.levels.size());
+  const LevelReport& on = r.levels.back();
+  CHECK(on.variables == finest.variables);
+  CHECK(on.lower_bound == finest.lower_bound);
+  CHECK(on.rounds > 1);
+  CHECK(on.rounds == 1 + int(r.rounding.rounds.size()));
+  CHECK(saved_again == int(r.rounding.rounds.size()));
+  CHECK(on.energy >= finest.lower_bound);
+  CHECK(on.gap == doctest::Approx(relative_gap(on.energy, finest.lower_bound)));
+  CHECK(check_graph_surface(r.finest.space, r.rounding.gamma).ok());
+  CHECK(satisfies_exactly(r.finest.lp, r.rounding.gamma));
+  for (int64_t j : g.ones) CHECK(std::binary_search(r.rounding.gamma.begin(), r.rounding.gamma.end(), j));
+
+  // A rounding of another LP (another build, say) is dropped: the attempt rounds afresh, as the
+  // whole run's did.
+  LevelCheckpoint other = last.front();
+  other.attempt.rounding.rows += 1;
+  const CoarseToFineResult afresh = matcher.run({}, &other);
+  CHECK(afresh.levels.back().energy == doctest::Approx(finest.energy).epsilon(1e-12));
+  CHECK(afresh.levels.back().gamma == finest.gamma);
+  CHECK(afresh.levels.back().rounds == finest.rounds);
+  // Decisions that name no column are refused.
+  LevelCheckpoint wrong = last.front();
+  wrong.attempt.rounding.ones.push_back(g.columns);
+  CHECK_THROWS_AS(matcher.run({}, &wrong), InvalidInputError);
 }

@@ -13,8 +13,9 @@ namespace shapematch {
 namespace {
 
 constexpr char kMagic[] = "shapematch level checkpoint\n";
-// 2: the attempt of the level in progress (LevelAttempt) follows the extra rings; 1 is read too.
-constexpr uint32_t kVersion = 2;
+// 2: the attempt of the level in progress (LevelAttempt) follows the extra rings. 3: its
+// rounding (LevelAttempt::Rounding) follows the attempt. 1 and 2 are read too.
+constexpr uint32_t kVersion = 3;
 
 // Every number of a report, in the file's order (the Γ follows on its own). A field added to
 // LevelReport goes here too, with kVersion one higher; the size check below is the reminder.
@@ -113,6 +114,12 @@ void save_checkpoint(const std::string& path, const LevelCheckpoint& c) {
       w(a.suspicions), w(a.trusted);
       each_field(a.report, w);
       w.array(a.extra);
+      const LevelAttempt::Rounding& g = a.rounding;
+      w(g.rounds);
+      if (!g.empty()) {
+        w(g.columns), w(g.rows), w(g.iterations), w(g.lower_bound), w(g.reference_seconds), w(g.reference_iterations);
+        w.array(g.ones);
+      }
     }
   });
 }
@@ -150,6 +157,13 @@ LevelCheckpoint load_checkpoint(const std::string& path) {
     r(a.suspicions), r(a.trusted);
     each_field(a.report, r);
     r.array(a.extra);
+    LevelAttempt::Rounding& g = a.rounding;
+    if (version >= 3) r(g.rounds);
+    if (g.rounds < 0) throw IoError(path + ": not a shapematch checkpoint (" + std::to_string(g.rounds) + " rounds)");
+    if (!g.empty()) {
+      r(g.columns), r(g.rows), r(g.iterations), r(g.lower_bound), r(g.reference_seconds), r(g.reference_iterations);
+      r.array(g.ones);
+    }
     if (a.ring < 0) throw IoError(path + ": not a shapematch checkpoint (an attempt at ring " + std::to_string(a.ring) + ")");
   }
   if (!r.done()) throw IoError(path + ": trailing bytes after the checkpoint");

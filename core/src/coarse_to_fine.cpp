@@ -616,6 +616,10 @@ void CoarseToFineMatcher::check(const LevelCheckpoint& c) const {
                      std::any_of(a.extra.begin(), a.extra.end(), [](int e) { return e < 0 || e > 64; }) ||
                      a.report.level != int(done)))
     throw InvalidInputError("the checkpoint's attempt of level " + std::to_string(done + 1) + " does not fit it");
+  const LevelAttempt::Rounding& g = a.rounding;
+  if (!g.empty() && (a.empty() || g.columns <= 0 || g.rows <= 0 || g.iterations < 0 ||
+                     std::any_of(g.ones.begin(), g.ones.end(), [&](int64_t j) { return j < 0 || j >= g.columns; })))
+    throw InvalidInputError("the checkpoint's rounding of level " + std::to_string(done + 1) + " does not fit it");
 }
 
 uint64_t CoarseToFineMatcher::fingerprint() const {
@@ -809,8 +813,11 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
     regional_done = resume->regional_done;
     around_done = resume->around_done;
     suspicions.restore(resume->suspicions, resume->trusted);
-    spdlog::info("level {}: going on from its checkpointed attempt: ring {}, {} faces with extra rings", l + 1, ring,
-                 std::count_if(extra.begin(), extra.end(), [](int e) { return e > 0; }));
+    spdlog::info("level {}: going on from its checkpointed attempt: ring {}, {} faces with extra rings{}", l + 1, ring,
+                 std::count_if(extra.begin(), extra.end(), [](int e) { return e > 0; }),
+                 resume->rounding.empty() ? std::string()
+                                          : fmt::format(", its rounding after round {} ({} fixings to 1)",
+                                                        resume->rounding.rounds, resume->rounding.ones.size()));
   }
   CarriedIterate warm;  // the last attempt's first LP, for the next
   // With stuck_carry, where rounding got stuck (StuckError) and the space widened around it: its
@@ -921,23 +928,28 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
                  l + 1, p.columns, p.below, p.threshold, p.lowest, p.noise, p.faces.size(), clock.seconds());
     return !p.faces.empty() && widen_locally(p.faces, "cutting off columns that price below zero", options_.max_ring);
   };
+  // The attempt about to start (or under way), for a checkpoint.
+  auto current_attempt = [&] {
+    LevelAttempt a;
+    a.ring = ring;
+    a.extra = extra;
+    a.extra.resize(lx.mesh.num_faces(), 0);
+    a.local = local;
+    a.propagated = propagated;
+    a.priced = priced;
+    a.regional_done = regional_done;
+    a.around_done = around_done;
+    a.suspicions = suspicions.count();
+    a.trusted = suspicions.trusted();
+    a.report = rep;
+    a.report.gamma.clear();
+    return a;
+  };
   for (bool first_attempt = true;; first_attempt = false) {
-    if (!first_attempt && attempted && l > 0) {
-      LevelAttempt a;
-      a.ring = ring;
-      a.extra = extra;
-      a.extra.resize(lx.mesh.num_faces(), 0);
-      a.local = local;
-      a.propagated = propagated;
-      a.priced = priced;
-      a.regional_done = regional_done;
-      a.around_done = around_done;
-      a.suspicions = suspicions.count();
-      a.trusted = suspicions.trusted();
-      a.report = rep;
-      a.report.gamma.clear();
-      attempted(a);
-    }
+    if (!first_attempt && attempted && l > 0) attempted(current_attempt());
+    // The checkpointed attempt's rounding, which this first attempt goes on from where it builds
+    // the same LP.
+    const LevelAttempt::Rounding* going_on = first_attempt && resume && !resume->rounding.empty() ? &resume->rounding : nullptr;
     MatchingLp m;
     if (l == 0) {
       m = build_matching_lp(ProductSpace::full(lx.mesh, ly.mesh), model, options_.matching.scale_costs);
@@ -951,12 +963,18 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
     }
     rep.variables = m.lp.cols();
     rep.constraints = m.lp.rows();
+    if (going_on && (going_on->columns != m.lp.cols() || going_on->rows != m.lp.rows())) {
+      spdlog::warn("level {}: the checkpointed rounding was of an LP of {} × {}, this one is {} × {}; rounding afresh",
+                   l + 1, going_on->rows, going_on->columns, m.lp.rows(), m.lp.cols());
+      going_on = nullptr;
+    }
     const double kept = 100.0 * double(rep.variables) / double(rep.full_variables);
     spdlog::info("level {}/{}: {} × {} faces, {} variables ({}){}", l + 1, hx_.size(), rep.faces_x, rep.faces_y,
                  rep.variables, l > 0 ? fmt::format("{:.3g} % of the full space", kept) : "the full space",
                  l > 0 ? fmt::format(", ring {}", ring) : std::string());
     // Propagation alone proves most reduced LPs infeasible, and says where: widen there first.
-    if (l > 0 && options_.local_widening) {
+    // (Not where a rounding of this LP goes on: it got past that.)
+    if (l > 0 && options_.local_widening && !going_on) {
       ProofPlace place(m);
       std::vector<int64_t> pi_faces;
       propagating = true;
@@ -1025,8 +1043,8 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
         ro.reference_iterations = cold_iterations;
       }
       price_warm = false;
-      const bool pricing = l > 0 && !carrying && priced < options_.price_widenings && options_.local_widening &&
-                           local < options_.max_local_widenings;
+      const bool pricing = l > 0 && !carrying && !going_on && priced < options_.price_widenings &&
+                           options_.local_widening && local < options_.max_local_widenings;
       // The iterate pricing reads (and a widening it calls for starts from).
       auto keep_for_pricing = [&](const std::vector<double>& x, const std::vector<double>& y, double omega) {
         first_x = x;
@@ -1045,7 +1063,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
         };
       }
       const bool may_carry = options_.stuck_after > 0.0 && options_.stuck_carry;
-      if (l > 0 && (options_.warm_widening || may_carry || pricing) && !carrying)
+      if (l > 0 && (options_.warm_widening || may_carry || pricing) && !carrying && !going_on)
         ro.first_iterate = [&](const std::vector<double>& x, const std::vector<double>& y, double omega) {
           if (pricing && !probing) keep_for_pricing(x, y, omega);
           if (!options_.carry_primal_weight) omega = 0.0;
@@ -1070,12 +1088,43 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
         spdlog::info("level {}: rounding goes on from {} of {} fixings to 1 in the widened space", l + 1,
                      ro.start_ones.size(), carried_ones.size());
       }
+      if (going_on) {  // its round 1 solves what the checkpointed fixings leave
+        ro.start_ones = going_on->ones;
+        cold_seconds = reference_seconds = ro.reference_seconds = going_on->reference_seconds;
+        cold_iterations = reference_iterations = first_iterations = ro.reference_iterations =
+            going_on->reference_iterations;
+        spdlog::info("level {}: rounding goes on after round {} from its {} fixings to 1", l + 1, going_on->rounds,
+                     going_on->ones.size());
+      }
+      // Where the rounding has got, saved as it goes (not where alternatives would run: a run gone
+      // on from fixings runs none).
+      double first_bound = going_on ? going_on->lower_bound : std::numeric_limits<double>::quiet_NaN();
+      int64_t iterations_so_far = going_on ? going_on->iterations : 0;
+      Stopwatch since_saved;
+      if (attempted && l > 0 && !carrying &&
+          (ro.alternative_thresholds.empty() || m.lp.cols() > ro.alternatives_below))
+        ro.decided = [&](const RoundingRound& r, const std::vector<int64_t>& ones, double bound) {
+          iterations_so_far += r.iterations;
+          if (r.round == 1 && !going_on) first_bound = bound;
+          if (since_saved.seconds() < options_.rounding_checkpoint_seconds) return;
+          LevelAttempt a = current_attempt();
+          a.rounding = {.columns = m.lp.cols(),
+                        .rows = m.lp.rows(),
+                        .ones = ones,
+                        .rounds = (going_on ? going_on->rounds : 0) + r.round,
+                        .iterations = iterations_so_far,
+                        .lower_bound = first_bound,
+                        .reference_seconds = reference_seconds,
+                        .reference_iterations = reference_iterations};
+          attempted(a);
+          since_saved.reset();
+        };
       // Where rounding gets stuck, widen around it (as for an infeasible LP) and solve again.
       if (l > 0 && options_.local_widening && local < options_.max_local_widenings)
         ro.stuck_after = options_.stuck_after;
       RoundingResult rr = round_to_graph_surface(m.space, m.lp, m.energy, ro,
                                                  [&](const RoundingRound& r) {
-                                                   if (r.round == 1 && !carrying) {
+                                                   if (r.round == 1 && !carrying && !going_on) {
                                                      first_iterations = r.iterations;
                                                      if (!warm_resolve) {
                                                        cold_iterations = r.iterations;
@@ -1114,7 +1163,15 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
         }
         rr.gap = relative_gap(rr.energy, rr.lower_bound);
       }
+      if (going_on) {  // the same LP: its round 1's bound stands
+        rr.lower_bound = going_on->lower_bound;
+        rr.gap = relative_gap(rr.energy, rr.lower_bound);
+      }
       accept(m, rr, rep, gamma);
+      if (going_on) {
+        rep.rounds += going_on->rounds;
+        rep.iterations += going_on->iterations;
+      }
       if (l + 1 == hx_.size()) {
         result.finest = std::move(m);
         result.rounding = std::move(rr);
@@ -1142,7 +1199,9 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
         if (widen_at(m, proof, "stuck in rounding")) {
           ++rep.stuck_widenings;
           carried_ones.clear();
-          if (!options_.stuck_carry) continue;  // afresh in the widened space
+          // Afresh in the widened space (also after a rounding gone on from a checkpoint, whose
+          // first LP is not at hand to certify the widened one).
+          if (!options_.stuck_carry || going_on) continue;
           released_x.assign(lx.mesh.num_vertices(), 0);
           for (int f = 0; f < lx.mesh.num_faces(); ++f)
             if (extra[f] > before[f])

@@ -1128,22 +1128,27 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
   // Work (iterations times free variables, which unlike seconds is the same on every run) of
   // round 1 and of the rounds after it (give_up_after).
   double first_work = 0.0, later_work = 0.0;
-  const auto record = [&](RoundingRound& info, const Stopwatch& clock) {
-    info.seconds = clock.seconds();
-    if (info.round > 1) later_work += double(info.iterations) * double(info.variables);
-    result.rounds.push_back(info);
-    if (progress) progress(info);
-  };
-  // Giving up where the caller can widen (stuck_after): the fixings to 1 so far and the iterate go with it.
-  // Only the decisions: what propagation forced to 1 in this space need not follow in a wider one.
-  const auto stuck = [&](const std::string& what, std::vector<int64_t> rows) {
+  // The fixings to 1 made so far, sorted. Only the decisions: what propagation forced to 1 in
+  // this space need not follow in a wider one, and follows from them in this one.
+  const auto decisions = [&] {
     std::vector<int64_t> ones;
     for (const Step& st : history)
       for (const auto& a : st.batch)
         if (a.second == 1 && fixer.state().value[a.first] == 1) ones.push_back(a.first);
     std::sort(ones.begin(), ones.end());
     ones.erase(std::unique(ones.begin(), ones.end()), ones.end());
-    return StuckError(what, std::move(rows), std::move(ones), x_full, y_full);
+    return ones;
+  };
+  const auto record = [&](RoundingRound& info, const Stopwatch& clock) {
+    info.seconds = clock.seconds();
+    if (info.round > 1) later_work += double(info.iterations) * double(info.variables);
+    result.rounds.push_back(info);
+    if (progress) progress(info);
+    if (options.decided) options.decided(info, decisions(), result.first_lp.lower_bound);
+  };
+  // Giving up where the caller can widen (stuck_after): the fixings to 1 so far and the iterate go with it.
+  const auto stuck = [&](const std::string& what, std::vector<int64_t> rows) {
+    return StuckError(what, std::move(rows), decisions(), x_full, y_full);
   };
   // The round's iterate over the whole LP, the next round's warm start.
   const auto keep_iterate = [&](const Reduced& red, const LpResult& r) {

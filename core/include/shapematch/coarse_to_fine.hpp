@@ -224,6 +224,10 @@ struct CoarseToFineOptions {
   // level<L>-<NNN>.smlp, NNN counting all first LPs of the run, for solving it again on its own
   // (`shapematch lp --from`). Empty: none.
   std::string dump_first_lps;
+  // With a checkpoint (run's `checkpoint`), where a level's rounding has got is saved after its
+  // rounds at most this often (LevelAttempt::rounding): each save writes every level's Γ, a few
+  // hundred kB at full resolution, and the last rounds take hundredths of a second each.
+  double rounding_checkpoint_seconds = 10.0;
 };
 
 // Pricing: the reduced costs c_j − A_jᵀy of `other`'s columns, in energy units, against a dual
@@ -305,6 +309,22 @@ struct LevelAttempt {
   int suspicions = 0;            // diverging first LPs in a row, and whether the watch is trusted
   bool trusted = true;
   LevelReport report;            // its counts so far (widenings, widened faces, …); no Γ
+  // Where the attempt's rounding had got, saved after its rounds (at most every few seconds): a
+  // run gone on from it builds the same LP, fixes `ones` before its round 1 and keeps round 1's
+  // bound (measured on the H200, 17 runs at once: a finest level's rounding takes 100-300 s, which
+  // a stop inside it lost). Empty (no rounds) where it had not finished round 1. Not kept: the
+  // rounding's own state (undo history, stall and stuck counts, the warm start), which begins
+  // afresh; and it is not saved where the level's LP is small enough for alternative thresholds.
+  struct Rounding {
+    int64_t columns = 0, rows = 0;   // of the attempt's LP, which a run gone on from it checks
+    std::vector<int64_t> ones;       // the rounding's fixings to 1 so far (RoundingOptions::decided)
+    int rounds = 0;                  // done, and their LP iterations
+    int64_t iterations = 0;
+    double lower_bound = 0.0;        // certified by round 1
+    double reference_seconds = 0.0;  // round 1's cold solve (RoundingOptions::reference_*)
+    int64_t reference_iterations = 0;
+    bool empty() const { return rounds == 0; }
+  } rounding;
   bool empty() const { return ring < 0; }
   int widenings() const { return report.widenings + report.local_widenings; }  // so far
 };

@@ -9,6 +9,8 @@
 
 namespace shapematch {
 
+struct RoundingRound;
+
 struct RoundingOptions {
   double threshold = 0.5;      // fix every variable above this to 1
   int max_rounds = 50;         // then fail (InfeasibleError, naming the open rows) rather than
@@ -156,6 +158,11 @@ struct RoundingOptions {
   // Called with round 1's LP (what propagation left free, as solved; not its warm start) just
   // before it is solved, where round 1 is a first LP (not one from carried fixings).
   std::function<void(const LpProblem& lp)> first_lp;
+  // Called after each round (after `progress`) with the decisions so far, the fixings to 1 that
+  // rounding chose (sorted; not what propagation forced, which follows from them), and round 1's
+  // certified bound: where the rounding has got, for a checkpoint (coarse to fine) that a later
+  // run goes on from with start_ones.
+  std::function<void(const RoundingRound& round, const std::vector<int64_t>& ones, double first_bound)> decided;
   // Where probe_tolerance is above lp.tolerance and `probe` is set, round 1's LP is solved first
   // to probe_tolerance and `probe` gets that iterate (over the whole LP, as first_iterate's) if it
   // was optimal there; it may throw to abandon the rounding (coarse to fine prices a wider space
