@@ -1090,6 +1090,9 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
       }
       if (going_on) {  // its round 1 solves what the checkpointed fixings leave
         ro.start_ones = going_on->ones;
+        // Unwatched, as a later round: where those fixings leave no solution, the proof undoes
+        // some of them (a diverging first LP would widen the space instead).
+        ro.lp.stop_on_divergence = false;
         cold_seconds = reference_seconds = ro.reference_seconds = going_on->reference_seconds;
         cold_iterations = reference_iterations = first_iterations = ro.reference_iterations =
             going_on->reference_iterations;
