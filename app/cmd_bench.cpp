@@ -529,6 +529,9 @@ struct MatchRow {
   double mean_error = kNaN, median_error = kNaN, symmetric_mean_error = kNaN, flips = kNaN;
   double point_mean_error = kNaN, point_flips = kNaN;  // the point map's (eval's `point_map`)
   double resumed_after_level = kNaN;  // levels taken from a checkpoint (their time is not in `run`)
+  // `run`'s seconds plus those of the runs whose checkpoint it went on from (NaN where one of
+  // them is not on record: a harness stopped during it).
+  double total_seconds = kNaN;
   ChildRun run;
 };
 
@@ -768,7 +771,7 @@ double median_ok(const std::vector<MatchRow>& rows, double (*value)(const MatchR
   return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
 
-const std::vector<std::string> kPairsHeader{"pair",        "faces_x", "faces_y", "seconds",
+const std::vector<std::string> kPairsHeader{"pair",        "faces_x", "faces_y", "seconds", "total_seconds",
                                             "peak_rss_mb", "energy",  "lower_bound", "gap", "max_level_gap",
                                             "rounds",      "mean_geodesic_error", "median_geodesic_error",
                                             "symmetric_mean_geodesic_error", "orientation_flips",
@@ -782,7 +785,7 @@ std::vector<std::vector<std::string>> pairs_cells(const std::vector<MatchRow>& r
   std::vector<std::vector<std::string>> cells;
   for (const MatchRow& r : rows)
     cells.push_back({r.name, csv_int(r.faces_x), csv_int(r.faces_y), num(r.run.seconds, 6, 2),
-                     num(r.run.peak_rss_mb, 5, 0), general(r.energy, 12), general(r.lower_bound, 12),
+                     num(r.total_seconds, 6, 2), num(r.run.peak_rss_mb, 5, 0), general(r.energy, 12), general(r.lower_bound, 12),
                      general(r.gap, 4), general(r.max_level_gap, 4), csv_int(r.rounds), num(r.mean_error, 6, 4),
                      num(r.median_error, 6, 4),
                      num(r.symmetric_mean_error, 6, 4), csv_int(r.flips), num(r.point_mean_error, 6, 4),
@@ -790,6 +793,7 @@ std::vector<std::vector<std::string>> pairs_cells(const std::vector<MatchRow>& r
   const auto ok = std::count_if(rows.begin(), rows.end(), [](const MatchRow& r) { return r.run.status == "ok"; });
   cells.push_back({csv ? "median" : "**median**", "", "",
                    num(median_ok(rows, [](const MatchRow& r) { return r.run.seconds; }), 6, 2),
+                   num(median_ok(rows, [](const MatchRow& r) { return r.total_seconds; }), 6, 2),
                    num(median_ok(rows, [](const MatchRow& r) { return r.run.peak_rss_mb; }), 5, 0), "", "",
                    general(median_ok(rows, [](const MatchRow& r) { return r.gap; }), 4),
                    general(median_ok(rows, [](const MatchRow& r) { return r.max_level_gap; }), 4), "",
@@ -880,6 +884,7 @@ void write_run_record(const fs::path& dir, const std::vector<std::string>& match
   }
   record.set("status", row.run.status);
   record.set("seconds", row.run.seconds);
+  record.set("total_seconds", row.total_seconds);
   record.set("peak_rss_mb", row.run.peak_rss_mb);
   write_file_atomic(dir.string() + ".run.json", record.dump() + "\n");
 }
@@ -935,11 +940,13 @@ CheckpointProgress checkpoint_progress(const fs::path& checkpoint) {
 // timed out counts only under a time limit no longer than its own, and only where it left its
 // checkpoint no further on than it found it (one that got further goes on from there: full
 // resolution's coarse levels take a quarter to a half of a run). An evaluation that failed is
-// run again (cheap). False: run the pair.
+// run again (cheap). False: run the pair; `earlier` is then the seconds of the runs that made the
+// checkpoint it goes on from, where it keeps one (NaN where not on record).
 bool resume_row(const BenchMatchArgs& args, const PairSpec& pair, const std::vector<std::string>& match,
-                const fs::path& dir, MatchRow& row) {
+                const fs::path& dir, MatchRow& row, double& earlier) {
   const std::string path = dir.string() + ".run.json";
   const fs::path checkpoint = dir.string() + ".ckpt";
+  earlier = 0.0;
   if (!fs::exists(path)) {
     fs::remove(checkpoint);  // (whatever made it is not on record)
     return false;
@@ -953,9 +960,16 @@ bool resume_row(const BenchMatchArgs& args, const PairSpec& pair, const std::vec
       fs::remove(checkpoint);
       return false;
     }
+    // (A record from before total_seconds: its own seconds, checkpoints it went on from unknown.)
+    const double recorded_total = record.get("total_seconds") ? record.number_or_nan("total_seconds")
+                                                              : record.number_or_nan("seconds");
     const JsonNode* status = record.get("status");
     if (!status || status->kind != JsonNode::Kind::String) return false;
-    if (status->text == "started") return false;  // the harness was stopped during the run
+    if (status->text == "started") {  // the harness was stopped during the run: its seconds unknown
+      earlier = kNaN;
+      return false;
+    }
+    earlier = recorded_total;
     // Another backend or device: its row is not this one's, but the levels it checkpointed are
     // (a run that ran out of a GPU's time goes on from them on the CPU, or on another GPU).
     if (const std::vector<std::string> was = where_run(recorded_match); was != where_run(match)) {
@@ -983,6 +997,7 @@ bool resume_row(const BenchMatchArgs& args, const PairSpec& pair, const std::vec
     }
     row.run.status = status->text;
     row.run.seconds = record.number_or_nan("seconds");
+    row.total_seconds = recorded_total;
     row.run.peak_rss_mb = record.number_or_nan("peak_rss_mb");
     const bool matched = row.run.status == "ok" || row.run.status.rfind("eval ", 0) == 0;
     if (!matched) return true;
@@ -1044,7 +1059,8 @@ int run_bench_pairs(const BenchMatchArgs& asked) {
     const PairSpec& pair = pairs[i];
     MatchRow& row = rows[i];
     const std::vector<std::string> match = match_command(args, pair.x, pair.y, faces);
-    if (args.resume && resume_row(args, pair, match, dirs[i], row)) {
+    double earlier = 0.0;
+    if (args.resume && resume_row(args, pair, match, dirs[i], row, earlier)) {
       spdlog::info("pair {} of {}: {} (resumed from {}.run.json)", i + 1, pairs.size(), row.name, dirs[i].string());
     } else {
       spdlog::info("pair {} of {}: {}", i + 1, pairs.size(), row.name);
@@ -1073,6 +1089,7 @@ int run_bench_pairs(const BenchMatchArgs& asked) {
         row = MatchRow{.name = row.name};
         attempt();
       }
+      row.total_seconds = row.run.seconds + (before.levels > 0 ? earlier : 0.0);
       if (row.run.status == "ok") evaluate(args, pair, dirs[i], row);
       write_run_record(dirs[i], match, pair, args.time_limit, row, before);
       // (A finished run needs no checkpoint; removed after its record.)

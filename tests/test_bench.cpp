@@ -243,7 +243,7 @@ TEST_CASE("cli: bench match --pairs matches and evaluates each pair and adds a r
                   err) == 0);
 
   const auto [header, rows] = read_csv(dir / "out" / "bench_pairs.csv");
-  const std::vector<std::string> expected = {"pair", "faces_x", "faces_y", "seconds", "peak_rss_mb", "energy",
+  const std::vector<std::string> expected = {"pair", "faces_x", "faces_y", "seconds", "total_seconds", "peak_rss_mb", "energy",
                                              "lower_bound", "gap", "max_level_gap", "rounds", "mean_geodesic_error",
                                              "median_geodesic_error", "symmetric_mean_geodesic_error",
                                              "orientation_flips", "point_mean_geodesic_error",
@@ -273,6 +273,7 @@ TEST_CASE("cli: bench match --pairs matches and evaluates each pair and adds a r
     CHECK(row.at("symmetric_mean_geodesic_error").empty() == (i == 0));
     if (i == 1) CHECK(std::stod(row.at("symmetric_mean_geodesic_error")) != doctest::Approx(mean));
     seconds.push_back(std::stod(row.at("seconds")));
+    CHECK(row.at("total_seconds") == row.at("seconds"));  // (no checkpoint before it)
   }
   const auto& median = rows[2];
   CHECK(median.at("pair") == "median");
@@ -477,6 +478,7 @@ TEST_CASE("cli: bench match --pairs --resume goes on from where a run that timed
   CHECK(read_text(err).find("not a shapematch checkpoint") != std::string::npos);
   CHECK(row().at("status") == "ok");
   CHECK(row().at("resumed_after_level") == "0");
+  CHECK(row().at("total_seconds") == row().at("seconds"));  // afresh: the stopped run's time is not in it
   CHECK(row().at("energy") == first.at("energy"));
   CHECK_FALSE(fs::exists(checkpoint));
 
@@ -488,7 +490,10 @@ TEST_CASE("cli: bench match --pairs --resume goes on from where a run that timed
   REQUIRE(fs::exists(checkpoint));
   fs::copy_file(checkpoint, dir / "saved.ckpt");
   edit_record("status", "\"timed out\"");
+  edit_record("total_seconds", "1000");  // (as if the run that timed out had taken that long)
   REQUIRE(run_cli(bench, err) == 0);  // the same limit, but the checkpoint got further: it goes on
+  CHECK(std::stod(row().at("total_seconds")) ==
+        doctest::Approx(1000 + std::stod(row().at("seconds"))).epsilon(1e-4));
   CHECK(read_text(err).find("going on from it") != std::string::npos);
   CHECK(read_text(log).find("going on from a checkpoint after level 2 of 3") != std::string::npos);
   CHECK(row().at("status") == "ok");
@@ -544,6 +549,7 @@ TEST_CASE("cli: bench match --pairs --resume goes on from where a run that timed
   fs::copy_file(dir / "saved.ckpt", checkpoint);
   edit_record("status", "\"timed out\"");
   edit_record("time_limit", "99999");
+  edit_record("total_seconds", "500");
   replace_in_file(record, "\"cpu\"", "\"vulkan\"");
   replace_in_file(record, kAssets + "/", "/root/q/data/");
   auto went_on = [&] {  // (the log goes on with the run: count)
@@ -557,10 +563,18 @@ TEST_CASE("cli: bench match --pairs --resume goes on from where a run that timed
   CHECK(read_text(err).find("ran elsewhere (--backend vulkan); running it again, from its checkpoint") !=
         std::string::npos);
   CHECK(went_on() == went_on_before + 1);
+  CHECK(std::stod(row().at("total_seconds")) == doctest::Approx(500 + std::stod(row().at("seconds"))).epsilon(1e-4));
   CHECK(row().at("status") == "ok");
   CHECK(row().at("resumed_after_level") == "2");
   CHECK(row().at("energy") == first.at("energy"));
   CHECK_FALSE(fs::exists(checkpoint));
+  // Stopped with the harness (its record says started): it goes on, its total unknown.
+  fs::copy_file(dir / "saved.ckpt", checkpoint);
+  edit_record("status", "\"started\"");
+  REQUIRE(run_cli(bench, err) == 0);
+  CHECK(went_on() == went_on_before + 2);
+  CHECK(row().at("status") == "ok");
+  CHECK(row().at("total_seconds").empty());
   // Without --resume (other options, say) a checkpoint left there goes: nothing on record made it.
   REQUIRE(run_cli("bench match --pairs " + (dir / "pairs.txt").string() + " --out " + (dir / "out").string() +
                       " --faces 200 --" + options + " --ring 1",
