@@ -1,11 +1,15 @@
-// Small subcommands: `devices` and `generate-assets`.
+// Small subcommands: `devices`, `generate-assets` and `checkpoint`.
 #include "commands.hpp"
+#include "shapematch/coarse_to_fine.hpp"
 #include "shapematch/device.hpp"
+#include "shapematch/json.hpp"
 #include "shapematch/shapes.hpp"
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <iostream>
+#include <memory>
 
 namespace shapematch::app {
 
@@ -23,6 +27,61 @@ Action add_devices_command(CLI::App& app) {
                 << d.max_storage_buffer_range / (1024 * 1024) << " MiB, subgroup " << d.subgroup_size << ", "
                 << d.driver << ")\n";
     }
+    return 0;
+  };
+}
+
+// Where a stopped run stands (match --checkpoint), as JSON on stdout: the levels done, the
+// attempt of the level in progress and how far its rounding got. The meshes are not needed: a
+// run gone on from the file checks that it fits them.
+Action add_checkpoint_command(CLI::App& app) {
+  auto file = std::make_shared<std::string>();
+  app.add_option("FILE", *file, "a checkpoint written by match --checkpoint")->required();
+  return [file] {
+    const LevelCheckpoint c = load_checkpoint(*file);
+    Json levels = Json::array();
+    for (const LevelReport& r : c.levels)
+      levels.push(Json::object()
+                      .set("level", r.level)  // (0 = coarsest, as in report.json)
+                      .set("faces_x", r.faces_x)
+                      .set("faces_y", r.faces_y)
+                      .set("variables", r.variables)
+                      .set("ring", r.ring)
+                      .set("widenings", r.widenings + r.local_widenings)
+                      .set("rounds", r.rounds)
+                      .set("energy", r.energy)
+                      .set("lower_bound", r.lower_bound)
+                      .set("gap", r.gap)
+                      .set("seconds", r.seconds));
+    Json attempt;  // null where no level is in progress
+    if (const LevelAttempt& a = c.attempt; !a.empty()) {
+      Json rounding;
+      if (const LevelAttempt::Rounding& g = a.rounding; !g.empty())
+        rounding = Json::object()
+                       .set("rounds", g.rounds)
+                       .set("fixings_to_one", static_cast<int64_t>(g.ones.size()))
+                       .set("iterations", g.iterations)
+                       .set("lower_bound", g.lower_bound)
+                       .set("variables", g.columns)
+                       .set("constraints", g.rows);
+      attempt = Json::object()
+                    .set("level", a.report.level)
+                    .set("ring", a.ring)
+                    .set("faces_with_extra_rings",
+                         static_cast<int64_t>(std::count_if(a.extra.begin(), a.extra.end(), [](int e) { return e > 0; })))
+                    .set("widenings", a.widenings())
+                    .set("propagation_widenings", a.report.propagation_widenings)
+                    .set("price_widenings", a.report.price_widenings)
+                    .set("stuck_widenings", a.report.stuck_widenings)
+                    .set("rounding", std::move(rounding));
+    }
+    std::cout << Json::object()
+                     .set("file", *file)
+                     .set("levels_done", static_cast<int64_t>(c.levels.size()))
+                     .set("levels", std::move(levels))
+                     .set("attempt", std::move(attempt))
+                     .dump()
+              << "\n";
     return 0;
   };
 }

@@ -15,6 +15,7 @@ Action add_devices_command(CLI::App& app);
 Action add_generate_assets_command(CLI::App& app);
 Action add_bench_command(CLI::App& app);
 Action add_eval_command(CLI::App& app);
+Action add_checkpoint_command(CLI::App& app);
 
 // The bundled demo pair (assets/), used when a command is given no meshes.
 std::string default_mesh_x();

@@ -45,6 +45,7 @@ int main(int argc, char** argv) {
   add(app::add_generate_assets_command, "generate-assets", "regenerate the bundled demo meshes");
   add(app::add_bench_command, "bench", "benchmarks: LP solvers (Fig. 4), memory bandwidth, match scaling and pair tables");
   add(app::add_eval_command, "eval", "evaluate a match output against ground truth: geodesic error, PCK, flips");
+  add(app::add_checkpoint_command, "checkpoint", "show where a stopped run stands (a match --checkpoint file), as JSON");
 
   try {
     cli.parse(argc, argv);

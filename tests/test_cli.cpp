@@ -278,6 +278,14 @@ TEST_CASE("cli: match --checkpoint goes on after the levels a stopped run finish
   REQUIRE(fs::exists(ckpt));  // after level 2 of 3
   const std::string first = read_file(tmp.path / "a" / "report.json");
   CHECK(json_number(first, "resumed_after_level") == 0);
+  // What it holds, without the meshes: two levels done, the second's energy as in the report.
+  r = run("checkpoint " + ckpt);
+  REQUIRE_MESSAGE(r.code == 0, r.err);
+  CHECK(json_number(r.out, "levels_done") == 2);
+  REQUIRE(r.out.find("\"level\": 1,") != std::string::npos);
+  REQUIRE(first.find("\"level\": 1,") != std::string::npos);
+  CHECK(json_number(r.out.substr(r.out.find("\"level\": 1,")), "energy") ==
+        json_number(first.substr(first.find("\"level\": 1,")), "energy"));
   // Going on from it solves only the finest level again, to the same Γ.
   r = run("match " + dolphin + " " + swimming + args + (tmp.path / "b").string());
   REQUIRE_MESSAGE(r.code == 0, r.err);
@@ -291,6 +299,10 @@ TEST_CASE("cli: match --checkpoint goes on after the levels a stopped run finish
   CHECK(r.code != 0);
   CHECK(r.err.find(ckpt + ": the checkpoint was written for other meshes") != std::string::npos);
   CHECK_FALSE(fs::exists(tmp.path / "c"));
+  // Not a checkpoint: one line naming the file.
+  r = run("checkpoint " + dolphin);
+  CHECK(r.code == 1);
+  CHECK(r.err.find(dolphin + ": not a shapematch checkpoint") != std::string::npos);
 }
 
 // tools/pdhg_work.sh reads what PDHG logs at debug level: on a written log its sums are checked
