@@ -99,6 +99,8 @@ export LIMIT DEADLINE BACKEND FACES THREADS
 timeout $((LIMIT + 45)) xargs -P "$P" -L 1 bash -c 'run1 "$@"' _ < "${JOBS:-jobs.txt}"
 kill $SMI
 cat out/*/bench_pairs.md > log/tables.md 2>/dev/null
+# Where each unfinished run stands (levels done, the attempt and its rounding), one line each.
+for c in out/*/runs/*.ckpt; do [ -f "$c" ] && echo "$c $(./shapematch checkpoint "$c" | tr -d ' \n')"; done > log/checkpoints.txt 2>&1
 tar cJf "${OUT:-/tmp}/q.txz" --exclude='*.ply' --exclude='*.png' --exclude=levels log out
 ls -la "${OUT:-/tmp}/q.txz"
 EOF
