@@ -333,7 +333,8 @@ struct LevelAttempt {
 // (match --checkpoint): the reports of the levels done, the last one's Γ being what the next
 // refines, and that level's extra rings per X face (inherit_widening). Only a level after which
 // a single chain goes on is a checkpoint (not inside lookahead), and never the finest. Each new
-// attempt of the next level (a widening) updates `attempt`, the finest level's too.
+// attempt of the next level (a widening) updates `attempt`, the finest level's too, and so does
+// its rounding as it goes (LevelAttempt::rounding).
 struct LevelCheckpoint {
   uint64_t hierarchy = 0;          // CoarseToFineMatcher::fingerprint() of the run that wrote it
   std::vector<LevelReport> levels; // levels 0 … levels.size() - 1, done
@@ -360,7 +361,9 @@ public:
   // `resume`: go on after its levels instead of starting at the coarsest; they are taken as they
   // are, whatever options made them (so a finer level's options can be tried without solving the
   // coarse ones again). InvalidInputError where it was written for other hierarchies.
-  // `checkpoint`: called after every level that can be a checkpoint.
+  // `checkpoint`: called after every level that can be a checkpoint, before each later attempt
+  // of the level after it, and after that attempt's rounds (at most every
+  // rounding_checkpoint_seconds).
   CoarseToFineResult run(const Progress& progress = {}, const LevelCheckpoint* resume = nullptr,
                          const Checkpointing& checkpoint = {}) const;
   // A hash of both hierarchies (every level's faces and input vertices): equal for equal inputs
