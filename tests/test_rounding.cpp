@@ -114,6 +114,46 @@ TEST_CASE("rounding: a deformed pair rounds to a verified graph surface within t
   CHECK_FALSE(check_graph_surface(m.space, broken).ok());
 }
 
+TEST_CASE("rounding: after each round it hands out its decisions, and a rounding from them keeps them") {
+  // Threshold 0 on the dolphins at 60 faces: several rounds (see the clashing-candidates test).
+  const MatchingLp& m = dolphins_60();
+  RoundingOptions o;
+  o.solver = "pdhg-cpu";
+  o.exact_below = 0;
+  o.threshold = 0.0;
+  o.alternative_thresholds = {};  // one rounding
+  o.close_pockets = false;        // (which may replace decided triangles)
+  struct Call {
+    int round;
+    std::vector<int64_t> ones;
+    double bound;
+  };
+  std::vector<Call> calls;
+  o.decided = [&](const RoundingRound& r, const std::vector<int64_t>& ones, double bound) {
+    calls.push_back({r.round, ones, bound});
+  };
+  const RoundingResult r = round_to_graph_surface(m.space, m.lp, m.energy, o);
+  REQUIRE(r.rounds.size() >= 2);
+  REQUIRE(calls.size() == r.rounds.size());
+  for (size_t k = 0; k < calls.size(); ++k) {
+    CAPTURE(k);
+    CHECK(calls[k].round == int(k) + 1);
+    CHECK(std::is_sorted(calls[k].ones.begin(), calls[k].ones.end()));
+    CHECK(std::adjacent_find(calls[k].ones.begin(), calls[k].ones.end()) == calls[k].ones.end());
+    CHECK(calls[k].bound == r.first_lp.lower_bound);
+  }
+  REQUIRE_FALSE(calls.front().ones.empty());
+  for (int64_t j : calls.back().ones) CHECK(std::binary_search(r.gamma.begin(), r.gamma.end(), j));
+  // Gone on from round 1's decisions: an exact graph surface that keeps every one of them.
+  RoundingOptions from = o;
+  from.decided = {};
+  from.start_ones = calls.front().ones;
+  const RoundingResult g = round_to_graph_surface(m.space, m.lp, m.energy, from);
+  CHECK(satisfies_exactly(m.lp, g.gamma));
+  CHECK(check_graph_surface(m.space, g.gamma).ok());
+  for (int64_t j : calls.front().ones) CHECK(std::binary_search(g.gamma.begin(), g.gamma.end(), j));
+}
+
 TEST_CASE("rounding: later rounds stop at their iteration cap and still end exact") {
   // Threshold 0 on the dolphins at 60 faces: several rounds (see the clashing-candidates test).
   const MatchingLp& m = dolphins_60();
