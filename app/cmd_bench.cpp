@@ -889,6 +889,11 @@ void write_run_record(const fs::path& dir, const std::vector<std::string>& match
   write_file_atomic(dir.string() + ".run.json", record.dump() + "\n");
 }
 
+// `--flag=value`: the flag and its value in one word.
+bool flag_with_value(std::string_view word, std::string_view flag) {
+  return word.size() > flag.size() && word.starts_with(flag) && word[flag.size()] == '=';
+}
+
 // What a recorded command asked for, apart from where it ran: less `--threads N` (the count
 // changes no Γ: the CPU kernels split their work in fixed chunks), `--backend` and `--device`
 // (their LPs differ only in rounding error), and with its files by name only (a list moved to
@@ -897,10 +902,8 @@ std::vector<std::string> what_asked(std::vector<std::string> cmd) {
   static constexpr std::array<std::string_view, 3> kWhere{"--threads", "--backend", "--device"};
   for (size_t i = 0; i < cmd.size();) {
     const std::string_view word = cmd[i];
-    const auto is = [&](std::string_view flag) {
-      return word == flag || (word.starts_with(flag) && word.size() > flag.size() && word[flag.size()] == '=');
-    };
-    const auto where = std::find_if(kWhere.begin(), kWhere.end(), is);
+    const auto where = std::find_if(kWhere.begin(), kWhere.end(),
+                                    [&](std::string_view flag) { return word == flag || flag_with_value(word, flag); });
     if (where == kWhere.end()) ++i;
     else if (word == *where && i + 1 < cmd.size()) cmd.erase(cmd.begin() + i, cmd.begin() + i + 2);
     else cmd.erase(cmd.begin() + i);
@@ -916,9 +919,9 @@ std::vector<std::string> what_asked(std::vector<std::string> cmd) {
 std::vector<std::string> where_run(const std::vector<std::string>& cmd) {
   std::vector<std::string> where;
   for (size_t i = 0; i < cmd.size(); ++i)
-    for (const char* flag : {"--backend", "--device"})
+    for (std::string_view flag : {"--backend", "--device"})
       if (cmd[i] == flag && i + 1 < cmd.size()) where.insert(where.end(), {cmd[i], cmd[i + 1]});
-      else if (cmd[i].starts_with(std::string(flag) + "=")) where.push_back(cmd[i]);
+      else if (flag_with_value(cmd[i], flag)) where.push_back(cmd[i]);
   return where;
 }
 
