@@ -77,6 +77,8 @@ struct MatchArgs {
   int price_dual_sweeps = CoarseToFineOptions{}.price_dual_sweeps;
   double stuck_after = CoarseToFineOptions{}.stuck_after;
   bool stuck_carry = CoarseToFineOptions{}.stuck_carry;
+  int stuck_restarts = CoarseToFineOptions{}.stuck_restarts;
+  double rounding_checkpoint_seconds = CoarseToFineOptions{}.rounding_checkpoint_seconds;
   int stuck_stalled = RoundingOptions{}.stuck_stalled;
   int price_widenings = CoarseToFineOptions{}.price_widenings;
   int lookahead_levels = CoarseToFineOptions{}.lookahead_levels;
@@ -162,6 +164,8 @@ int run_match(const MatchArgs& args) {
   co.price_dual_sweeps = args.price_dual_sweeps;
   co.stuck_after = args.stuck_after;
   co.stuck_carry = args.stuck_carry;
+  co.stuck_restarts = args.stuck_restarts;
+  co.rounding_checkpoint_seconds = args.rounding_checkpoint_seconds;
   co.price_widenings = args.price_widenings;
   co.lookahead_levels = args.lookahead_levels;
   co.price_threshold = args.price_threshold;
@@ -250,7 +254,7 @@ int run_match(const MatchArgs& args) {
   const MatchingLp& m = c2f.finest;
   const RoundingResult& rr = c2f.rounding;
   // The finest rounding's rounds, with those before a checkpoint inside it that this run went on
-  // from (rr holds only the rounds after it).
+  // from, or before a stuck restart (rr holds only the rounds after it).
   const int64_t finest_rounds = c2f.levels.empty() ? int64_t(rr.rounds.size()) : c2f.levels.back().rounds;
   seconds.set("solve_and_round", stage.seconds());
 
@@ -371,7 +375,7 @@ int run_match(const MatchArgs& args) {
     report.set("bound_scope", c2f.levels.size() > 1 ? "reduced space of the finest level" : "full product space");
     report.set("first_lp_objective", rr.first_lp.objective).set("first_lp_status", to_string(rr.first_lp.status));
     report.set("rounds", finest_rounds);
-    // (first_lp_* and the log per round then describe the rounds after the checkpoint.)
+    // (first_lp_* and the log per round then describe the rounds after the checkpoint or restart.)
     report.set("rounds_before_checkpoint", finest_rounds - static_cast<int64_t>(rr.rounds.size()));
     report.set("verified", true);
     report.set("theorem1", Json::object()
@@ -452,6 +456,8 @@ int run_match(const MatchArgs& args) {
                               .set("price_dual_sweeps", args.price_dual_sweeps)
                               .set("stuck_after", args.stuck_after)
                               .set("stuck_carry", args.stuck_carry)
+                              .set("stuck_restarts", args.stuck_restarts)
+                              .set("rounding_checkpoint_seconds", args.rounding_checkpoint_seconds)
                               .set("stuck_stalled", args.stuck_stalled)
                               .set("price_widenings", args.price_widenings)
                               .set("price_threshold", args.price_threshold)
@@ -476,6 +482,7 @@ int run_match(const MatchArgs& args) {
                       .set("margin_widenings", l.margin_widenings)
                       .set("widened_faces", l.widened_faces)
                       .set("stuck_widenings", l.stuck_widenings)
+                      .set("stuck_restarts", l.stuck_restarts)
                       .set("price_widenings", l.price_widenings)
                       .set("propagation_widenings", l.propagation_widenings)
                       .set("recurring_widenings", l.recurring_widenings)
@@ -674,6 +681,11 @@ Action add_match_command(CLI::App& app) {
   app.add_option("--checkpoint", a->checkpoint,
                  "after every level below the finest, save the run's state to FILE; where FILE exists, go on "
                  "after the levels it holds (solved with whatever options made them)");
+  app.add_option("--rounding-checkpoint-seconds", a->rounding_checkpoint_seconds,
+                 "with --checkpoint: save where a level's rounding has got after its rounds, at most this often "
+                 "(seconds)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
   app.add_option("--dump-first-lps", a->dump_first_lps,
                  "write every first LP of a rounding to this directory (level<L>-<NNN>.smlp), to solve it again "
                  "with `shapematch lp --from`");
@@ -734,6 +746,11 @@ Action add_match_command(CLI::App& app) {
   app.add_flag("--stuck-carry", a->stuck_carry,
                "with --stuck-after: go on from the stuck rounding's fixings in the widened space instead of "
                "afresh (measured slower)");
+  app.add_option("--stuck-restarts", a->stuck_restarts,
+                 "with --stuck-after: the first N times a level's rounding is stuck, start it again in the same "
+                 "space from its fixings to 1, its other state afresh, before widening (0: off)")
+      ->check(CLI::Range(0, 100))
+      ->capture_default_str();
   app.add_option("--price-widenings", a->price_widenings,
                  "after a refined level's first LP, price the columns one ring out against its dual and widen the X "
                  "faces of those below zero, up to this many times per level, before rounding (0: off)")

@@ -73,6 +73,7 @@ Action add_checkpoint_command(CLI::App& app) {
                     .set("propagation_widenings", a.report.propagation_widenings)
                     .set("price_widenings", a.report.price_widenings)
                     .set("stuck_widenings", a.report.stuck_widenings)
+                    .set("stuck_restarts", a.report.stuck_restarts)
                     .set("rounding", std::move(rounding));
     }
     std::cout << Json::object()

@@ -272,12 +272,19 @@ TEST_CASE("cli: match --checkpoint goes on after the levels a stopped run finish
   const std::string dolphin = std::string(SHAPEMATCH_ASSETS_DIR) + "/dolphin_straight.off";
   const std::string swimming = std::string(SHAPEMATCH_ASSETS_DIR) + "/dolphin_swimming.off";
   const std::string ckpt = (tmp.path / "pair.ckpt").string();
-  const std::string args = " --faces 200 --levels 3 --backend cpu --checkpoint " + ckpt + " -o ";
+  const std::string args = " --faces 200 --levels 3 --backend cpu --rounding-checkpoint-seconds 2.5 --stuck-restarts 1"
+                           " --checkpoint " + ckpt + " -o ";
   Run r = run("match " + dolphin + " " + swimming + args + (tmp.path / "a").string());
   REQUIRE_MESSAGE(r.code == 0, r.err);
   REQUIRE(fs::exists(ckpt));  // after level 2 of 3
   const std::string first = read_file(tmp.path / "a" / "report.json");
   CHECK(json_number(first, "resumed_after_level") == 0);
+  CHECK(json_number(first, "rounding_checkpoint_seconds") == 2.5);  // echoed with the options
+  CHECK(first.find("\"stuck_restarts\": 1") != std::string::npos);
+  CHECK(first.find("\"stuck_restarts\": 0") != std::string::npos);  // per level
+  r = run("match " + dolphin + " " + swimming + " --stuck-restarts -1 -o " + (tmp.path / "d").string());
+  CHECK(r.code != 0);
+  CHECK_FALSE(fs::exists(tmp.path / "d"));
   // What it holds, without the meshes: two levels done, the second's energy as in the report.
   r = run("checkpoint " + ckpt);
   REQUIRE_MESSAGE(r.code == 0, r.err);

@@ -14,22 +14,24 @@ namespace {
 
 constexpr char kMagic[] = "shapematch level checkpoint\n";
 // 2: the attempt of the level in progress (LevelAttempt) follows the extra rings. 3: its
-// rounding (LevelAttempt::Rounding) follows the attempt. 1 and 2 are read too.
-constexpr uint32_t kVersion = 3;
+// rounding (LevelAttempt::Rounding) follows the attempt. 4: LevelReport::stuck_restarts. 1 to 3
+// are read too.
+constexpr uint32_t kVersion = 4;
 
 // Every number of a report, in the file's order (the Γ follows on its own). A field added to
 // LevelReport goes here too, with kVersion one higher; the size check below is the reminder.
 template <class R, class F>
-void each_field(R& r, F&& f) {
+void each_field(R& r, F&& f, uint32_t version) {
   f(r.level), f(r.faces_x), f(r.faces_y), f(r.variables), f(r.full_variables), f(r.constraints), f(r.ring);
   f(r.widenings), f(r.local_widenings), f(r.margin_widenings), f(r.widened_faces), f(r.stuck_widenings);
+  if (version >= 4) f(r.stuck_restarts);
   f(r.price_widenings), f(r.propagation_widenings), f(r.recurring_widenings), f(r.inherited_faces);
   f(r.carried_fixings), f(r.iterations_bound), f(r.rounds), f(r.iterations), f(r.lower_bound), f(r.energy);
   f(r.gap), f(r.threshold), f(r.roundings), f(r.seconds), f(r.peak_rss_mb), f(r.second_start_energy);
   f(r.second_start_kept), f(r.lookahead_other_energy), f(r.lookahead_switched);
 }
 // (It misses a new int or bool that fits in padding: LevelReport's comment asks for this list too.)
-static_assert(sizeof(LevelReport) == 208 + sizeof(std::vector<ProductTriangle>),
+static_assert(sizeof(LevelReport) == 216 + sizeof(std::vector<ProductTriangle>),
               "LevelReport changed: add the new field to each_field and raise kVersion");
 
 class Writer {
@@ -95,25 +97,30 @@ static_assert(std::is_trivially_copyable_v<ProductTriangle> && sizeof(ProductTri
 
 }  // namespace
 
-void save_checkpoint(const std::string& path, const LevelCheckpoint& c) {
+void save_checkpoint(const std::string& path, const LevelCheckpoint& c) { detail::save_checkpoint_as(path, c, kVersion); }
+
+void detail::save_checkpoint_as(const std::string& path, const LevelCheckpoint& c, uint32_t version) {
+  if (version < 1 || version > kVersion) throw InvalidInputError("checkpoint version " + std::to_string(version));
   write_file_atomic(path, [&](std::ostream& out) {
     Writer w(out);
     out.write(kMagic, sizeof kMagic - 1);
-    w(kVersion);
+    w(version);
     w(c.hierarchy);
     w(uint64_t(c.levels.size()));
     for (const LevelReport& r : c.levels) {
-      each_field(r, w);
+      each_field(r, w, version);
       w.array(r.gamma);
     }
     w.array(c.widened);
+    if (version < 2) return;
     w(!c.attempt.empty());
     if (!c.attempt.empty()) {
       const LevelAttempt& a = c.attempt;
       w(a.ring), w(a.local), w(a.propagated), w(a.priced), w(a.regional_done), w(a.around_done);
       w(a.suspicions), w(a.trusted);
-      each_field(a.report, w);
+      each_field(a.report, w, version);
       w.array(a.extra);
+      if (version < 3) return;
       const LevelAttempt::Rounding& g = a.rounding;
       w(g.rounds);
       if (!g.empty()) {
@@ -145,7 +152,7 @@ LevelCheckpoint load_checkpoint(const std::string& path) {
   if (n == 0 || n > 64) throw IoError(path + ": the checkpoint claims " + std::to_string(n) + " levels");
   c.levels.resize(n);
   for (LevelReport& rep : c.levels) {
-    each_field(rep, r);
+    each_field(rep, r, version);
     r.array(rep.gamma);
   }
   r.array(c.widened);
@@ -155,7 +162,7 @@ LevelCheckpoint load_checkpoint(const std::string& path) {
     LevelAttempt& a = c.attempt;
     r(a.ring), r(a.local), r(a.propagated), r(a.priced), r(a.regional_done), r(a.around_done);
     r(a.suspicions), r(a.trusted);
-    each_field(a.report, r);
+    each_field(a.report, r, version);
     r.array(a.extra);
     LevelAttempt::Rounding& g = a.rounding;
     if (version >= 3) r(g.rounds);

@@ -17,6 +17,7 @@
 #include <cmath>
 #include <exception>
 #include <limits>
+#include <optional>
 
 namespace shapematch {
 namespace {
@@ -820,6 +821,14 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
                                                         resume->rounding.rounds, resume->rounding.ones.size()));
   }
   CarriedIterate warm;  // the last attempt's first LP, for the next
+  // A stuck rounding to start again in the same space (stuck_restarts), and the one the attempt
+  // under way goes on from; where the attempt's rounding has got (its rounds, LP iterations and
+  // round 1's bound), for both and for the checkpoint.
+  std::optional<LevelAttempt::Rounding> restart, restarted;
+  int restarts = 0;
+  int rounds_so_far = 0;
+  int64_t iterations_so_far = 0;
+  double first_bound = std::numeric_limits<double>::quiet_NaN();
   // With stuck_carry, where rounding got stuck (StuckError) and the space widened around it: its
   // fixings to 1 (by key), except those over the X faces just widened, go on in the widened
   // space, warm-started from its last iterate; `first` (the first LP of the attempt that started
@@ -946,10 +955,18 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
     return a;
   };
   for (bool first_attempt = true;; first_attempt = false) {
-    if (!first_attempt && attempted && l > 0) attempted(current_attempt());
-    // The checkpointed attempt's rounding, which this first attempt goes on from where it builds
-    // the same LP.
-    const LevelAttempt::Rounding* going_on = first_attempt && resume && !resume->rounding.empty() ? &resume->rounding : nullptr;
+    restarted = std::move(restart);
+    restart.reset();
+    if (!first_attempt && attempted && l > 0) {
+      LevelAttempt a = current_attempt();
+      if (restarted) a.rounding = *restarted;
+      attempted(a);
+    }
+    // The rounding this attempt goes on from where it builds the same LP: a stuck one's, or the
+    // checkpointed attempt's.
+    const LevelAttempt::Rounding* going_on =
+        restarted ? &*restarted
+                  : (first_attempt && resume && !resume->rounding.empty() ? &resume->rounding : nullptr);
     MatchingLp m;
     if (l == 0) {
       m = build_matching_lp(ProductSpace::full(lx.mesh, ly.mesh), model, options_.matching.scale_costs);
@@ -1099,22 +1116,25 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
         spdlog::info("level {}: rounding goes on after round {} from its {} fixings to 1", l + 1, going_on->rounds,
                      going_on->ones.size());
       }
-      // Where the rounding has got, saved as it goes (not where alternatives would run: a run gone
-      // on from fixings runs none).
-      double first_bound = going_on ? going_on->lower_bound : std::numeric_limits<double>::quiet_NaN();
-      int64_t iterations_so_far = going_on ? going_on->iterations : 0;
+      // Where the rounding has got, saved as it goes and kept for a restart (not where
+      // alternatives would run: a run gone on from fixings runs none).
+      const bool tracking = (attempted || restarts < options_.stuck_restarts) && l > 0 && !carrying &&
+                            (ro.alternative_thresholds.empty() || m.lp.cols() > ro.alternatives_below);
+      first_bound = going_on ? going_on->lower_bound : std::numeric_limits<double>::quiet_NaN();
+      rounds_so_far = tracking && going_on ? going_on->rounds : 0;  // (0: nothing to restart from)
+      iterations_so_far = going_on ? going_on->iterations : 0;
       Stopwatch since_saved;
-      if (attempted && l > 0 && !carrying &&
-          (ro.alternative_thresholds.empty() || m.lp.cols() > ro.alternatives_below))
+      if (tracking)
         ro.decided = [&](const RoundingRound& r, const std::vector<int64_t>& ones, double bound) {
           iterations_so_far += r.iterations;
+          rounds_so_far = (going_on ? going_on->rounds : 0) + r.round;
           if (r.round == 1 && !going_on) first_bound = bound;
-          if (since_saved.seconds() < options_.rounding_checkpoint_seconds) return;
+          if (!attempted || since_saved.seconds() < options_.rounding_checkpoint_seconds) return;
           LevelAttempt a = current_attempt();
           a.rounding = {.columns = m.lp.cols(),
                         .rows = m.lp.rows(),
                         .ones = ones,
-                        .rounds = (going_on ? going_on->rounds : 0) + r.round,
+                        .rounds = rounds_so_far,
                         .iterations = iterations_so_far,
                         .lower_bound = first_bound,
                         .reference_seconds = reference_seconds,
@@ -1196,6 +1216,23 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
       // from its fixings but those over the faces just widened (what failed there). Where nothing
       // could widen there, on as below (without trying the same place again).
       const auto* s = dynamic_cast<const StuckError*>(&e);
+      // First (stuck_restarts) start its rounding again here from its fixings, its state afresh.
+      if (s && restarts < options_.stuck_restarts && !s->ones().empty() && rounds_so_far > 0 &&
+          std::isfinite(first_bound)) {
+        ++restarts;
+        ++rep.stuck_restarts;
+        restart = LevelAttempt::Rounding{.columns = m.lp.cols(),
+                                         .rows = m.lp.rows(),
+                                         .ones = s->ones(),
+                                         .rounds = rounds_so_far,
+                                         .iterations = iterations_so_far,
+                                         .lower_bound = first_bound,
+                                         .reference_seconds = reference_seconds,
+                                         .reference_iterations = reference_iterations};
+        spdlog::warn("level {}: {}; starting its rounding again from its {} fixings to 1 ({} of {})", l + 1,
+                     e.what(), s->ones().size(), restarts, options_.stuck_restarts);
+        continue;
+      }
       if (s) {
         std::vector<int> before = extra;
         before.resize(lx.mesh.num_faces(), 0);

@@ -155,6 +155,17 @@ struct CoarseToFineOptions {
   // first LP's iterations) stayed unconverged, and its rounds failed and were trimmed for
   // 10+ minutes, where a fresh attempt finished in 7 (its first LP included).
   bool stuck_carry = false;
+  // With stuck_after: the first this many times a level's rounding is stuck, it starts again in
+  // the same space from its fixings to 1 so far, with its own state afresh (its undo history,
+  // refuted fixings, cap scale and warm start: round 1 solves what the fixings leave, cold), as a
+  // run gone on from a rounding checkpoint does; stuck again after that, it widens as above.
+  // Why: FAUST_r 026-029 without WKS at full resolution thrashed for 60 minutes (rounds undone as
+  // infeasible, releases, doubled caps) and, gone on from its round-51 checkpoint with that state
+  // dropped, finished in 49 rounds and 5:25; a stuck widening solves the whole level again
+  // (round 1 alone took 370-870 s there on one core). 0: off: 043-063 with WKS, gone on twice
+  // that way, thrashed on (its LPs stay at their cap), and a restart keeps what the narrow space
+  // cuts off (the test pair: energy 11.86 against 6.93 after the stuck widening).
+  int stuck_restarts = 0;
   // After a refined level's first LP (optimal), price the product triangles that one more fine
   // ring on every X face would add against its dual; where some price below zero (by more than
   // price_threshold, in energy units, and than the kept columns' low tail, set by the columns
@@ -263,6 +274,7 @@ struct LevelReport {
   int margin_widenings = 0;    // of those, past max_ring near the proof or with a margin around it
   int64_t widened_faces = 0;   // fine X faces widened locally, summed over those times
   int stuck_widenings = 0;     // of the local widenings, those where rounding was stuck (stuck_after)
+  int stuck_restarts = 0;      // times rounding was stuck and started again from its fixings (stuck_restarts)
   int price_widenings = 0;     // of the local widenings, those where pricing found columns below zero
   int propagation_widenings = 0;  // of the local widenings, those where propagation found the contradiction
   int recurring_widenings = 0;    // of those, where it came back in the same π row (recurring_margin)
@@ -345,6 +357,11 @@ struct LevelCheckpoint {
 // missing, not a checkpoint, or cut short.
 void save_checkpoint(const std::string& path, const LevelCheckpoint& checkpoint);
 LevelCheckpoint load_checkpoint(const std::string& path);
+namespace detail {
+// In an earlier version's layout (1 up to the current), what it lacks left out: for tests that
+// older files still load.
+void save_checkpoint_as(const std::string& path, const LevelCheckpoint& checkpoint, uint32_t version);
+}  // namespace detail
 
 // Stateful: owns both hierarchies, so the result's space stays valid while the matcher lives.
 class CoarseToFineMatcher {
