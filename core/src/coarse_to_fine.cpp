@@ -825,7 +825,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
   // under way goes on from; where the attempt's rounding has got (its rounds, LP iterations and
   // round 1's bound), for both and for the checkpoint.
   std::optional<LevelAttempt::Rounding> restart, restarted;
-  int restarts = 0;
+  int restarts = rep.stuck_restarts;  // (a checkpointed attempt's count with it)
   int rounds_so_far = 0;
   int64_t iterations_so_far = 0;
   double first_bound = std::numeric_limits<double>::quiet_NaN();
