@@ -66,6 +66,7 @@ struct MatchArgs {
   int max_local_widenings = CoarseToFineOptions{}.max_local_widenings;
   int max_propagation_widenings = CoarseToFineOptions{}.max_propagation_widenings;
   int recurring_margin = CoarseToFineOptions{}.recurring_margin;
+  double recurring_max_share = CoarseToFineOptions{}.recurring_max_share;
   bool watch_resolve = CoarseToFineOptions{}.watch_resolve;
   int max_suspected_widenings = CoarseToFineOptions{}.max_suspected_widenings;
   double second_start_budget = CoarseToFineOptions{}.second_start_budget;
@@ -149,6 +150,7 @@ int run_match(const MatchArgs& args) {
   co.max_local_widenings = args.max_local_widenings;
   co.max_propagation_widenings = args.max_propagation_widenings;
   co.recurring_margin = args.recurring_margin;
+  co.recurring_max_share = args.recurring_max_share;
   co.watch_resolve = args.watch_resolve;
   co.max_suspected_widenings = args.max_suspected_widenings;
   co.second_start_budget = args.second_start_budget;
@@ -447,6 +449,7 @@ int run_match(const MatchArgs& args) {
                               .set("max_local_widenings", args.max_local_widenings)
                               .set("max_propagation_widenings", args.max_propagation_widenings)
                               .set("recurring_margin", args.recurring_margin)
+                              .set("recurring_max_share", args.recurring_max_share)
                               .set("watch_resolve", args.watch_resolve)
                               .set("max_suspected_widenings", args.max_suspected_widenings)
                               .set("second_start_budget", args.second_start_budget)
@@ -715,6 +718,11 @@ Action add_match_command(CLI::App& app) {
                  "where propagation's contradiction comes back in the same π row, the k-th time widen X faces "
                  "within 1 + this·k rings of it to the largest ring at once (0: off)")
       ->check(CLI::Range(0, 64))
+      ->capture_default_str();
+  app.add_option("--recurring-max-share", a->recurring_max_share,
+                 "with --recurring-margin: where that would widen more than this share of the X faces, widen at the "
+                 "proof as for any contradiction instead (0: no limit)")
+      ->check(CLI::Range(0.0, 1.0))
       ->capture_default_str();
   app.add_option("--second-start-budget", a->second_start_budget,
                  "beside a refined Γ, the second start's rounding gives up once its rounds after the first did this "

@@ -95,6 +95,13 @@ struct CoarseToFineOptions {
   // full resolution: 27 of level 6's 52 propagation widenings were Y face 6 939's π row (639
   // variables every time), in 4-step series per place (docs/results-log.md, twenty-fifth session).
   int recurring_margin = 2;
+  // A return whose widening would take more than this share of the X faces is widened at its
+  // proof as any other contradiction instead (one ring, the proof's X faces). Its margin is
+  // counted from every X face that maps near its Y side, which after one such widening reaches
+  // far: measured, TOSCA_r victoria0-victoria4 without WKS at full resolution, the first return
+  // took 432 faces to ring 6 (10.1 M -> 16.0 M variables), the next 3 179 (45.4 M), an LP
+  // that one core cannot solve in an hour. 0: no limit.
+  double recurring_max_share = 0.1;
   // Let the divergence watch stop the re-solve after pricing too (as before the twenty-sixth
   // session). Off: that re-solve starts at the optimum of a space it contains, and stops at the
   // cold first LP's iterations anyway (detail::watch_divergence says why).
