@@ -1004,16 +1004,19 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
         ProofPlace again(m);
         for (int64_t f : back) again.add(m, m.closedness_rows + f);
         const int margin = options_.widen_margin + options_.recurring_margin * returns;
+        const int cap = options_.max_ring + kMaxRingBeyond;
         const std::vector<int> faces = faces_to_widen(m, again, margin, true);
+        const auto growing = std::count_if(faces.begin(), faces.end(), [&](int f) {
+          return ring + (size_t(f) < extra.size() ? extra[f] : 0) < cap;
+        });
         const bool too_many = options_.recurring_max_share > 0.0 &&
-                              double(faces.size()) > options_.recurring_max_share * double(lx.mesh.num_faces());
+                              double(growing) > options_.recurring_max_share * double(lx.mesh.num_faces());
         if (too_many)
           spdlog::info("level {}: a π row's contradiction came back ({} times), but widening around it would take {} "
-                       "of {} faces: widened at the proof instead",
-                       l + 1, returns, faces.size(), lx.mesh.num_faces());
+                       "of {} faces: widening at the proof instead",
+                       l + 1, returns, growing, lx.mesh.num_faces());
         else
-          widened = widen_locally(faces, "infeasible (a contradiction came back)", options_.max_ring + kMaxRingBeyond,
-                                  false, true);
+          widened = widen_locally(faces, "infeasible (a contradiction came back)", cap, false, true);
         if (widened) {
           ++rep.recurring_widenings;
           spdlog::info("level {}: the same π row's contradiction came back ({} times): widened {} rings around it "
