@@ -806,6 +806,11 @@ TEST_CASE("coarse to fine: a stuck rounding starts again from its fixings in the
     CHECK(check_graph_surface(r.finest.space, r.rounding.gamma).ok());
     CHECK(satisfies_exactly(r.finest.lp, r.rounding.gamma));
     CHECK(l.lower_bound <= l.energy + 1e-9);
+    // The same without a checkpoint to save to: it restarts all the same.
+    const CoarseToFineResult quiet = again.run();
+    CHECK(quiet.levels.back().stuck_restarts == l.stuck_restarts);
+    CHECK(quiet.levels.back().rounds == l.rounds);
+    CHECK(quiet.levels.back().energy == doctest::Approx(l.energy).epsilon(1e-12));
     if (l.stuck_widenings == 0) {  // finished in the space it was stuck in
       const LevelAttempt::Rounding& last = saved.back().rounding;
       CHECK(l.variables == last.columns);

@@ -1046,7 +1046,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
            .trusted = suspicions.trusted(),
            .warm_resolve = warm_resolve,
            .watch_resolve = options_.watch_resolve});
-      if (l > 0 && options_.warm_widening && !carrying) {
+      if (l > 0 && options_.warm_widening && !carrying && !going_on) {  // (a restart starts cold)
         if (!warm.empty()) warm.apply(m, ro.lp);
       }
       // A warm re-solve after pricing starts at an optimum of a slightly smaller LP: it takes a
