@@ -980,6 +980,17 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
     }
     rep.variables = m.lp.cols();
     rep.constraints = m.lp.rows();
+    // This attempt's rounding where it has got, with these fixings to 1: for a checkpoint or a restart.
+    const auto rounding_now = [&](const std::vector<int64_t>& ones) {
+      return LevelAttempt::Rounding{.columns = m.lp.cols(),
+                                    .rows = m.lp.rows(),
+                                    .ones = ones,
+                                    .rounds = rounds_so_far,
+                                    .iterations = iterations_so_far,
+                                    .lower_bound = first_bound,
+                                    .reference_seconds = reference_seconds,
+                                    .reference_iterations = reference_iterations};
+    };
     if (going_on && (going_on->columns != m.lp.cols() || going_on->rows != m.lp.rows())) {
       spdlog::warn("level {}: the checkpointed rounding was of an LP of {} × {}, this one is {} × {}; rounding afresh",
                    l + 1, going_on->rows, going_on->columns, m.lp.rows(), m.lp.cols());
@@ -1142,14 +1153,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
           if (r.round == 1 && !going_on) first_bound = bound;
           if (!attempted || since_saved.seconds() < options_.rounding_checkpoint_seconds) return;
           LevelAttempt a = current_attempt();
-          a.rounding = {.columns = m.lp.cols(),
-                        .rows = m.lp.rows(),
-                        .ones = ones,
-                        .rounds = rounds_so_far,
-                        .iterations = iterations_so_far,
-                        .lower_bound = first_bound,
-                        .reference_seconds = reference_seconds,
-                        .reference_iterations = reference_iterations};
+          a.rounding = rounding_now(ones);
           attempted(a);
           since_saved.reset();
         };
@@ -1232,14 +1236,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
           std::isfinite(first_bound)) {
         ++restarts;
         ++rep.stuck_restarts;
-        restart = LevelAttempt::Rounding{.columns = m.lp.cols(),
-                                         .rows = m.lp.rows(),
-                                         .ones = s->ones(),
-                                         .rounds = rounds_so_far,
-                                         .iterations = iterations_so_far,
-                                         .lower_bound = first_bound,
-                                         .reference_seconds = reference_seconds,
-                                         .reference_iterations = reference_iterations};
+        restart = rounding_now(s->ones());
         spdlog::warn("level {}: {}; starting its rounding again from its {} fixings to 1 ({} of {})", l + 1,
                      e.what(), s->ones().size(), restarts, options_.stuck_restarts);
         continue;
