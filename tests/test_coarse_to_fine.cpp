@@ -949,6 +949,29 @@ TEST_CASE("coarse to fine: a contradiction counts as back only in the π row of 
   CHECK(back.empty());
 }
 
+TEST_CASE("coarse to fine: a recurring widening is too wide by the faces it would still grow") {
+  using detail::recurring_too_wide;
+  // 100 faces at ring 2; faces 0-9 already have 4 extra rings (ring 6 = the cap), 10-19 have 1.
+  std::vector<int> extra(100, 0);
+  for (int f = 0; f < 10; ++f) extra[f] = 4;
+  for (int f = 10; f < 20; ++f) extra[f] = 1;
+  std::vector<int> faces;
+  for (int f = 0; f < 30; ++f) faces.push_back(f);
+  int64_t growing = -1;
+  // 30 faces, but the 10 at the cap do not grow: 20 of 100.
+  CHECK_FALSE(recurring_too_wide(faces, extra, 2, 6, 0.2, 100, &growing));
+  CHECK(growing == 20);
+  CHECK(recurring_too_wide(faces, extra, 2, 6, 0.19, 100, &growing));
+  // A lower cap: faces 10-19 (ring 3) reach it too.
+  CHECK_FALSE(recurring_too_wide(faces, extra, 2, 3, 0.1, 100, &growing));
+  CHECK(growing == 10);
+  // Faces past the end of `extra` have no extra rings; share 0 is never too wide.
+  CHECK(recurring_too_wide({150, 151, 152}, extra, 2, 6, 0.01, 200, &growing));
+  CHECK(growing == 3);
+  CHECK_FALSE(recurring_too_wide(faces, extra, 2, 6, 0.0, 100));
+  CHECK_FALSE(recurring_too_wide({}, extra, 2, 6, 0.1, 100));
+}
+
 TEST_CASE("coarse to fine: the divergence watch stops first LPs with widenings left, not the re-solve after pricing") {
   using detail::FirstLpState;
   using detail::watch_divergence;

@@ -1017,11 +1017,9 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
         const int margin = options_.widen_margin + options_.recurring_margin * returns;
         const int cap = options_.max_ring + kMaxRingBeyond;
         const std::vector<int> faces = faces_to_widen(m, again, margin, true);
-        const auto growing = std::count_if(faces.begin(), faces.end(), [&](int f) {
-          return ring + (size_t(f) < extra.size() ? extra[f] : 0) < cap;
-        });
-        const bool too_many = options_.recurring_max_share > 0.0 &&
-                              double(growing) > options_.recurring_max_share * double(lx.mesh.num_faces());
+        int64_t growing = 0;
+        const bool too_many = detail::recurring_too_wide(faces, extra, ring, cap, options_.recurring_max_share,
+                                                         lx.mesh.num_faces(), &growing);
         if (too_many)
           spdlog::info("level {}: a π row's contradiction came back ({} times), but widening around it would take {} "
                        "of {} faces: widening at the proof instead",

@@ -33,4 +33,17 @@ private:
   std::unordered_map<int64_t, int> seen_;
 };
 
+// Whether a recurring widening of `faces` (fine X faces, each at ring + extra[f] now) to ring `cap`
+// is too wide for it (CoarseToFineOptions::recurring_max_share): it would grow more than `share`
+// of the level's `num_faces`. Faces already at the cap do not grow and do not count. `share` 0:
+// never too wide.
+inline bool recurring_too_wide(const std::vector<int>& faces, const std::vector<int>& extra, int ring, int cap,
+                               double share, int64_t num_faces, int64_t* growing_out = nullptr) {
+  const auto growing = std::count_if(faces.begin(), faces.end(), [&](int f) {
+    return ring + (size_t(f) < extra.size() ? extra[size_t(f)] : 0) < cap;
+  });
+  if (growing_out) *growing_out = growing;
+  return share > 0.0 && double(growing) > share * double(num_faces);
+}
+
 }  // namespace shapematch::detail
