@@ -1030,7 +1030,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
           ++rep.recurring_widenings;
           spdlog::info("level {}: the same π row's contradiction came back ({} times): widened {} rings around it "
                        "to ring {}",
-                       l + 1, returns, 1 + margin, options_.max_ring + kMaxRingBeyond);
+                       l + 1, returns, 1 + margin, cap);
         }
       }
       if (found && !widened) widened = widen_at(m, place, "infeasible");
