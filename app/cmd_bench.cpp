@@ -931,7 +931,7 @@ CheckpointProgress checkpoint_progress(const fs::path& checkpoint) {
   if (!fs::exists(checkpoint)) return {0, 0};
   try {
     const LevelCheckpoint c = load_checkpoint(checkpoint.string());
-    return {static_cast<int>(c.levels.size()), c.attempt.empty() ? 0 : c.attempt.widenings(), c.attempt.rounding.rounds};
+    return {c.done(), c.attempt.empty() ? 0 : c.attempt.widenings(), c.attempt.rounding.rounds};
   } catch (const Error& e) {
     spdlog::warn("{}; starting afresh", e.what());
     fs::remove(checkpoint);

@@ -216,7 +216,8 @@ int run_match(const MatchArgs& args) {
     checkpointing = [&](const LevelCheckpoint& c) {
       save_checkpoint(args.checkpoint, c);
       if (c.attempt.empty())
-        spdlog::info("checkpoint after level {}: {}", c.levels.size(), args.checkpoint);
+        spdlog::info("checkpoint after level {}{}: {}", c.done(), c.chains.empty() ? "" : " (both chains of its lookahead)",
+                     args.checkpoint);
       else if (!c.attempt.rounding.empty())
         spdlog::info("checkpoint in level {}'s rounding, after round {} ({} fixings to 1): {}", c.levels.size() + 1,
                      c.attempt.rounding.rounds, c.attempt.rounding.ones.size(), args.checkpoint);

@@ -39,20 +39,27 @@ Action add_checkpoint_command(CLI::App& app) {
   app.add_option("FILE", *file, "a checkpoint written by match --checkpoint")->required();
   return [file] {
     const LevelCheckpoint c = load_checkpoint(*file);
-    Json levels = Json::array();
-    for (const LevelReport& r : c.levels)
-      levels.push(Json::object()
-                      .set("level", r.level)  // (0 = coarsest, as in report.json)
-                      .set("faces_x", r.faces_x)
-                      .set("faces_y", r.faces_y)
-                      .set("variables", r.variables)
-                      .set("ring", r.ring)
-                      .set("widenings", r.widenings + r.local_widenings)
-                      .set("rounds", r.rounds)
-                      .set("energy", r.energy)
-                      .set("lower_bound", r.lower_bound)
-                      .set("gap", r.gap)
-                      .set("seconds", r.seconds));
+    auto reports = [](const std::vector<LevelReport>& rs) {
+      Json levels = Json::array();
+      for (const LevelReport& r : rs)
+        levels.push(Json::object()
+                        .set("level", r.level)  // (0 = coarsest, as in report.json)
+                        .set("faces_x", r.faces_x)
+                        .set("faces_y", r.faces_y)
+                        .set("variables", r.variables)
+                        .set("ring", r.ring)
+                        .set("widenings", r.widenings + r.local_widenings)
+                        .set("rounds", r.rounds)
+                        .set("energy", r.energy)
+                        .set("lower_bound", r.lower_bound)
+                        .set("gap", r.gap)
+                        .set("seconds", r.seconds));
+      return levels;
+    };
+    Json levels = reports(c.levels);
+    Json lookahead = Json::array();  // inside lookahead: both chains' levels since its split
+    for (const LevelCheckpoint::Chain& chain : c.chains)
+      lookahead.push(Json::object().set("leading", chain.leading).set("levels", reports(chain.pending)));
     Json attempt;  // null where no level is in progress
     if (const LevelAttempt& a = c.attempt; !a.empty()) {
       Json rounding;
@@ -78,8 +85,9 @@ Action add_checkpoint_command(CLI::App& app) {
     }
     std::cout << Json::object()
                      .set("file", *file)
-                     .set("levels_done", static_cast<int64_t>(c.levels.size()))
+                     .set("levels_done", c.done())
                      .set("levels", std::move(levels))
+                     .set("lookahead", std::move(lookahead))
                      .set("attempt", std::move(attempt))
                      .dump()
               << "\n";

@@ -1,4 +1,5 @@
 // End-to-end tests of the `shapematch` executable: exit codes, one-line errors, JSON output.
+#include "shapematch/coarse_to_fine.hpp"
 #include "shapematch/rounding.hpp"
 #include "shapematch/system.hpp"
 #include "test_helpers.hpp"
@@ -310,6 +311,33 @@ TEST_CASE("cli: match --checkpoint goes on after the levels a stopped run finish
   r = run("checkpoint " + dolphin);
   CHECK(r.code == 1);
   CHECK(r.err.find(dolphin + ": not a shapematch checkpoint") != std::string::npos);
+}
+
+TEST_CASE("cli: checkpoint shows both chains of a run stopped inside lookahead") {
+  shapematch::test::TempDir tmp;
+  const std::string ckpt = (tmp.path / "two.ckpt").string();
+  // Level 1 done before the split, then levels 2 and 3 on each chain (the command needs no meshes).
+  shapematch::LevelCheckpoint c;
+  auto level = [](int l, double energy) {
+    shapematch::LevelReport r;
+    r.level = l;
+    r.energy = energy;
+    r.gamma.resize(3);
+    return r;
+  };
+  c.levels = {level(0, 1.5)};
+  c.chains = {{{level(1, 2.25), level(2, 3.5)}, {}, true}, {{level(1, 2.5), level(2, 3.25)}, {}, false}};
+  shapematch::save_checkpoint(ckpt, c);
+  const Run r = run("checkpoint " + ckpt);
+  REQUIRE_MESSAGE(r.code == 0, r.err);
+  CHECK(json_number(r.out, "levels_done") == 3);
+  const size_t lookahead = r.out.find("\"lookahead\"");
+  REQUIRE(lookahead != std::string::npos);
+  const std::string chains = r.out.substr(lookahead);
+  CHECK(chains.find("\"leading\": true") < chains.find("\"leading\": false"));
+  for (const char* energy : {"2.25", "3.5", "2.5", "3.25"})
+    CHECK(chains.find(std::string("\"energy\": ") + energy) != std::string::npos);
+  CHECK(r.out.substr(0, lookahead).find("\"energy\": 2.25") == std::string::npos);  // not among `levels`
 }
 
 // tools/pdhg_work.sh reads what PDHG logs at debug level: on a written log its sums are checked

@@ -697,6 +697,94 @@ TEST_CASE("coarse to fine: two lookahead chains that reach the same Γ go on as 
   CHECK(check_graph_surface(r.finest.space, r.rounding.gamma).ok());
 }
 
+TEST_CASE("coarse to fine: a run gone on from a checkpoint inside lookahead ends as the whole run") {
+  // The dolphins of the lookahead test: both chains go on from level 2 to level 4's decision.
+  const Mesh dx = decimate(shapes::dolphin(20, 0), 80), dy = decimate(shapes::dolphin(-20, 40), 90);
+  CoarseToFineOptions o = small_levels();
+  o.lookahead_levels = 2;
+  const CoarseToFineMatcher matcher(dx, dy, o);
+  REQUIRE(matcher.x_levels().size() == 5);
+  std::vector<LevelCheckpoint> saved;
+  const CoarseToFineResult whole = matcher.run({}, nullptr, [&](const LevelCheckpoint& c) {
+    if (c.attempt.empty()) saved.push_back(c);
+  });
+  // After levels 1 to 4: one chain, two (levels 2 and 3, before the decision at 4), then one.
+  REQUIRE(saved.size() == 4);
+  for (size_t k = 0; k < saved.size(); ++k) {
+    CHECK(saved[k].done() == int(k + 1));
+    CHECK(saved[k].chains.size() == (k == 1 || k == 2 ? 2u : 0u));
+  }
+  for (size_t k : {size_t(1), size_t(2)}) {
+    CHECK(saved[k].levels.size() == 1);  // the levels before the split
+    CHECK(saved[k].chains[0].leading);
+    CHECK_FALSE(saved[k].chains[1].leading);
+    for (const LevelCheckpoint::Chain& chain : saved[k].chains) CHECK(chain.pending.size() == k);
+    // One of the two is the chain that went on.
+    const bool first = saved[k].chains[0].pending.back().gamma == whole.levels[k].gamma;
+    const bool second = saved[k].chains[1].pending.back().gamma == whole.levels[k].gamma;
+    CHECK(first != second);
+  }
+  const LevelReport& d = whole.levels[3];
+  REQUIRE(std::isfinite(d.lookahead_other_energy));
+
+  test::TempDir tmp;
+  const std::string file = (tmp.path / "lookahead.ckpt").string();
+  for (size_t k : {size_t(1), size_t(2)}) {
+    save_checkpoint(file, saved[k]);
+    const LevelCheckpoint loaded = load_checkpoint(file);
+    REQUIRE(loaded.chains.size() == 2);
+    for (int i = 0; i < 2; ++i) {
+      CHECK(loaded.chains[i].leading == saved[k].chains[i].leading);
+      CHECK(loaded.chains[i].widened == saved[k].chains[i].widened);
+      REQUIRE(loaded.chains[i].pending.size() == saved[k].chains[i].pending.size());
+      CHECK(loaded.chains[i].pending.back().gamma == saved[k].chains[i].pending.back().gamma);
+      CHECK(loaded.chains[i].pending.back().energy == saved[k].chains[i].pending.back().energy);
+    }
+    int called = 0;
+    const CoarseToFineResult r = matcher.run({}, &loaded, [&](const LevelCheckpoint& c) { called += c.attempt.empty(); });
+    CHECK(called == 3 - int(k));  // the levels after it but the finest
+    REQUIRE(r.levels.size() == whole.levels.size());
+    for (size_t l = 0; l < r.levels.size(); ++l) {
+      CHECK(r.levels[l].energy == doctest::Approx(whole.levels[l].energy).epsilon(1e-12));
+      CHECK(r.levels[l].gamma == whole.levels[l].gamma);
+      CHECK(r.levels[l].second_start_kept == whole.levels[l].second_start_kept);
+      CHECK(r.levels[l].lookahead_switched == whole.levels[l].lookahead_switched);
+    }
+    CHECK(r.levels[3].lookahead_other_energy == doctest::Approx(d.lookahead_other_energy).epsilon(1e-12));
+    CHECK(r.rounding.energy == doctest::Approx(whole.rounding.energy).epsilon(1e-12));
+    CHECK(check_graph_surface(r.finest.space, r.rounding.gamma).ok());
+  }
+
+  // With less lookahead, a checkpoint past the decision is decided at once: at level 3, by
+  // energy there.
+  o.lookahead_levels = 1;
+  const CoarseToFineMatcher shorter(dx, dy, o);
+  REQUIRE(shorter.fingerprint() == matcher.fingerprint());
+  const CoarseToFineResult r = shorter.run({}, &saved[2]);
+  REQUIRE(r.levels.size() == whole.levels.size());
+  const auto& chains = saved[2].chains;
+  const double e0 = chains[0].pending.back().energy, e1 = chains[1].pending.back().energy;
+  CHECK(r.levels[2].energy == std::min(e0, e1));
+  CHECK(r.levels[2].lookahead_other_energy == std::max(e0, e1));
+  CHECK(r.levels[2].gamma == chains[e1 < e0 ? 1 : 0].pending.back().gamma);
+  CHECK(std::isnan(r.levels[3].lookahead_other_energy));
+  CHECK(check_graph_surface(r.finest.space, r.rounding.gamma).ok());
+
+  // Chains of different lengths, beside an attempt, or a version-4 file (which drops them).
+  LevelCheckpoint uneven = saved[2];
+  uneven.chains[1].pending.pop_back();
+  CHECK_THROWS_AS(matcher.run({}, &uneven), InvalidInputError);
+  LevelCheckpoint beside = saved[2];
+  beside.attempt.ring = 1;
+  beside.attempt.extra.assign(matcher.x_levels().levels[3].mesh.num_faces(), 0);
+  beside.attempt.report.level = 3;
+  CHECK_THROWS_AS(matcher.run({}, &beside), InvalidInputError);
+  detail::save_checkpoint_as(file, saved[2], 4);
+  const LevelCheckpoint v4 = load_checkpoint(file);
+  CHECK(v4.chains.empty());
+  CHECK(v4.done() == 1);
+}
+
 TEST_CASE("coarse to fine: a stuck rounding widens around its failed parts and goes on from its fixings") {
   // Measured: with max_rounds 3 and a wide greedy margin (few fixings per round), this pair's
   // finest rounding (ring 0) runs out of rounds with a few faces open. Stuck (stuck_after), it

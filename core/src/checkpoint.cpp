@@ -14,9 +14,9 @@ namespace {
 
 constexpr char kMagic[] = "shapematch level checkpoint\n";
 // 2: the attempt of the level in progress (LevelAttempt) follows the extra rings. 3: its
-// rounding (LevelAttempt::Rounding) follows the attempt. 4: LevelReport::stuck_restarts. 1 to 3
-// are read too.
-constexpr uint32_t kVersion = 4;
+// rounding (LevelAttempt::Rounding) follows the attempt. 4: LevelReport::stuck_restarts. 5: the
+// lookahead's chains (LevelCheckpoint::chains) follow. 1 to 4 are read too.
+constexpr uint32_t kVersion = 5;
 
 // Every number of a report, in the file's order (the Γ follows on its own). A field added to
 // LevelReport goes here too, with kVersion one higher; the size check below is the reminder.
@@ -128,6 +128,17 @@ void detail::save_checkpoint_as(const std::string& path, const LevelCheckpoint& 
         w.array(g.ones);
       }
     }
+    if (version < 5) return;
+    w(uint64_t(c.chains.size()));
+    for (const LevelCheckpoint::Chain& chain : c.chains) {
+      w(chain.leading);
+      w(uint64_t(chain.pending.size()));
+      for (const LevelReport& r : chain.pending) {
+        each_field(r, w, version);
+        w.array(r.gamma);
+      }
+      w.array(chain.widened);
+    }
   });
 }
 
@@ -172,6 +183,26 @@ LevelCheckpoint load_checkpoint(const std::string& path) {
       r.array(g.ones);
     }
     if (a.ring < 0) throw IoError(path + ": not a shapematch checkpoint (an attempt at ring " + std::to_string(a.ring) + ")");
+  }
+  if (version >= 5) {
+    uint64_t chains = 0;
+    r(chains);
+    if (chains != 0 && chains != 2)
+      throw IoError(path + ": the checkpoint claims " + std::to_string(chains) + " lookahead chains");
+    c.chains.resize(chains);
+    for (LevelCheckpoint::Chain& chain : c.chains) {
+      r(chain.leading);
+      uint64_t k = 0;
+      r(k);
+      if (k == 0 || n + k > 64)  // (n: the levels before the split)
+        throw IoError(path + ": a lookahead chain claims " + std::to_string(k) + " levels");
+      chain.pending.resize(k);
+      for (LevelReport& rep : chain.pending) {
+        each_field(rep, r, version);
+        r.array(rep.gamma);
+      }
+      r.array(chain.widened);
+    }
   }
   if (!r.done()) throw IoError(path + ": trailing bytes after the checkpoint");
   return c;

@@ -471,17 +471,66 @@ CoarseToFineResult CoarseToFineMatcher::run(const Progress& progress, const Leve
   const int levels = hx_.size();
   int decide_at = -1;
   int start = 0;
+  // After level l: two chains that reached the same Γ go on as one, two at decide_at are
+  // decided, and a single chain's reports become the result's. Every level but the finest is
+  // then a checkpoint (where `save`), with both chains inside lookahead.
+  auto settle = [&](int l, bool save) {
+    // Two chains that reached the same Γ would repeat each other's every LP from here on: the
+    // leading one goes on alone, as the decision would keep it on a tie. Measured, FAUST_r 065-069
+    // at full resolution (the chains met at 532 faces): its 1 414-face level took 82 s, not 191.
+    if (chains.size() > 1 && l < decide_at && same_surface(chains[0].gamma, chains[1].gamma) &&
+        (options_.inherit_widening == 0 || chains[0].widened == chains[1].widened)) {
+      chains[0].pending.back().lookahead_other_energy = chains[1].pending.back().energy;
+      spdlog::info("level {}: both chains reached the same Γ (energy {:.6g}): one goes on", l + 1,
+                   chains[0].pending.back().energy);
+      chains.pop_back();
+    }
+    if (chains.size() > 1 && l >= decide_at) {
+      const size_t best = chains[1].pending.back().energy < chains[0].pending.back().energy ? 1 : 0;
+      chains[best].pending.back().lookahead_other_energy = chains[1 - best].pending.back().energy;
+      spdlog::info("level {}: lookahead energies {:.6g} (the chain leading at level 2) and {:.6g}: the {} goes on",
+                   l + 1, chains[0].pending.back().energy, chains[1].pending.back().energy,
+                   best == 0 ? "leading one" : "other one");
+      Chain kept = std::move(chains[best]);
+      chains.clear();
+      chains.push_back(std::move(kept));
+    }
+    if (chains.size() == 1) {
+      Chain& c = chains.front();
+      if (c.pending.size() > 1) c.pending.back().lookahead_switched = !c.leading;  // reports held since a split
+      for (LevelReport& r : c.pending) result.levels.push_back(r);
+      c.pending.clear();
+      if (save && checkpoint && l + 1 < levels) checkpoint(LevelCheckpoint{fingerprint(), result.levels, c.widened});
+    } else if (save && checkpoint && l + 1 < levels) {
+      LevelCheckpoint both{fingerprint(), result.levels};
+      for (const Chain& c : chains) both.chains.push_back({c.pending, c.widened, c.leading});
+      checkpoint(both);
+    }
+  };
   if (resume) {
     check(*resume);
     result.levels = resume->levels;
-    chains[0].gamma = resume->levels.back().gamma;
-    chains[0].widened = resume->widened;
-    start = static_cast<int>(resume->levels.size());
-    spdlog::info("going on from a checkpoint after level {} of {} (energy {:.6g}){}", start, levels,
-                 resume->levels.back().energy,
+    start = resume->done();
+    if (resume->chains.empty()) {
+      chains[0].gamma = resume->levels.back().gamma;
+      chains[0].widened = resume->widened;
+    } else {
+      chains.clear();
+      for (const LevelCheckpoint::Chain& saved : resume->chains)
+        chains.push_back(Chain{saved.pending.back().gamma, saved.pending, saved.leading, saved.widened});
+      // Decided where this run's options put the decision, counted from the split as there (a
+      // checkpoint already past it is decided at once).
+      decide_at = std::min(static_cast<int>(resume->levels.size()) + options_.lookahead_levels, levels - 2);
+    }
+    spdlog::info("going on from a checkpoint after level {} of {} (energy {}){}", start, levels,
+                 chains.size() == 1
+                     ? fmt::format("{:.6g}", resume->levels.back().energy)
+                     : fmt::format("{:.6g} and {:.6g}, both chains of its lookahead", chains[0].pending.back().energy,
+                                   chains[1].pending.back().energy),
                  resume->attempt.empty() ? std::string()
                                          : fmt::format(", level {}'s widenings {}", start + 1,
                                                        resume->attempt.widenings()));
+    if (chains.size() > 1) settle(start - 1, false);  // (its file holds this state, or one it decides)
   }
   for (int l = start; l < levels; ++l) {
     const MeshLevel& lx = hx_.levels[l];
@@ -559,33 +608,7 @@ CoarseToFineResult CoarseToFineMatcher::run(const Progress& progress, const Leve
       c.pending.back().seconds = seconds;
       c.pending.back().peak_rss_mb = rss;
     }
-    // Two chains that reached the same Γ would repeat each other's every LP from here on: the
-    // leading one goes on alone, as the decision would keep it on a tie. Measured, FAUST_r 065-069
-    // at full resolution (the chains met at 532 faces): its 1 414-face level took 82 s, not 191.
-    if (chains.size() > 1 && l < decide_at && same_surface(chains[0].gamma, chains[1].gamma) &&
-        (options_.inherit_widening == 0 || chains[0].widened == chains[1].widened)) {
-      chains[0].pending.back().lookahead_other_energy = chains[1].pending.back().energy;
-      spdlog::info("level {}: both chains reached the same Γ (energy {:.6g}): one goes on", l + 1,
-                   chains[0].pending.back().energy);
-      chains.pop_back();
-    }
-    if (chains.size() > 1 && l >= decide_at) {
-      const size_t best = chains[1].pending.back().energy < chains[0].pending.back().energy ? 1 : 0;
-      chains[best].pending.back().lookahead_other_energy = chains[1 - best].pending.back().energy;
-      spdlog::info("level {}: lookahead energies {:.6g} (the chain leading at level 2) and {:.6g}: the {} goes on",
-                   l + 1, chains[0].pending.back().energy, chains[1].pending.back().energy,
-                   best == 0 ? "leading one" : "other one");
-      Chain kept = std::move(chains[best]);
-      chains.clear();
-      chains.push_back(std::move(kept));
-    }
-    if (chains.size() == 1) {
-      Chain& c = chains.front();
-      if (c.pending.size() > 1) c.pending.back().lookahead_switched = !c.leading;  // reports held since a split
-      for (LevelReport& r : c.pending) result.levels.push_back(r);
-      c.pending.clear();
-      if (checkpoint && l + 1 < levels) checkpoint(LevelCheckpoint{fingerprint(), result.levels, c.widened});
-    }
+    settle(l, true);
   }
   return result;
 }
@@ -593,13 +616,12 @@ CoarseToFineResult CoarseToFineMatcher::run(const Progress& progress, const Leve
 void CoarseToFineMatcher::check(const LevelCheckpoint& c) const {
   if (c.hierarchy != fingerprint())
     throw InvalidInputError("the checkpoint was written for other meshes or another hierarchy");
-  const size_t done = c.levels.size();
-  if (done == 0 || done >= size_t(hx_.size()))
+  const size_t done = c.done();
+  if (c.levels.empty() || done >= size_t(hx_.size()))
     throw InvalidInputError("the checkpoint holds " + std::to_string(done) + " levels of " + std::to_string(hx_.size()) +
                             "; a run goes on from one only below the finest");
   // (A file damaged in place still has its fingerprint: its Γ indexes the meshes.)
-  for (size_t l = 0; l < done; ++l) {
-    const LevelReport& r = c.levels[l];
+  auto fit = [&](const LevelReport& r, size_t l) {
     const Mesh& x = hx_.levels[l].mesh;
     const Mesh& y = hy_.levels[l].mesh;
     bool fits = r.level == int(l) && r.faces_x == x.num_faces() && r.faces_y == y.num_faces() && !r.gamma.empty();
@@ -609,9 +631,21 @@ void CoarseToFineMatcher::check(const LevelCheckpoint& c) const {
       fits = fits && t.fa >= -1 && t.fa < x.num_faces() && t.fb >= -1 && t.fb < y.num_faces();
     }
     if (!fits) throw InvalidInputError("the checkpoint's level " + std::to_string(l + 1) + " does not fit its meshes");
-  }
-  if (!c.widened.empty() && c.widened.size() != size_t(hx_.levels[done - 1].mesh.num_faces()))
+  };
+  for (size_t l = 0; l < c.levels.size(); ++l) fit(c.levels[l], l);
+  const size_t last_faces = hx_.levels[done - 1].mesh.num_faces();
+  if (!c.widened.empty() && c.widened.size() != last_faces)
     throw InvalidInputError("the checkpoint's extra rings do not fit its last level");
+  if (!c.chains.empty() && (c.chains.size() != 2 || !c.attempt.empty() || !c.widened.empty()))
+    throw InvalidInputError("the checkpoint's lookahead holds " + std::to_string(c.chains.size()) +
+                            " chains, or a level's attempt beside them");
+  for (const LevelCheckpoint::Chain& chain : c.chains) {
+    if (chain.pending.empty() || c.levels.size() + chain.pending.size() != done)
+      throw InvalidInputError("the checkpoint's lookahead chains hold different levels");
+    for (size_t k = 0; k < chain.pending.size(); ++k) fit(chain.pending[k], c.levels.size() + k);
+    if (!chain.widened.empty() && chain.widened.size() != last_faces)
+      throw InvalidInputError("the checkpoint's extra rings do not fit its last level");
+  }
   const LevelAttempt& a = c.attempt;
   if (!a.empty() && (a.extra.size() != size_t(hx_.levels[done].mesh.num_faces()) || a.ring > 64 ||
                      std::any_of(a.extra.begin(), a.extra.end(), [](int e) { return e < 0 || e > 64; }) ||
