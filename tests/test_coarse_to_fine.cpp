@@ -1113,7 +1113,7 @@ TEST_CASE("coarse to fine: after N suspicions in a row the watch is off until a 
 
 TEST_CASE("coarse to fine: a run gone on from a level's checkpoint ends as the whole run") {
   CoarseToFineOptions o = small_levels();
-  o.lookahead_levels = 0;  // (with lookahead no level before the decision is a checkpoint)
+  o.lookahead_levels = 0;  // (one chain throughout; inside lookahead: the test case above)
   o.inherit_widening = 2;  // so that the extra rings a level widened by carry over too
   const CoarseToFineMatcher matcher = finger_matcher(o);
   const int levels = matcher.x_levels().size();
