@@ -95,6 +95,21 @@ private:
 
 static_assert(std::is_trivially_copyable_v<ProductTriangle> && sizeof(ProductTriangle) == 8 * sizeof(int));
 
+// Level reports, each followed by its Γ (the count is the caller's).
+void write_levels(Writer& w, const std::vector<LevelReport>& levels, uint32_t version) {
+  for (const LevelReport& r : levels) {
+    each_field(r, w, version);
+    w.array(r.gamma);
+  }
+}
+void read_levels(Reader& r, std::vector<LevelReport>& levels, uint64_t count, uint32_t version) {
+  levels.resize(count);
+  for (LevelReport& rep : levels) {
+    each_field(rep, r, version);
+    r.array(rep.gamma);
+  }
+}
+
 }  // namespace
 
 void save_checkpoint(const std::string& path, const LevelCheckpoint& c) { detail::save_checkpoint_as(path, c, kVersion); }
@@ -107,10 +122,7 @@ void detail::save_checkpoint_as(const std::string& path, const LevelCheckpoint& 
     w(version);
     w(c.hierarchy);
     w(uint64_t(c.levels.size()));
-    for (const LevelReport& r : c.levels) {
-      each_field(r, w, version);
-      w.array(r.gamma);
-    }
+    write_levels(w, c.levels, version);
     w.array(c.widened);
     if (version < 2) return;
     w(!c.attempt.empty());
@@ -133,10 +145,7 @@ void detail::save_checkpoint_as(const std::string& path, const LevelCheckpoint& 
     for (const LevelCheckpoint::Chain& chain : c.chains) {
       w(chain.leading);
       w(uint64_t(chain.pending.size()));
-      for (const LevelReport& r : chain.pending) {
-        each_field(r, w, version);
-        w.array(r.gamma);
-      }
+      write_levels(w, chain.pending, version);
       w.array(chain.widened);
     }
   });
@@ -161,11 +170,7 @@ LevelCheckpoint load_checkpoint(const std::string& path) {
   uint64_t n = 0;
   r(n);
   if (n == 0 || n > 64) throw IoError(path + ": the checkpoint claims " + std::to_string(n) + " levels");
-  c.levels.resize(n);
-  for (LevelReport& rep : c.levels) {
-    each_field(rep, r, version);
-    r.array(rep.gamma);
-  }
+  read_levels(r, c.levels, n, version);
   r.array(c.widened);
   bool attempt = false;
   if (version >= 2) r(attempt);
@@ -196,11 +201,7 @@ LevelCheckpoint load_checkpoint(const std::string& path) {
       r(k);
       if (k == 0 || n + k > 64)  // (n: the levels before the split)
         throw IoError(path + ": a lookahead chain claims " + std::to_string(k) + " levels");
-      chain.pending.resize(k);
-      for (LevelReport& rep : chain.pending) {
-        each_field(rep, r, version);
-        r.array(rep.gamma);
-      }
+      read_levels(r, chain.pending, k, version);
       r.array(chain.widened);
     }
   }
