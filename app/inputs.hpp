@@ -20,8 +20,10 @@ struct PairArgs {
   std::string features_x, features_y;
   std::string wks = "auto";  // on, off, auto (on unless user features are given)
   // On by default since measured (docs/results-log.md, "The feature term with the whole chain"):
-  // FAUST_r at 1000 faces 0.098 → 0.051 mean error over 8 pairs, TOSCA_r at 500 no worse.
-  double feature_weight = 1.0;
+  // FAUST_r at 1000 faces 0.098 → 0.051 mean error over 8 pairs, TOSCA_r at 500 no worse. 10
+  // since the forty-fourth session: at full resolution FAUST_r 029-069 0.0327 -> 0.0287 and
+  // 026-063 0.0312 -> 0.0261, up to 1 414 faces lower on all nine pairs tried (forty-third).
+  double feature_weight = 10.0;
   double degenerate_penalty = 0.0;
   // 0.05 since measured at full resolution (docs/results-log.md, thirty-fourth session): FAUST_r
   // 021-029's error 0.0319 -> 0.0170 (the one above issue 6's 0.03), 020-024 0.0169 -> 0.0177,
