@@ -1230,22 +1230,28 @@ TEST_CASE("coarse to fine: a run gone on from an attempt of a level in progress 
   wrong.attempt.report.level = 0;
   CHECK_THROWS_AS(matcher.run({}, &wrong), InvalidInputError);
   // Files of earlier versions still load: the first (no attempt), the second (an attempt, no
-  // rounding), the third (no stuck_restarts).
+  // rounding), the third (no stuck_restarts), the fourth (no lookahead chains).
   LevelCheckpoint marked = last;
   marked.attempt.report.stuck_restarts = 2;
   for (LevelReport& rep : marked.levels) rep.stuck_restarts = 1;
   save_checkpoint(file, marked);
+  const LevelCheckpoint current = load_checkpoint(file);
+  CHECK(current.attempt.report.stuck_restarts == 2);
+  CHECK(current.levels.front().stuck_restarts == 1);
+  detail::save_checkpoint_as(file, marked, 4);
   const LevelCheckpoint v4 = load_checkpoint(file);
   CHECK(v4.attempt.report.stuck_restarts == 2);
   CHECK(v4.levels.front().stuck_restarts == 1);
+  CHECK(v4.attempt.rounding.ones == marked.attempt.rounding.ones);
+  save_checkpoint(file, marked);
   std::string bytes;
   {
     std::ifstream in(file, std::ios::binary);
     bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
   }
   const size_t at = std::string("shapematch level checkpoint\n").size();
-  REQUIRE(bytes[at] == 4);
-  bytes[at] = 5;  // a later version than this build's
+  REQUIRE(bytes[at] == 5);
+  bytes[at] = 6;  // a later version than this build's
   std::ofstream(file, std::ios::binary) << bytes;
   CHECK_THROWS_AS(load_checkpoint(file), IoError);
   detail::save_checkpoint_as(file, marked, 1);
@@ -1265,7 +1271,7 @@ TEST_CASE("coarse to fine: a run gone on from an attempt of a level in progress 
   CHECK(v3.attempt.report.widened_faces == a.report.widened_faces);
   CHECK(v3.attempt.report.stuck_restarts == 0);
   CHECK(v3.levels.back().gamma == last.levels.back().gamma);
-  CHECK_THROWS_AS(detail::save_checkpoint_as(file, marked, 5), InvalidInputError);
+  CHECK_THROWS_AS(detail::save_checkpoint_as(file, marked, 6), InvalidInputError);
 }
 
 TEST_CASE("coarse to fine: a run gone on from a checkpoint inside a rounding fixes its decisions and keeps its bound") {
