@@ -2,6 +2,7 @@
 #include "commands.hpp"
 #include "shapematch/coarse_to_fine.hpp"
 #include "shapematch/device.hpp"
+#include "shapematch/errors.hpp"
 #include "shapematch/json.hpp"
 #include "shapematch/shapes.hpp"
 
@@ -10,6 +11,7 @@
 #include <algorithm>
 #include <iostream>
 #include <memory>
+#include <string>
 
 namespace shapematch::app {
 
@@ -31,14 +33,43 @@ Action add_devices_command(CLI::App& app) {
   };
 }
 
+// The first `keep` levels of a checkpoint and nothing after them (no attempt, no lookahead), so
+// that a level can be solved again from scratch under other options: a run gone on from the
+// whole file would go on in its attempt's space. The extra rings the next level inherits are
+// only known for the last level held (inherit_widening), so they go with any level before it.
+LevelCheckpoint keep_levels(LevelCheckpoint c, int keep, const std::string& file) {
+  if (keep < 1 || keep > int(c.levels.size()))
+    throw InvalidInputError(file + ": --keep-levels " + std::to_string(keep) + " is not between 1 and the " +
+                            std::to_string(c.levels.size()) + " levels it holds" +
+                            (c.chains.empty() ? "" : " before its lookahead"));
+  if (keep < int(c.levels.size())) c.widened.clear();
+  c.levels.resize(keep);
+  c.chains.clear();
+  c.attempt = LevelAttempt{};
+  return c;
+}
+
 // Where a stopped run stands (match --checkpoint), as JSON on stdout: the levels done, the
 // attempt of the level in progress and how far its rounding got. The meshes are not needed: a
-// run gone on from the file checks that it fits them.
+// run gone on from the file checks that it fits them. With --keep-levels, the same of a new
+// file holding only the first levels.
 Action add_checkpoint_command(CLI::App& app) {
   auto file = std::make_shared<std::string>();
+  auto keep = std::make_shared<int>(0);
+  auto out = std::make_shared<std::string>();
   app.add_option("FILE", *file, "a checkpoint written by match --checkpoint")->required();
-  return [file] {
-    const LevelCheckpoint c = load_checkpoint(*file);
+  auto* keep_opt = app.add_option("--keep-levels", *keep,
+                                  "write to --out a checkpoint of the first N levels only: no attempt in progress, "
+                                  "no lookahead (to solve the next level again from scratch)");
+  app.add_option("--out", *out, "where --keep-levels writes (may be FILE itself)")->needs(keep_opt);
+  keep_opt->needs(app.get_option("--out"));
+  return [file, keep, out, keep_opt] {
+    LevelCheckpoint c = load_checkpoint(*file);
+    if (keep_opt->count() > 0) {
+      c = keep_levels(std::move(c), *keep, *file);
+      save_checkpoint(*out, c);
+      *file = *out;
+    }
     auto reports = [](const std::vector<LevelReport>& rs) {
       Json levels = Json::array();
       for (const LevelReport& r : rs)

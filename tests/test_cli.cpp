@@ -302,6 +302,28 @@ TEST_CASE("cli: match --checkpoint goes on after the levels a stopped run finish
   CHECK(json_number(second, "resumed_after_level") == 2);
   CHECK(json_number(second, "energy") == json_number(first, "energy"));
   CHECK(read_file(tmp.path / "b" / "map_x_to_y.txt") == read_file(tmp.path / "a" / "map_x_to_y.txt"));
+  // Only level 1 of it: the run solves level 2 again, from level 1's Γ as in the first run, so
+  // every level ends as there.
+  const std::string one = (tmp.path / "one.ckpt").string();
+  r = run("checkpoint " + ckpt + " --keep-levels 1 --out " + one);
+  REQUIRE_MESSAGE(r.code == 0, r.err);
+  CHECK(json_number(r.out, "levels_done") == 1);
+  CHECK(r.out.find(one) != std::string::npos);  // what it shows is the new file
+  r = run("match " + dolphin + " " + swimming + args.substr(0, args.find(" --checkpoint ")) + " --checkpoint " + one +
+          " -o " + (tmp.path / "e").string());
+  REQUIRE_MESSAGE(r.code == 0, r.err);
+  CHECK(r.err.find("going on from a checkpoint after level 1 of 3") != std::string::npos);
+  CHECK(json_number(read_file(tmp.path / "e" / "report.json"), "energy") == json_number(first, "energy"));
+  CHECK(read_file(tmp.path / "e" / "map_x_to_y.txt") == read_file(tmp.path / "a" / "map_x_to_y.txt"));
+  // More levels than it holds, or none: one line naming the file, nothing written.
+  for (const char* keep : {"3", "0"}) {
+    r = run("checkpoint " + ckpt + " --keep-levels " + keep + " --out " + (tmp.path / "bad.ckpt").string());
+    CHECK(r.code != 0);
+    CHECK(r.err.find(ckpt + ": --keep-levels " + keep + " is not between 1 and the 2 levels") != std::string::npos);
+    CHECK_FALSE(fs::exists(tmp.path / "bad.ckpt"));
+  }
+  r = run("checkpoint " + ckpt + " --keep-levels 1");  // where to?
+  CHECK(r.code != 0);
   // Another pair: one line naming the file, nothing written.
   r = run("match " + swimming + " " + dolphin + args + (tmp.path / "c").string());
   CHECK(r.code != 0);
@@ -338,6 +360,44 @@ TEST_CASE("cli: checkpoint shows both chains of a run stopped inside lookahead")
   for (const char* energy : {"2.25", "3.5", "2.5", "3.25"})
     CHECK(chains.find(std::string("\"energy\": ") + energy) != std::string::npos);
   CHECK(r.out.substr(0, lookahead).find("\"energy\": 2.25") == std::string::npos);  // not among `levels`
+  // Its first level alone: neither chain goes with it.
+  const Run kept = run("checkpoint " + ckpt + " --keep-levels 1 --out " + ckpt);
+  REQUIRE_MESSAGE(kept.code == 0, kept.err);
+  CHECK(json_number(kept.out, "levels_done") == 1);
+  CHECK(kept.out.find("\"energy\": 2.25") == std::string::npos);
+  CHECK(shapematch::load_checkpoint(ckpt).chains.empty());
+}
+
+TEST_CASE("cli: checkpoint --keep-levels drops the attempt of the level in progress") {
+  shapematch::test::TempDir tmp;
+  const std::string ckpt = (tmp.path / "attempt.ckpt").string();
+  shapematch::LevelCheckpoint c;
+  for (int l = 0; l < 2; ++l) {
+    shapematch::LevelReport r;
+    r.level = l;
+    r.gamma.resize(3);
+    c.levels.push_back(r);
+  }
+  c.widened = {0, 1, 0};
+  c.attempt.ring = 1;
+  c.attempt.extra = {0, 2, 0, 1};
+  c.attempt.report.level = 2;
+  shapematch::save_checkpoint(ckpt, c);
+  Run r = run("checkpoint " + ckpt);
+  REQUIRE_MESSAGE(r.code == 0, r.err);
+  CHECK(r.out.find("\"faces_with_extra_rings\": 2") != std::string::npos);
+  const std::string two = (tmp.path / "two.ckpt").string(), one = (tmp.path / "one.ckpt").string();
+  r = run("checkpoint " + ckpt + " --keep-levels 2 --out " + two);
+  REQUIRE_MESSAGE(r.code == 0, r.err);
+  CHECK(r.out.find("\"attempt\": null") != std::string::npos);
+  const shapematch::LevelCheckpoint kept = shapematch::load_checkpoint(two);
+  CHECK(kept.levels.size() == 2);
+  CHECK(kept.attempt.empty());
+  CHECK(kept.widened == c.widened);  // the last level's, still the one the next refines
+  r = run("checkpoint " + ckpt + " --keep-levels 1 --out " + one);
+  REQUIRE_MESSAGE(r.code == 0, r.err);
+  CHECK(shapematch::load_checkpoint(one).widened.empty());  // level 2's, not level 1's
+  CHECK(shapematch::load_checkpoint(ckpt).attempt.ring == 1);  // the file itself unchanged
 }
 
 // tools/pdhg_work.sh reads what PDHG logs at debug level: on a written log its sums are checked
