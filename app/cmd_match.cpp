@@ -69,6 +69,7 @@ struct MatchArgs {
   double recurring_max_share = CoarseToFineOptions{}.recurring_max_share;
   bool watch_resolve = CoarseToFineOptions{}.watch_resolve;
   int max_suspected_widenings = CoarseToFineOptions{}.max_suspected_widenings;
+  int suspicion_rings = CoarseToFineOptions{}.suspicion_rings;
   double second_start_budget = CoarseToFineOptions{}.second_start_budget;
   bool warm_widening = CoarseToFineOptions{}.warm_widening;
   bool carry_primal_weight = CoarseToFineOptions{}.carry_primal_weight;
@@ -153,6 +154,7 @@ int run_match(const MatchArgs& args) {
   co.recurring_max_share = args.recurring_max_share;
   co.watch_resolve = args.watch_resolve;
   co.max_suspected_widenings = args.max_suspected_widenings;
+  co.suspicion_rings = args.suspicion_rings;
   co.second_start_budget = args.second_start_budget;
   co.warm_widening = args.warm_widening;
   co.carry_primal_weight = args.carry_primal_weight;
@@ -453,6 +455,7 @@ int run_match(const MatchArgs& args) {
                               .set("recurring_max_share", args.recurring_max_share)
                               .set("watch_resolve", args.watch_resolve)
                               .set("max_suspected_widenings", args.max_suspected_widenings)
+                              .set("suspicion_rings", args.suspicion_rings)
                               .set("second_start_budget", args.second_start_budget)
                               .set("warm_widening", args.warm_widening)
                               .set("carry_primal_weight", args.carry_primal_weight)
@@ -710,6 +713,11 @@ Action add_match_command(CLI::App& app) {
                  "widenings in a row at a level on first LPs that the divergence watch stopped (no proof) before "
                  "the level's next first LPs run unwatched, to an optimum or a proof (0: no limit)")
       ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  app.add_option("--suspicion-rings", a->suspicion_rings,
+                 "where --max-suspected-widenings ends the watch, every X face within this many fine rings of "
+                 "the faces widened so far at the level gets one more ring first (0: off)")
+      ->check(CLI::Range(0, 16))
       ->capture_default_str();
   app.add_option("--max-propagation-widenings", a->max_propagation_widenings,
                  "local widenings per level where unit propagation found the contradiction (before any LP)")

@@ -1295,11 +1295,21 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
       if (!s && widen_at(m, proof, e.certified() ? "infeasible" : "probably infeasible (PDHG diverging)")) {
         // A suspicion that keeps coming back is checked: the next first LPs run to an optimum or
         // a proof. A proof restores the watch.
-        if (e.certified())
+        if (e.certified()) {
           suspicions.proof();
-        else if (suspicions.suspicion())
+        } else if (suspicions.suspicion()) {
           spdlog::info("level {}: {} widenings in a row on a diverging PDHG, none proved: the next first LPs run "
                        "unwatched", l + 1, suspicions.count());
+          // An unwatched LP costs what several watched ones do: give it room around every
+          // suspicion first (CoarseToFineOptions::suspicion_rings says why).
+          if (options_.suspicion_rings > 0 &&
+              widen_locally(around_widened(options_.suspicion_rings), "probably infeasible around its widenings",
+                            options_.max_ring + kMaxRingBeyond, true)) {
+            spdlog::info("level {}: widened around all earlier local widenings ({} rings) before it", l + 1,
+                         options_.suspicion_rings);
+            ++rep.margin_widenings;
+          }
+        }
         continue;
       }
       if (!e.certified()) {  // nothing left to widen locally on a suspicion: solve for a proof

@@ -112,6 +112,13 @@ struct CoarseToFineOptions {
   // suspicions in a row each at their 1 414-face level (6.2 % → 21.6 % of the full space), and
   // one such first LP, let run, was feasible (docs/results-log.md, thirty-fifth session).
   int max_suspected_widenings = 3;
+  // Where max_suspected_widenings ends the watch, every X face within this many fine rings of the
+  // faces widened so far at the level gets one more ring before the unwatched LP, each time. The
+  // suspicions' own places (the window's dual growth) are narrow: measured, FAUST_r 029-063 at
+  // μ = 10, level 6: suspicions widened 497, 24, 47, 9, 17, 14, 15 faces, mostly faces widened
+  // already, while the two unwatched LPs' Farkas proofs named 13 and 853; 100 minutes on one core
+  // without a round (forty-fourth session). 0: off.
+  int suspicion_rings = 0;
   // Start the first LP of a widened space from the previous attempt's iterate (its dual reset
   // where it diverged), by variable and row identity. Off: measured at full resolution (FAUST_r
   // 020-024) after a diverging attempt, the widened LP took 3 008 iterations warm against 2 048
