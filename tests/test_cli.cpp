@@ -281,10 +281,15 @@ TEST_CASE("cli: match --checkpoint goes on after the levels a stopped run finish
   const std::string first = read_file(tmp.path / "a" / "report.json");
   CHECK(json_number(first, "resumed_after_level") == 0);
   CHECK(json_number(first, "rounding_checkpoint_seconds") == 2.5);  // echoed with the options
+  CHECK(json_number(first, "suspicion_rings") == 2);                // the default
   CHECK(first.find("\"stuck_restarts\": 1") != std::string::npos);
   CHECK(first.find("\"stuck_restarts\": 0") != std::string::npos);  // per level
   r = run("match " + dolphin + " " + swimming + " --stuck-restarts -1 -o " + (tmp.path / "d").string());
   CHECK(r.code != 0);
+  CHECK_FALSE(fs::exists(tmp.path / "d"));
+  r = run("match " + dolphin + " " + swimming + " --suspicion-rings 17 -o " + (tmp.path / "d").string());
+  CHECK(r.code != 0);
+  CHECK(r.err.find("--suspicion-rings") != std::string::npos);
   CHECK_FALSE(fs::exists(tmp.path / "d"));
   // What it holds, without the meshes: two levels done, the second's energy as in the report.
   r = run("checkpoint " + ckpt);
