@@ -921,6 +921,13 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
         for (int v : X.faces[f]) near[v] = 1;
     return faces_on(X, near, rings);
   };
+  // One more ring on every X face within `rings` of those widened so far, past max_ring if need
+  // be (not counted against max_local_widenings; counted as a margin widening).
+  auto widen_around = [&](int rings, const char* why) {
+    if (!widen_locally(around_widened(rings), why, options_.max_ring + kMaxRingBeyond, true)) return false;
+    ++rep.margin_widenings;
+    return true;
+  };
   // Widens around a proof (its place): the X faces on it first; where the same faces come back
   // (the X side alone did not help) also those that map next to its Y side; where every one of
   // them is at max_ring, those faces alone beyond it, up to kMaxRingBeyond more, and then a
@@ -1072,11 +1079,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
       if (widened) continue;
       if (options_.widen_around > 0 && !around_done && local + propagated > 0) {
         around_done = true;
-        if (widen_locally(around_widened(options_.widen_around), "infeasible nearby (pre-emptively)",
-                          options_.max_ring + kMaxRingBeyond, true)) {
-          ++rep.margin_widenings;
-          continue;
-        }
+        if (widen_around(options_.widen_around, "infeasible nearby (pre-emptively)")) continue;
       }
     }
     try {
@@ -1303,12 +1306,9 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
           // An unwatched LP costs what several watched ones do: give it room around every
           // suspicion first (CoarseToFineOptions::suspicion_rings says why).
           if (options_.suspicion_rings > 0 &&
-              widen_locally(around_widened(options_.suspicion_rings), "probably infeasible around its widenings",
-                            options_.max_ring + kMaxRingBeyond, true)) {
+              widen_around(options_.suspicion_rings, "probably infeasible around its widenings"))
             spdlog::info("level {}: widened around all earlier local widenings ({} rings) before it", l + 1,
                          options_.suspicion_rings);
-            ++rep.margin_widenings;
-          }
         }
         continue;
       }
@@ -1324,9 +1324,8 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
       // (a Y face's coverage row) remained, so it saves nothing on that pair.
       if (!regional_done && local + propagated > 0) {
         regional_done = true;
-        if (widen_locally(around_widened(kRegionRings), "infeasible", options_.max_ring + kMaxRingBeyond, true)) {
+        if (widen_around(kRegionRings, "infeasible")) {
           spdlog::info("level {}: widened around all earlier local widenings ({} rings)", l + 1, kRegionRings);
-          ++rep.margin_widenings;
           continue;
         }
       }
