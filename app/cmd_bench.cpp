@@ -866,7 +866,9 @@ std::vector<std::string> strings_of(const JsonNode* node) {
 // progress (each started an attempt that a run gone on from it does not repeat), then the rounds
 // of that attempt's rounding. Levels -1: none used.
 struct CheckpointProgress {
-  int levels = -1, widenings = 0, rounds = 0;
+  int levels = -1;
+  int ahead = 0;  // inside a level of lookahead, the first chain has done it
+  int widenings = 0, rounds = 0;
   auto operator<=>(const CheckpointProgress&) const = default;
 };
 
@@ -879,6 +881,7 @@ void write_run_record(const fs::path& dir, const std::vector<std::string>& match
   record.set("time_limit", time_limit);
   if (checkpoint_before.levels >= 0) {
     record.set("checkpoint_levels_before", checkpoint_before.levels);
+    record.set("checkpoint_chain_ahead_before", checkpoint_before.ahead);
     record.set("checkpoint_widenings_before", checkpoint_before.widenings);
     record.set("checkpoint_rounds_before", checkpoint_before.rounds);
   }
@@ -931,7 +934,8 @@ CheckpointProgress checkpoint_progress(const fs::path& checkpoint) {
   if (!fs::exists(checkpoint)) return {0, 0};
   try {
     const LevelCheckpoint c = load_checkpoint(checkpoint.string());
-    return {c.done(), c.attempt.empty() ? 0 : c.attempt.widenings(), c.attempt.rounding.rounds};
+    const LevelAttempt& a = c.in_progress();
+    return {c.done(), c.first_chain_ahead() ? 1 : 0, a.empty() ? 0 : a.widenings(), a.rounding.rounds};
   } catch (const Error& e) {
     spdlog::warn("{}; starting afresh", e.what());
     fs::remove(checkpoint);
@@ -989,8 +993,8 @@ bool resume_row(const BenchMatchArgs& args, const PairSpec& pair, const std::vec
         const double v = record.number_or_nan(key);
         return v >= 0 ? static_cast<int>(v) : 0;
       };
-      const CheckpointProgress before{recorded("checkpoint_levels_before"), recorded("checkpoint_widenings_before"),
-                                      recorded("checkpoint_rounds_before")};
+      const CheckpointProgress before{recorded("checkpoint_levels_before"), recorded("checkpoint_chain_ahead_before"),
+                                      recorded("checkpoint_widenings_before"), recorded("checkpoint_rounds_before")};
       if (const CheckpointProgress now = checkpoint_progress(checkpoint); now > before) {
         spdlog::info("{}: timed out after its checkpoint went from {} levels (and {} widenings of the next, {} rounds "
                      "of its rounding) to {} (and {}, {}); going on from it",

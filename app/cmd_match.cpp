@@ -217,17 +217,20 @@ int run_match(const MatchArgs& args) {
   if (!args.checkpoint.empty())
     checkpointing = [&](const LevelCheckpoint& c) {
       save_checkpoint(args.checkpoint, c);
-      if (c.attempt.empty())
+      const LevelAttempt& a = c.in_progress();
+      const std::string chain = c.chains.empty() ? std::string()
+                                : c.chains[0].attempt.empty() ? " (the lookahead's second chain)"
+                                                              : " (the lookahead's first chain)";
+      if (a.empty())
         spdlog::info("checkpoint after level {}{}: {}", c.done(), c.chains.empty() ? "" : " (both chains of its lookahead)",
                      args.checkpoint);
-      else if (!c.attempt.rounding.empty())
-        spdlog::info("checkpoint in level {}'s rounding, after round {} ({} fixings to 1): {}", c.levels.size() + 1,
-                     c.attempt.rounding.rounds, c.attempt.rounding.ones.size(), args.checkpoint);
+      else if (!a.rounding.empty())
+        spdlog::info("checkpoint in level {}'s rounding{}, after round {} ({} fixings to 1): {}", c.done() + 1, chain,
+                     a.rounding.rounds, a.rounding.ones.size(), args.checkpoint);
       else
-        spdlog::info("checkpoint in level {}, before its next attempt (ring {}, {} faces with extra rings): {}",
-                     c.levels.size() + 1, c.attempt.ring,
-                     std::count_if(c.attempt.extra.begin(), c.attempt.extra.end(), [](int e) { return e > 0; }),
-                     args.checkpoint);
+        spdlog::info("checkpoint in level {}{}, before its next attempt (ring {}, {} faces with extra rings): {}",
+                     c.done() + 1, chain, a.ring,
+                     std::count_if(a.extra.begin(), a.extra.end(), [](int e) { return e > 0; }), args.checkpoint);
     };
 
   stage.reset();

@@ -87,12 +87,9 @@ Action add_checkpoint_command(CLI::App& app) {
                         .set("seconds", r.seconds));
       return levels;
     };
-    Json levels = reports(c.levels);
-    Json lookahead = Json::array();  // inside lookahead: both chains' levels since its split
-    for (const LevelCheckpoint::Chain& chain : c.chains)
-      lookahead.push(Json::object().set("leading", chain.leading).set("levels", reports(chain.pending)));
-    Json attempt;  // null where no level is in progress
-    if (const LevelAttempt& a = c.attempt; !a.empty()) {
+    auto attempt_json = [](const LevelAttempt& a) {
+      Json attempt;  // null where no level is in progress
+      if (a.empty()) return attempt;
       Json rounding;
       if (const LevelAttempt::Rounding& g = a.rounding; !g.empty())
         rounding = Json::object()
@@ -102,18 +99,27 @@ Action add_checkpoint_command(CLI::App& app) {
                        .set("lower_bound", g.lower_bound)
                        .set("variables", g.columns)
                        .set("constraints", g.rows);
-      attempt = Json::object()
-                    .set("level", a.report.level)
-                    .set("ring", a.ring)
-                    .set("faces_with_extra_rings",
-                         static_cast<int64_t>(std::count_if(a.extra.begin(), a.extra.end(), [](int e) { return e > 0; })))
-                    .set("widenings", a.widenings())
-                    .set("propagation_widenings", a.report.propagation_widenings)
-                    .set("price_widenings", a.report.price_widenings)
-                    .set("stuck_widenings", a.report.stuck_widenings)
-                    .set("stuck_restarts", a.report.stuck_restarts)
-                    .set("rounding", std::move(rounding));
-    }
+      return Json::object()
+          .set("level", a.report.level)
+          .set("ring", a.ring)
+          .set("faces_with_extra_rings",
+               static_cast<int64_t>(std::count_if(a.extra.begin(), a.extra.end(), [](int e) { return e > 0; })))
+          .set("widenings", a.widenings())
+          .set("propagation_widenings", a.report.propagation_widenings)
+          .set("price_widenings", a.report.price_widenings)
+          .set("stuck_widenings", a.report.stuck_widenings)
+          .set("stuck_restarts", a.report.stuck_restarts)
+          .set("rounding", std::move(rounding));
+    };
+    Json levels = reports(c.levels);
+    Json lookahead = Json::array();  // inside lookahead: both chains' levels since its split
+    for (const LevelCheckpoint::Chain& chain : c.chains)
+      lookahead.push(Json::object()
+                         .set("leading", chain.leading)
+                         .set("levels", reports(chain.pending))
+                         .set("attempt", attempt_json(chain.attempt)));
+    // The level in progress, where one is (inside lookahead also under its chain).
+    Json attempt = attempt_json(c.in_progress());
     std::cout << Json::object()
                      .set("file", *file)
                      .set("levels_done", c.done())

@@ -365,6 +365,30 @@ TEST_CASE("cli: checkpoint shows both chains of a run stopped inside lookahead")
   for (const char* energy : {"2.25", "3.5", "2.5", "3.25"})
     CHECK(chains.find(std::string("\"energy\": ") + energy) != std::string::npos);
   CHECK(r.out.substr(0, lookahead).find("\"energy\": 2.25") == std::string::npos);  // not among `levels`
+  CHECK(r.out.find("\"attempt\": null") != std::string::npos);
+  // Inside level 4: the first chain has done it, the second is at it (its attempt, in its rounding).
+  shapematch::LevelCheckpoint inside = c;
+  inside.chains[0].pending.push_back(level(3, 4.75));
+  shapematch::LevelAttempt& a = inside.chains[1].attempt;
+  a.ring = 2;
+  a.report.level = 3;
+  a.extra = {0, 1, 1};
+  a.rounding.rounds = 3;
+  a.rounding.columns = 10;
+  a.rounding.rows = 4;
+  a.rounding.ones = {1, 7};
+  const std::string inside_file = (tmp.path / "inside.ckpt").string();
+  shapematch::save_checkpoint(inside_file, inside);
+  const Run at = run("checkpoint " + inside_file);
+  REQUIRE_MESSAGE(at.code == 0, at.err);
+  CHECK(json_number(at.out, "levels_done") == 3);
+  const size_t second = at.out.find("\"leading\": false");
+  REQUIRE(second != std::string::npos);
+  CHECK(at.out.find("\"energy\": 4.75") < second);  // the first chain's level 4
+  CHECK(at.out.find("\"faces_with_extra_rings\": 2", second) != std::string::npos);  // under the second chain
+  const size_t top = at.out.rfind("\"attempt\"");  // the level in progress, after `lookahead`
+  CHECK(json_number(at.out.substr(top), "level") == 3);
+  CHECK(json_number(at.out.substr(top), "fixings_to_one") == 2);
   // Its first level alone: neither chain goes with it.
   const Run kept = run("checkpoint " + ckpt + " --keep-levels 1 --out " + ckpt);
   REQUIRE_MESSAGE(kept.code == 0, kept.err);

@@ -706,7 +706,7 @@ TEST_CASE("coarse to fine: a run gone on from a checkpoint inside lookahead ends
   REQUIRE(matcher.x_levels().size() == 5);
   std::vector<LevelCheckpoint> saved;
   const CoarseToFineResult whole = matcher.run({}, nullptr, [&](const LevelCheckpoint& c) {
-    if (c.attempt.empty()) saved.push_back(c);
+    if (c.in_progress().empty()) saved.push_back(c);
   });
   // After levels 1 to 4: one chain, two (levels 2 and 3, before the decision at 4), then one.
   REQUIRE(saved.size() == 4);
@@ -741,7 +741,7 @@ TEST_CASE("coarse to fine: a run gone on from a checkpoint inside lookahead ends
       CHECK(loaded.chains[i].pending.back().energy == saved[k].chains[i].pending.back().energy);
     }
     int called = 0;
-    const CoarseToFineResult r = matcher.run({}, &loaded, [&](const LevelCheckpoint& c) { called += c.attempt.empty(); });
+    const CoarseToFineResult r = matcher.run({}, &loaded, [&](const LevelCheckpoint& c) { called += c.in_progress().empty(); });
     CHECK(called == 3 - int(k));  // the levels after it but the finest
     REQUIRE(r.levels.size() == whole.levels.size());
     for (size_t l = 0; l < r.levels.size(); ++l) {
@@ -783,6 +783,110 @@ TEST_CASE("coarse to fine: a run gone on from a checkpoint inside lookahead ends
   const LevelCheckpoint v4 = load_checkpoint(file);
   CHECK(v4.chains.empty());
   CHECK(v4.done() == 1);
+}
+
+TEST_CASE("coarse to fine: a run gone on from inside a level of lookahead goes on in the chain that was at it") {
+  // The dolphins of the lookahead test, with a checkpoint after every round of every rounding.
+  const Mesh dx = decimate(shapes::dolphin(20, 0), 80), dy = decimate(shapes::dolphin(-20, 40), 90);
+  CoarseToFineOptions o = small_levels();
+  o.lookahead_levels = 2;
+  o.rounding.alternative_thresholds = {};  // (with them a level's rounding is not saved)
+  o.rounding_checkpoint_seconds = 0.0;
+  const CoarseToFineMatcher matcher(dx, dy, o);
+  std::vector<LevelCheckpoint> inside;
+  const CoarseToFineResult whole = matcher.run({}, nullptr, [&](const LevelCheckpoint& c) {
+    if (!c.chains.empty() && !c.in_progress().empty()) inside.push_back(c);
+  });
+  // At levels 3 and 4 (below the decision at 4), each chain in turn: the first at the level, then
+  // the second with the first's report of it.
+  auto find = [&](int done, bool ahead, bool rounding) -> const LevelCheckpoint* {
+    for (const LevelCheckpoint& c : inside)
+      if (c.done() == done && c.first_chain_ahead() == ahead && c.in_progress().rounding.empty() != rounding)
+        return &c;
+    return nullptr;
+  };
+  for (const LevelCheckpoint& c : inside) {
+    REQUIRE(c.chains.size() == 2);
+    CHECK((c.done() == 2 || c.done() == 3));
+    // The chain at the level holds the attempt: the first, or the second once the first is done.
+    CHECK(c.chains[0].attempt.empty() == c.first_chain_ahead());
+    CHECK(c.chains[1].attempt.empty() != c.first_chain_ahead());
+    CHECK(c.in_progress().report.level == c.done());
+    CHECK(c.chains[0].pending.size() == c.chains[1].pending.size() + (c.first_chain_ahead() ? 1 : 0));
+  }
+
+  test::TempDir tmp;
+  const std::string file = (tmp.path / "inside.ckpt").string();
+  for (const LevelCheckpoint* c : {find(2, false, false), find(2, true, false), find(3, true, true)}) {
+    REQUIRE(c != nullptr);
+    save_checkpoint(file, *c);
+    const LevelCheckpoint loaded = load_checkpoint(file);
+    REQUIRE(loaded.chains.size() == 2);
+    CHECK(loaded.done() == c->done());
+    CHECK(loaded.first_chain_ahead() == c->first_chain_ahead());
+    for (int i = 0; i < 2; ++i) {
+      const LevelAttempt &a = loaded.chains[i].attempt, &b = c->chains[i].attempt;
+      CHECK(a.ring == b.ring);
+      CHECK(a.extra == b.extra);
+      CHECK(a.report.widened_faces == b.report.widened_faces);
+      CHECK(a.rounding.ones == b.rounding.ones);
+      CHECK(a.rounding.rounds == b.rounding.rounds);
+    }
+    // Gone on from it: the first chain's report of the level, where it had done it, is kept as
+    // it was, and the chain at the level does not start it again (no attempt before its widened one).
+    const int level = c->done();
+    bool first_end = true;
+    int earlier_attempts = 0;
+    const CoarseToFineResult r = matcher.run({}, &loaded, [&](const LevelCheckpoint& k) {
+      const LevelAttempt& a = k.in_progress();
+      if (!a.empty() && a.report.level == level && a.widenings() < c->in_progress().widenings()) ++earlier_attempts;
+      if (!a.empty() || !first_end) return;
+      first_end = false;  // after the level gone on in
+      CHECK(k.done() == level + 1);
+      CHECK(k.chains.size() == (level == 3 ? 0u : 2u));  // (decided at level 4)
+      if (c->first_chain_ahead() && level == 2) {
+        CHECK(k.chains[0].pending.back().gamma == c->chains[0].pending.back().gamma);
+        CHECK(k.chains[0].pending.back().energy == c->chains[0].pending.back().energy);
+        CHECK(k.chains[0].pending.back().seconds == c->chains[0].pending.back().seconds);
+      }
+    });
+    if (c->first_chain_ahead() && level == 3 && !r.levels[3].lookahead_switched) {  // the first chain won
+      CHECK(r.levels[3].gamma == c->chains[0].pending.back().gamma);
+      CHECK(r.levels[3].energy == c->chains[0].pending.back().energy);
+    }
+    CHECK(earlier_attempts == 0);
+    CHECK_FALSE(first_end);
+    REQUIRE(r.levels.size() == whole.levels.size());
+    CHECK(r.levels[0].gamma == whole.levels[0].gamma);
+    CHECK(r.levels[1].energy == whole.levels[1].energy);
+    CHECK(std::isfinite(r.levels[3].lookahead_other_energy));  // decided at level 4, as the whole run
+    CHECK(check_graph_surface(r.finest.space, r.rounding.gamma).ok());
+    CHECK(satisfies_exactly(r.finest.lp, r.rounding.gamma));
+    // Before its rounding, the attempt is the whole run's: so is every level.
+    if (c->in_progress().rounding.empty())
+      for (size_t l = 0; l < r.levels.size(); ++l) {
+        CHECK(r.levels[l].energy == doctest::Approx(whole.levels[l].energy).epsilon(1e-12));
+        CHECK(r.levels[l].gamma == whole.levels[l].gamma);
+      }
+  }
+
+  // An attempt on a chain that is not at the level in progress, or a second chain ahead, is refused.
+  const LevelCheckpoint& at_second = *find(2, true, false);
+  LevelCheckpoint wrong = at_second;
+  wrong.chains[0].attempt = wrong.chains[1].attempt;
+  CHECK_THROWS_AS(matcher.check(wrong), InvalidInputError);
+  wrong = *find(2, false, false);
+  wrong.chains[1].attempt = wrong.chains[0].attempt;
+  CHECK_THROWS_AS(matcher.check(wrong), InvalidInputError);
+  wrong = at_second;
+  std::swap(wrong.chains[0], wrong.chains[1]);
+  CHECK_THROWS_AS(matcher.check(wrong), InvalidInputError);
+  // A version-5 file keeps the chains' levels but not their attempts.
+  detail::save_checkpoint_as(file, at_second, 5);
+  const LevelCheckpoint v5 = load_checkpoint(file);
+  CHECK(v5.first_chain_ahead());
+  CHECK(v5.in_progress().empty());
+  CHECK_NOTHROW(matcher.check(v5));
 }
 
 TEST_CASE("coarse to fine: a stuck rounding widens around its failed parts and goes on from its fixings") {
@@ -1250,8 +1354,8 @@ TEST_CASE("coarse to fine: a run gone on from an attempt of a level in progress 
     bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
   }
   const size_t at = std::string("shapematch level checkpoint\n").size();
-  REQUIRE(bytes[at] == 5);
-  bytes[at] = 6;  // a later version than this build's
+  REQUIRE(bytes[at] == 6);
+  bytes[at] = 7;  // a later version than this build's
   std::ofstream(file, std::ios::binary) << bytes;
   CHECK_THROWS_AS(load_checkpoint(file), IoError);
   detail::save_checkpoint_as(file, marked, 1);
@@ -1271,7 +1375,7 @@ TEST_CASE("coarse to fine: a run gone on from an attempt of a level in progress 
   CHECK(v3.attempt.report.widened_faces == a.report.widened_faces);
   CHECK(v3.attempt.report.stuck_restarts == 0);
   CHECK(v3.levels.back().gamma == last.levels.back().gamma);
-  CHECK_THROWS_AS(detail::save_checkpoint_as(file, marked, 6), InvalidInputError);
+  CHECK_THROWS_AS(detail::save_checkpoint_as(file, marked, 7), InvalidInputError);
 }
 
 TEST_CASE("coarse to fine: a run gone on from a checkpoint inside a rounding fixes its decisions and keeps its bound") {

@@ -15,8 +15,9 @@ namespace {
 constexpr char kMagic[] = "shapematch level checkpoint\n";
 // 2: the attempt of the level in progress (LevelAttempt) follows the extra rings. 3: its
 // rounding (LevelAttempt::Rounding) follows the attempt. 4: LevelReport::stuck_restarts. 5: the
-// lookahead's chains (LevelCheckpoint::chains) follow. 1 to 4 are read too.
-constexpr uint32_t kVersion = 5;
+// lookahead's chains (LevelCheckpoint::chains) follow. 6: each chain's attempt follows it. 1 to
+// 5 are read too.
+constexpr uint32_t kVersion = 6;
 
 // Every number of a report, in the file's order (the Γ follows on its own). A field added to
 // LevelReport goes here too, with kVersion one higher; the size check below is the reminder.
@@ -110,6 +111,40 @@ void read_levels(Reader& r, std::vector<LevelReport>& levels, uint64_t count, ui
   }
 }
 
+// A flag, then (where set) the attempt (version >= 2).
+void write_attempt(Writer& w, const LevelAttempt& a, uint32_t version) {
+  w(!a.empty());
+  if (a.empty()) return;
+  w(a.ring), w(a.local), w(a.propagated), w(a.priced), w(a.regional_done), w(a.around_done);
+  w(a.suspicions), w(a.trusted);
+  each_field(a.report, w, version);
+  w.array(a.extra);
+  if (version < 3) return;
+  const LevelAttempt::Rounding& g = a.rounding;
+  w(g.rounds);
+  if (!g.empty()) {
+    w(g.columns), w(g.rows), w(g.iterations), w(g.lower_bound), w(g.reference_seconds), w(g.reference_iterations);
+    w.array(g.ones);
+  }
+}
+void read_attempt(Reader& r, LevelAttempt& a, uint32_t version, const std::string& path) {
+  bool held = false;
+  r(held);
+  if (!held) return;
+  r(a.ring), r(a.local), r(a.propagated), r(a.priced), r(a.regional_done), r(a.around_done);
+  r(a.suspicions), r(a.trusted);
+  each_field(a.report, r, version);
+  r.array(a.extra);
+  LevelAttempt::Rounding& g = a.rounding;
+  if (version >= 3) r(g.rounds);
+  if (g.rounds < 0) throw IoError(path + ": not a shapematch checkpoint (" + std::to_string(g.rounds) + " rounds)");
+  if (!g.empty()) {
+    r(g.columns), r(g.rows), r(g.iterations), r(g.lower_bound), r(g.reference_seconds), r(g.reference_iterations);
+    r.array(g.ones);
+  }
+  if (a.ring < 0) throw IoError(path + ": not a shapematch checkpoint (an attempt at ring " + std::to_string(a.ring) + ")");
+}
+
 }  // namespace
 
 void save_checkpoint(const std::string& path, const LevelCheckpoint& c) { detail::save_checkpoint_as(path, c, kVersion); }
@@ -125,21 +160,7 @@ void detail::save_checkpoint_as(const std::string& path, const LevelCheckpoint& 
     write_levels(w, c.levels, version);
     w.array(c.widened);
     if (version < 2) return;
-    w(!c.attempt.empty());
-    if (!c.attempt.empty()) {
-      const LevelAttempt& a = c.attempt;
-      w(a.ring), w(a.local), w(a.propagated), w(a.priced), w(a.regional_done), w(a.around_done);
-      w(a.suspicions), w(a.trusted);
-      each_field(a.report, w, version);
-      w.array(a.extra);
-      if (version < 3) return;
-      const LevelAttempt::Rounding& g = a.rounding;
-      w(g.rounds);
-      if (!g.empty()) {
-        w(g.columns), w(g.rows), w(g.iterations), w(g.lower_bound), w(g.reference_seconds), w(g.reference_iterations);
-        w.array(g.ones);
-      }
-    }
+    write_attempt(w, c.attempt, version);
     if (version < 5) return;
     w(uint64_t(c.chains.size()));
     for (const LevelCheckpoint::Chain& chain : c.chains) {
@@ -147,6 +168,7 @@ void detail::save_checkpoint_as(const std::string& path, const LevelCheckpoint& 
       w(uint64_t(chain.pending.size()));
       write_levels(w, chain.pending, version);
       w.array(chain.widened);
+      if (version >= 6) write_attempt(w, chain.attempt, version);
     }
   });
 }
@@ -172,23 +194,7 @@ LevelCheckpoint load_checkpoint(const std::string& path) {
   if (n == 0 || n > 64) throw IoError(path + ": the checkpoint claims " + std::to_string(n) + " levels");
   read_levels(r, c.levels, n, version);
   r.array(c.widened);
-  bool attempt = false;
-  if (version >= 2) r(attempt);
-  if (attempt) {
-    LevelAttempt& a = c.attempt;
-    r(a.ring), r(a.local), r(a.propagated), r(a.priced), r(a.regional_done), r(a.around_done);
-    r(a.suspicions), r(a.trusted);
-    each_field(a.report, r, version);
-    r.array(a.extra);
-    LevelAttempt::Rounding& g = a.rounding;
-    if (version >= 3) r(g.rounds);
-    if (g.rounds < 0) throw IoError(path + ": not a shapematch checkpoint (" + std::to_string(g.rounds) + " rounds)");
-    if (!g.empty()) {
-      r(g.columns), r(g.rows), r(g.iterations), r(g.lower_bound), r(g.reference_seconds), r(g.reference_iterations);
-      r.array(g.ones);
-    }
-    if (a.ring < 0) throw IoError(path + ": not a shapematch checkpoint (an attempt at ring " + std::to_string(a.ring) + ")");
-  }
+  if (version >= 2) read_attempt(r, c.attempt, version, path);
   if (version >= 5) {
     uint64_t chains = 0;
     r(chains);
@@ -203,6 +209,7 @@ LevelCheckpoint load_checkpoint(const std::string& path) {
         throw IoError(path + ": a lookahead chain claims " + std::to_string(k) + " levels");
       read_levels(r, chain.pending, k, version);
       r.array(chain.widened);
+      if (version >= 6) read_attempt(r, chain.attempt, version, path);
     }
   }
   if (!r.done()) throw IoError(path + ": trailing bytes after the checkpoint");

@@ -466,6 +466,8 @@ CoarseToFineResult CoarseToFineMatcher::run(const Progress& progress, const Leve
     std::vector<LevelReport> pending;
     bool leading = true;
     std::vector<int> widened;  // the last level's extra rings per X face
+    LevelAttempt resume;       // where a run gone on from a checkpoint finds this chain's level in progress
+    bool carried = false;      // the level in progress was done before the checkpoint gone on from
   };
   std::vector<Chain> chains(1);
   const int levels = hx_.size();
@@ -503,7 +505,7 @@ CoarseToFineResult CoarseToFineMatcher::run(const Progress& progress, const Leve
       if (save && checkpoint && l + 1 < levels) checkpoint(LevelCheckpoint{fingerprint(), result.levels, c.widened});
     } else if (save && checkpoint && l + 1 < levels) {
       LevelCheckpoint both{fingerprint(), result.levels};
-      for (const Chain& c : chains) both.chains.push_back({c.pending, c.widened, c.leading});
+      for (const Chain& c : chains) both.chains.push_back({c.pending, c.widened, c.leading, {}});
       checkpoint(both);
     }
   };
@@ -514,13 +516,16 @@ CoarseToFineResult CoarseToFineMatcher::run(const Progress& progress, const Leve
     if (resume->chains.empty()) {
       chains[0].gamma = resume->levels.back().gamma;
       chains[0].widened = resume->widened;
+      chains[0].resume = resume->attempt;
     } else {
       chains.clear();
       for (const LevelCheckpoint::Chain& saved : resume->chains)
-        chains.push_back(Chain{saved.pending.back().gamma, saved.pending, saved.leading, saved.widened});
+        chains.push_back(Chain{saved.pending.back().gamma, saved.pending, saved.leading, saved.widened, saved.attempt});
       // Decided where this run's options put the decision, counted from the split as there (a
-      // checkpoint already past it is decided at once).
+      // checkpoint already past it is decided at once; one inside a level, where the first chain
+      // has done it, no earlier than that level: the second chain's report of it is missing).
       decide_at = std::min(static_cast<int>(resume->levels.size()) + options_.lookahead_levels, levels - 2);
+      if (resume->first_chain_ahead()) decide_at = std::max(decide_at, start);
     }
     spdlog::info("going on from a checkpoint after level {} of {} (energy {}){}", start, levels,
                  chains.size() == 1
@@ -530,7 +535,8 @@ CoarseToFineResult CoarseToFineMatcher::run(const Progress& progress, const Leve
                  resume->attempt.empty() ? std::string()
                                          : fmt::format(", level {}'s widenings {}", start + 1,
                                                        resume->attempt.widenings()));
-    if (chains.size() > 1) settle(start - 1, false);  // (its file holds this state, or one it decides)
+    // (Its file holds this state, or one it decides.)
+    if (chains.size() > 1 && !resume->first_chain_ahead()) settle(start - 1, false);
   }
   for (int l = start; l < levels; ++l) {
     const MeshLevel& lx = hx_.levels[l];
@@ -550,14 +556,29 @@ CoarseToFineResult CoarseToFineMatcher::run(const Progress& progress, const Leve
     const bool second_start = l == 1 && second_level_;
     std::vector<Chain> next;
     std::exception_ptr failure;
-    // Each attempt of a level after the first is a checkpoint where a single chain goes on.
-    const LevelAttempt* attempt = resume && l == start && !resume->attempt.empty() ? &resume->attempt : nullptr;
-    std::function<void(const LevelAttempt&)> attempted;
-    if (checkpoint && chains.size() == 1)
-      attempted = [&](const LevelAttempt& a) {
-        checkpoint(LevelCheckpoint{fingerprint(), result.levels, chains.front().widened, a});
-      };
-    for (Chain& c : chains) {
+    for (size_t i = 0; i < chains.size(); ++i) {
+      Chain& c = chains[i];
+      if (result.levels.size() + c.pending.size() > size_t(l)) {  // done before the checkpoint gone on from
+        c.carried = true;
+        next.push_back(std::move(c));
+        continue;
+      }
+      // Each attempt of a level after the first is a checkpoint: of the level, or inside
+      // lookahead of both chains, those before this one having done the level (not where one of
+      // them dropped out at it: no file holds that state).
+      std::function<void(const LevelAttempt&)> attempted;
+      if (checkpoint)
+        attempted = [&, i](const LevelAttempt& a) {
+          if (chains.size() == 1) return checkpoint(LevelCheckpoint{fingerprint(), result.levels, c.widened, a});
+          if (next.size() != i) return;
+          LevelCheckpoint both{fingerprint(), result.levels};
+          for (size_t j = 0; j < chains.size(); ++j) {
+            const Chain& d = j < i ? next[j] : chains[j];
+            both.chains.push_back({d.pending, d.widened, d.leading, j == i ? a : LevelAttempt{}});
+          }
+          checkpoint(both);
+        };
+      const LevelAttempt* attempt = l == start && !c.resume.empty() ? &c.resume : nullptr;
       LevelReport rep = header;
       try {
         solve_refined(l, model, rep, c.gamma, result, progress, c.widened, attempt, attempted);
@@ -605,8 +626,11 @@ CoarseToFineResult CoarseToFineMatcher::run(const Progress& progress, const Leve
     chains = std::move(next);
     const double seconds = clock.seconds(), rss = peak_rss_mb();  // the level's, every chain's
     for (Chain& c : chains) {
-      c.pending.back().seconds = seconds;
-      c.pending.back().peak_rss_mb = rss;
+      if (!std::exchange(c.carried, false)) {
+        c.pending.back().seconds = seconds;
+        c.pending.back().peak_rss_mb = rss;
+      }
+      c.resume = {};
     }
     settle(l, true);
   }
@@ -639,14 +663,21 @@ void CoarseToFineMatcher::check(const LevelCheckpoint& c) const {
   if (!c.chains.empty() && (c.chains.size() != 2 || !c.attempt.empty() || !c.widened.empty()))
     throw InvalidInputError("the checkpoint's lookahead holds " + std::to_string(c.chains.size()) +
                             " chains, or a level's attempt beside them");
-  for (const LevelCheckpoint::Chain& chain : c.chains) {
-    if (chain.pending.empty() || c.levels.size() + chain.pending.size() != done)
+  // Inside a level, the first chain may have done it and the second be at it (run's order).
+  for (size_t k = 0; k < c.chains.size(); ++k) {
+    const LevelCheckpoint::Chain& chain = c.chains[k];
+    const size_t held = c.levels.size() + chain.pending.size();
+    if (chain.pending.empty() || (held != done && !(k == 0 && held == done + 1)))
       throw InvalidInputError("the checkpoint's lookahead chains hold different levels");
-    for (size_t k = 0; k < chain.pending.size(); ++k) fit(chain.pending[k], c.levels.size() + k);
-    if (!chain.widened.empty() && chain.widened.size() != last_faces)
+    for (size_t i = 0; i < chain.pending.size(); ++i) fit(chain.pending[i], c.levels.size() + i);
+    if (!chain.widened.empty() && chain.widened.size() != size_t(hx_.levels[held - 1].mesh.num_faces()))
       throw InvalidInputError("the checkpoint's extra rings do not fit its last level");
   }
-  const LevelAttempt& a = c.attempt;
+  if (c.chains.size() == 2 &&
+      ((!c.chains[0].attempt.empty() && (c.first_chain_ahead() || !c.chains[1].attempt.empty())) ||
+       (!c.chains[1].attempt.empty() && !c.first_chain_ahead())))
+    throw InvalidInputError("the checkpoint's lookahead holds an attempt of a chain that is not at the level in progress");
+  const LevelAttempt& a = c.in_progress();
   if (!a.empty() && (a.extra.size() != size_t(hx_.levels[done].mesh.num_faces()) || a.ring > 64 ||
                      std::any_of(a.extra.begin(), a.extra.end(), [](int e) { return e < 0 || e > 64; }) ||
                      a.report.level != int(done)))

@@ -5,6 +5,7 @@
 #include "shapematch/matching.hpp"
 #include "shapematch/rounding.hpp"
 
+#include <algorithm>
 #include <atomic>
 #include <cstdint>
 #include <functional>
@@ -375,13 +376,30 @@ struct LevelCheckpoint {
   // last one's Γ is what its next level refines) and its last level's extra rings. `widened` and
   // `attempt` are then empty. (Before, a run stopped inside lookahead kept only its coarsest
   // level: eight of seventeen full-resolution runs in a 170 s call on the H200, 39th session.)
+  // The chains solve a level one after the other, so inside a level the first may hold one
+  // report more than the second; the chain at the level in progress holds its attempt. (Before,
+  // a stop there lost the level: FAUST_r 016-026, 45th session, 2 h 24 min in one chain's level 4.)
   struct Chain {
     std::vector<LevelReport> pending;
     std::vector<int> widened;
     bool leading = true;
+    LevelAttempt attempt;  // of level done(), where this chain is at it
   };
   std::vector<Chain> chains;       // none or two
-  int done() const { return int(levels.size() + (chains.empty() ? 0 : chains.front().pending.size())); }
+  // The levels both chains have done; the level in progress, if any, is the next.
+  int done() const {
+    size_t pending = chains.empty() ? 0 : chains.front().pending.size();
+    for (const Chain& c : chains) pending = std::min(pending, c.pending.size());
+    return int(levels.size() + pending);
+  }
+  // The attempt of the level in progress: `attempt`, or a chain's (empty where none).
+  const LevelAttempt& in_progress() const {
+    for (const Chain& c : chains)
+      if (!c.attempt.empty()) return c.attempt;
+    return attempt;
+  }
+  // Inside a level of lookahead: whether the first chain has done it (and the second is at it).
+  bool first_chain_ahead() const { return chains.size() == 2 && chains[0].pending.size() > chains[1].pending.size(); }
 };
 // Binary, versioned. save: atomically (files.hpp); load: IoError naming the file where it is
 // missing, not a checkpoint, or cut short.
