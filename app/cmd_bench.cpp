@@ -997,8 +997,11 @@ bool resume_row(const BenchMatchArgs& args, const PairSpec& pair, const std::vec
                                       recorded("checkpoint_widenings_before"), recorded("checkpoint_rounds_before")};
       if (const CheckpointProgress now = checkpoint_progress(checkpoint); now > before) {
         spdlog::info("{}: timed out after its checkpoint went from {} levels (and {} widenings of the next, {} rounds "
-                     "of its rounding) to {} (and {}, {}); going on from it",
-                     row.name, before.levels, before.widenings, before.rounds, now.levels, now.widenings, now.rounds);
+                     "of its rounding) to {} (and {}, {}){}; going on from it",
+                     row.name, before.levels, before.widenings, before.rounds, now.levels, now.widenings, now.rounds,
+                     now.ahead > before.ahead && now.levels == before.levels
+                         ? ", the first lookahead chain having done the next"
+                         : "");
         return false;
       }
     }

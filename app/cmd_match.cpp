@@ -221,7 +221,10 @@ int run_match(const MatchArgs& args) {
       const std::string chain = c.chains.empty() ? std::string()
                                 : c.chains[0].attempt.empty() ? " (the lookahead's second chain)"
                                                               : " (the lookahead's first chain)";
-      if (a.empty())
+      if (a.empty() && c.first_chain_ahead())
+        spdlog::info("checkpoint in level {}: the lookahead's first chain has done it: {}", c.done() + 1,
+                     args.checkpoint);
+      else if (a.empty())
         spdlog::info("checkpoint after level {}{}: {}", c.done(), c.chains.empty() ? "" : " (both chains of its lookahead)",
                      args.checkpoint);
       else if (!a.rounding.empty())

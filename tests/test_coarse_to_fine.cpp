@@ -706,7 +706,7 @@ TEST_CASE("coarse to fine: a run gone on from a checkpoint inside lookahead ends
   REQUIRE(matcher.x_levels().size() == 5);
   std::vector<LevelCheckpoint> saved;
   const CoarseToFineResult whole = matcher.run({}, nullptr, [&](const LevelCheckpoint& c) {
-    if (c.in_progress().empty()) saved.push_back(c);
+    if (c.in_progress().empty() && !c.first_chain_ahead()) saved.push_back(c);
   });
   // After levels 1 to 4: one chain, two (levels 2 and 3, before the decision at 4), then one.
   REQUIRE(saved.size() == 4);
@@ -741,7 +741,8 @@ TEST_CASE("coarse to fine: a run gone on from a checkpoint inside lookahead ends
       CHECK(loaded.chains[i].pending.back().energy == saved[k].chains[i].pending.back().energy);
     }
     int called = 0;
-    const CoarseToFineResult r = matcher.run({}, &loaded, [&](const LevelCheckpoint& c) { called += c.in_progress().empty(); });
+    const CoarseToFineResult r =
+        matcher.run({}, &loaded, [&](const LevelCheckpoint& c) { called += c.in_progress().empty() && !c.first_chain_ahead(); });
     CHECK(called == 3 - int(k));  // the levels after it but the finest
     REQUIRE(r.levels.size() == whole.levels.size());
     for (size_t l = 0; l < r.levels.size(); ++l) {
@@ -793,16 +794,20 @@ TEST_CASE("coarse to fine: a run gone on from inside a level of lookahead goes o
   o.rounding.alternative_thresholds = {};  // (with them a level's rounding is not saved)
   o.rounding_checkpoint_seconds = 0.0;
   const CoarseToFineMatcher matcher(dx, dy, o);
-  std::vector<LevelCheckpoint> inside;
+  std::vector<LevelCheckpoint> inside, ends;  // inside a level of lookahead; after level 3
   const CoarseToFineResult whole = matcher.run({}, nullptr, [&](const LevelCheckpoint& c) {
-    if (!c.chains.empty() && !c.in_progress().empty()) inside.push_back(c);
+    if (!c.chains.empty() && (!c.in_progress().empty() || c.first_chain_ahead())) inside.push_back(c);
+    if (!c.chains.empty() && c.in_progress().empty() && !c.first_chain_ahead()) ends.push_back(c);
   });
   // At levels 3 and 4 (below the decision at 4), each chain in turn: the first at the level, then
-  // the second with the first's report of it.
-  auto find = [&](int done, bool ahead, bool rounding) -> const LevelCheckpoint* {
-    for (const LevelCheckpoint& c : inside)
-      if (c.done() == done && c.first_chain_ahead() == ahead && c.in_progress().rounding.empty() != rounding)
-        return &c;
+  // (a checkpoint when it has done it) the second with the first's report of it.
+  enum class At { none, attempt, rounding };
+  auto find = [&](int done, bool ahead, At at) -> const LevelCheckpoint* {
+    for (const LevelCheckpoint& c : inside) {
+      const LevelAttempt& a = c.in_progress();
+      const At kind = a.empty() ? At::none : a.rounding.empty() ? At::attempt : At::rounding;
+      if (c.done() == done && c.first_chain_ahead() == ahead && kind == at) return &c;
+    }
     return nullptr;
   };
   for (const LevelCheckpoint& c : inside) {
@@ -810,14 +815,15 @@ TEST_CASE("coarse to fine: a run gone on from inside a level of lookahead goes o
     CHECK((c.done() == 2 || c.done() == 3));
     // The chain at the level holds the attempt: the first, or the second once the first is done.
     CHECK(c.chains[0].attempt.empty() == c.first_chain_ahead());
-    CHECK(c.chains[1].attempt.empty() != c.first_chain_ahead());
-    CHECK(c.in_progress().report.level == c.done());
+    CHECK((c.chains[1].attempt.empty() || c.first_chain_ahead()));
+    if (!c.in_progress().empty()) CHECK(c.in_progress().report.level == c.done());
     CHECK(c.chains[0].pending.size() == c.chains[1].pending.size() + (c.first_chain_ahead() ? 1 : 0));
+    if (c.first_chain_ahead()) CHECK(c.chains[0].pending.back().seconds > 0);  // its own time so far
   }
 
   test::TempDir tmp;
   const std::string file = (tmp.path / "inside.ckpt").string();
-  for (const LevelCheckpoint* c : {find(2, false, false), find(2, true, false), find(3, true, true)}) {
+  for (const LevelCheckpoint* c : {find(2, false, At::attempt), find(2, true, At::attempt), find(3, true, At::rounding)}) {
     REQUIRE(c != nullptr);
     save_checkpoint(file, *c);
     const LevelCheckpoint loaded = load_checkpoint(file);
@@ -840,14 +846,14 @@ TEST_CASE("coarse to fine: a run gone on from inside a level of lookahead goes o
     const CoarseToFineResult r = matcher.run({}, &loaded, [&](const LevelCheckpoint& k) {
       const LevelAttempt& a = k.in_progress();
       if (!a.empty() && a.report.level == level && a.widenings() < c->in_progress().widenings()) ++earlier_attempts;
-      if (!a.empty() || !first_end) return;
+      if (!a.empty() || k.first_chain_ahead() || !first_end) return;
       first_end = false;  // after the level gone on in
       CHECK(k.done() == level + 1);
       CHECK(k.chains.size() == (level == 3 ? 0u : 2u));  // (decided at level 4)
       if (c->first_chain_ahead() && level == 2) {
         CHECK(k.chains[0].pending.back().gamma == c->chains[0].pending.back().gamma);
         CHECK(k.chains[0].pending.back().energy == c->chains[0].pending.back().energy);
-        CHECK(k.chains[0].pending.back().seconds == c->chains[0].pending.back().seconds);
+        CHECK(k.chains[0].pending.back().seconds > c->chains[0].pending.back().seconds);  // this run's added
       }
     });
     if (c->first_chain_ahead() && level == 3 && !r.levels[3].lookahead_switched) {  // the first chain won
@@ -870,16 +876,44 @@ TEST_CASE("coarse to fine: a run gone on from inside a level of lookahead goes o
       }
   }
 
-  // An attempt on a chain that is not at the level in progress, or a second chain ahead, is refused.
-  const LevelCheckpoint& at_second = *find(2, true, false);
+  // Without lookahead past the split, a run gone on from the first chain's end of level 3
+  // decides there, between its report and the second chain's, solved now as in the whole run.
+  const LevelCheckpoint* first_done = find(2, true, At::none);
+  REQUIRE(first_done != nullptr);
+  REQUIRE(first_done->chains[1].attempt.empty());
+  const LevelCheckpoint* after = nullptr;
+  for (const LevelCheckpoint& c : ends)
+    if (c.done() == 3) after = &c;
+  REQUIRE(after != nullptr);
+  CoarseToFineOptions none = o;
+  none.lookahead_levels = 0;
+  const CoarseToFineMatcher deciding(dx, dy, none);
+  REQUIRE(deciding.fingerprint() == matcher.fingerprint());
+  const CoarseToFineResult decided = deciding.run({}, first_done);
+  const double e0 = first_done->chains[0].pending.back().energy, e1 = after->chains[1].pending.back().energy;
+  CHECK(after->chains[0].pending.back().energy == e0);
+  REQUIRE(decided.levels.size() == whole.levels.size());
+  CHECK(decided.levels[2].energy == doctest::Approx(std::min(e0, e1)).epsilon(1e-12));
+  CHECK(decided.levels[2].lookahead_other_energy == doctest::Approx(std::max(e0, e1)).epsilon(1e-12));
+  CHECK(std::isnan(decided.levels[3].lookahead_other_energy));
+  CHECK(check_graph_surface(decided.finest.space, decided.rounding.gamma).ok());
+
+  // An attempt on a chain that is not at the level in progress, a second chain ahead, or chains
+  // that reach the finest level are refused.
+  const LevelCheckpoint& at_second = *find(2, true, At::attempt);
   LevelCheckpoint wrong = at_second;
   wrong.chains[0].attempt = wrong.chains[1].attempt;
   CHECK_THROWS_AS(matcher.check(wrong), InvalidInputError);
-  wrong = *find(2, false, false);
-  wrong.chains[1].attempt = wrong.chains[0].attempt;
+  wrong = *find(2, false, At::attempt);
+  wrong.chains[1].attempt = find(2, false, At::attempt)->chains[0].attempt;
   CHECK_THROWS_AS(matcher.check(wrong), InvalidInputError);
   wrong = at_second;
   std::swap(wrong.chains[0], wrong.chains[1]);
+  CHECK_THROWS_AS(matcher.check(wrong), InvalidInputError);
+  wrong = *find(3, true, At::rounding);
+  wrong.chains[0].pending.push_back(whole.levels[4]);
+  wrong.chains[1].pending.push_back(whole.levels[3]);
+  wrong.chains[1].attempt = {};
   CHECK_THROWS_AS(matcher.check(wrong), InvalidInputError);
   // A version-5 file keeps the chains' levels but not their attempts.
   detail::save_checkpoint_as(file, at_second, 5);

@@ -527,14 +527,15 @@ CoarseToFineResult CoarseToFineMatcher::run(const Progress& progress, const Leve
       decide_at = std::min(static_cast<int>(resume->levels.size()) + options_.lookahead_levels, levels - 2);
       if (resume->first_chain_ahead()) decide_at = std::max(decide_at, start);
     }
+    const LevelAttempt& at = resume->in_progress();
     spdlog::info("going on from a checkpoint after level {} of {} (energy {}){}", start, levels,
-                 chains.size() == 1
-                     ? fmt::format("{:.6g}", resume->levels.back().energy)
+                 chains.size() == 1 ? fmt::format("{:.6g}", resume->levels.back().energy)
+                 : resume->first_chain_ahead()
+                     ? fmt::format("{:.6g}, the second chain of its lookahead; the first has done level {} ({:.6g})",
+                                   chains[1].pending.back().energy, start + 1, chains[0].pending.back().energy)
                      : fmt::format("{:.6g} and {:.6g}, both chains of its lookahead", chains[0].pending.back().energy,
                                    chains[1].pending.back().energy),
-                 resume->attempt.empty() ? std::string()
-                                         : fmt::format(", level {}'s widenings {}", start + 1,
-                                                       resume->attempt.widenings()));
+                 at.empty() ? std::string() : fmt::format(", level {}'s widenings {}", start + 1, at.widenings()));
     // (Its file holds this state, or one it decides.)
     if (chains.size() > 1 && !resume->first_chain_ahead()) settle(start - 1, false);
   }
@@ -589,8 +590,20 @@ CoarseToFineResult CoarseToFineMatcher::run(const Progress& progress, const Leve
         failure = std::current_exception();
         continue;
       }
+      // Its own time so far: a run gone on from inside this level adds its own to it.
+      rep.seconds = clock.seconds();
+      rep.peak_rss_mb = peak_rss_mb();
       c.pending.push_back(rep);
       next.push_back(std::move(c));
+      // Inside lookahead, the first chain done: a checkpoint before the second starts the level.
+      if (checkpoint && i + 1 < chains.size() && next.size() == i + 1) {
+        LevelCheckpoint both{fingerprint(), result.levels};
+        for (size_t j = 0; j < chains.size(); ++j) {
+          const Chain& d = j <= i ? next[j] : chains[j];
+          both.chains.push_back({d.pending, d.widened, d.leading, {}});
+        }
+        checkpoint(both);
+      }
     }
     if (second_start) {
       Chain s;
@@ -626,9 +639,13 @@ CoarseToFineResult CoarseToFineMatcher::run(const Progress& progress, const Leve
     chains = std::move(next);
     const double seconds = clock.seconds(), rss = peak_rss_mb();  // the level's, every chain's
     for (Chain& c : chains) {
-      if (!std::exchange(c.carried, false)) {
-        c.pending.back().seconds = seconds;
-        c.pending.back().peak_rss_mb = rss;
+      LevelReport& r = c.pending.back();
+      if (std::exchange(c.carried, false)) {  // its time before the checkpoint, and this run's
+        r.seconds += seconds;
+        r.peak_rss_mb = std::max(r.peak_rss_mb, rss);
+      } else {
+        r.seconds = seconds;
+        r.peak_rss_mb = rss;
       }
       c.resume = {};
     }
@@ -663,6 +680,8 @@ void CoarseToFineMatcher::check(const LevelCheckpoint& c) const {
   if (!c.chains.empty() && (c.chains.size() != 2 || !c.attempt.empty() || !c.widened.empty()))
     throw InvalidInputError("the checkpoint's lookahead holds " + std::to_string(c.chains.size()) +
                             " chains, or a level's attempt beside them");
+  if (!c.chains.empty() && done + 1 >= size_t(hx_.size()))  // (decided below the finest level)
+    throw InvalidInputError("the checkpoint's lookahead goes on into the finest level");
   // Inside a level, the first chain may have done it and the second be at it (run's order).
   for (size_t k = 0; k < c.chains.size(); ++k) {
     const LevelCheckpoint::Chain& chain = c.chains[k];
