@@ -473,6 +473,13 @@ CoarseToFineResult CoarseToFineMatcher::run(const Progress& progress, const Leve
   const int levels = hx_.size();
   int decide_at = -1;
   int start = 0;
+  // A checkpoint of the two lookahead chains, `at` (if one) with the attempt `a` of its level.
+  auto save_chains = [&](const Chain& first, const Chain& second, const Chain* at, const LevelAttempt& a) {
+    LevelCheckpoint both{fingerprint(), result.levels};
+    for (const Chain* c : {&first, &second})
+      both.chains.push_back({c->pending, c->widened, c->leading, c == at ? a : LevelAttempt{}});
+    checkpoint(both);
+  };
   // After level l: two chains that reached the same Γ go on as one, two at decide_at are
   // decided, and a single chain's reports become the result's. Every level but the finest is
   // then a checkpoint (where `save`), with both chains inside lookahead.
@@ -504,9 +511,7 @@ CoarseToFineResult CoarseToFineMatcher::run(const Progress& progress, const Leve
       c.pending.clear();
       if (save && checkpoint && l + 1 < levels) checkpoint(LevelCheckpoint{fingerprint(), result.levels, c.widened});
     } else if (save && checkpoint && l + 1 < levels) {
-      LevelCheckpoint both{fingerprint(), result.levels};
-      for (const Chain& c : chains) both.chains.push_back({c.pending, c.widened, c.leading, {}});
-      checkpoint(both);
+      save_chains(chains[0], chains[1], nullptr, {});
     }
   };
   if (resume) {
@@ -572,12 +577,7 @@ CoarseToFineResult CoarseToFineMatcher::run(const Progress& progress, const Leve
         attempted = [&, i](const LevelAttempt& a) {
           if (chains.size() == 1) return checkpoint(LevelCheckpoint{fingerprint(), result.levels, c.widened, a});
           if (next.size() != i) return;
-          LevelCheckpoint both{fingerprint(), result.levels};
-          for (size_t j = 0; j < chains.size(); ++j) {
-            const Chain& d = j < i ? next[j] : chains[j];
-            both.chains.push_back({d.pending, d.widened, d.leading, j == i ? a : LevelAttempt{}});
-          }
-          checkpoint(both);
+          save_chains(i == 0 ? chains[0] : next[0], chains[1], &c, a);
         };
       const LevelAttempt* attempt = l == start && !c.resume.empty() ? &c.resume : nullptr;
       LevelReport rep = header;
@@ -596,14 +596,7 @@ CoarseToFineResult CoarseToFineMatcher::run(const Progress& progress, const Leve
       c.pending.push_back(rep);
       next.push_back(std::move(c));
       // Inside lookahead, the first chain done: a checkpoint before the second starts the level.
-      if (checkpoint && i + 1 < chains.size() && next.size() == i + 1) {
-        LevelCheckpoint both{fingerprint(), result.levels};
-        for (size_t j = 0; j < chains.size(); ++j) {
-          const Chain& d = j <= i ? next[j] : chains[j];
-          both.chains.push_back({d.pending, d.widened, d.leading, {}});
-        }
-        checkpoint(both);
-      }
+      if (checkpoint && i == 0 && chains.size() == 2 && next.size() == 1) save_chains(next[0], chains[1], nullptr, {});
     }
     if (second_start) {
       Chain s;
