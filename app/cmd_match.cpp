@@ -84,6 +84,7 @@ struct MatchArgs {
   int stuck_stalled = RoundingOptions{}.stuck_stalled;
   int price_widenings = CoarseToFineOptions{}.price_widenings;
   int lookahead_levels = CoarseToFineOptions{}.lookahead_levels;
+  bool lookahead_drop_stuck = CoarseToFineOptions{}.lookahead_drop_stuck;
   double price_threshold = CoarseToFineOptions{}.price_threshold;
   double price_tolerance = CoarseToFineOptions{}.price_tolerance;
 };
@@ -172,6 +173,7 @@ int run_match(const MatchArgs& args) {
   co.rounding_checkpoint_seconds = args.rounding_checkpoint_seconds;
   co.price_widenings = args.price_widenings;
   co.lookahead_levels = args.lookahead_levels;
+  co.lookahead_drop_stuck = args.lookahead_drop_stuck;
   co.price_threshold = args.price_threshold;
   co.price_tolerance = args.price_tolerance;
   co.matching = matching_options(args.pair, p);
@@ -445,6 +447,7 @@ int run_match(const MatchArgs& args) {
                               .set("coarsest_faces", args.hierarchy.coarsest_faces)
                               .set("second_faces", args.hierarchy.second_faces)
                               .set("lookahead_levels", args.lookahead_levels)
+                              .set("lookahead_drop_stuck", args.lookahead_drop_stuck)
                               .set("surface_parents", args.hierarchy.surface_parents)
                               .set("level_ratio", args.hierarchy.ratio)
                               .set("ring", args.ring)
@@ -663,6 +666,9 @@ Action add_match_command(CLI::App& app) {
                  "(never the finest) and go on with the lower energy there; 0: decide at the second level")
       ->check(CLI::Range(0, 16))
       ->capture_default_str();
+  app.add_flag("--lookahead-drop-stuck", a->lookahead_drop_stuck,
+               "inside lookahead, a chain whose rounding gets stuck at a level drops out there instead of widening "
+               "(the other chain goes on; where it finds no Γ either, the first solves the level again)");
   app.add_option("--ring", a->ring, "neighbourhood rings of the reduced product space (eq. 17)")
       ->check(CLI::Range(0, 8))
       ->capture_default_str();

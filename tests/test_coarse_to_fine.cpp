@@ -17,6 +17,7 @@
 #include <map>
 #include <random>
 #include <memory>
+#include <optional>
 #include <set>
 
 using namespace shapematch;
@@ -1488,4 +1489,74 @@ TEST_CASE("coarse to fine: a run gone on from a checkpoint inside a rounding fix
   LevelCheckpoint wrong = last.front();
   wrong.attempt.rounding.ones.push_back(g.columns);
   CHECK_THROWS_AS(matcher.run({}, &wrong), InvalidInputError);
+}
+
+TEST_CASE("coarse to fine: with lookahead_drop_stuck a chain stuck inside lookahead drops out and the other goes on") {
+  // The dolphins of the lookahead test, gone on from after level 3 (both chains, decided at 4)
+  // with one round per level: there the second chain's rounding cannot finish (stuck: out of
+  // rounds) and, without dropping, widens and solves level 4 again; the first's finishes.
+  const Mesh dx = decimate(shapes::dolphin(20, 0), 80), dy = decimate(shapes::dolphin(-20, 40), 90);
+  CoarseToFineOptions o = small_levels();
+  o.lookahead_levels = 2;
+  const CoarseToFineMatcher matcher(dx, dy, o);
+  std::vector<LevelCheckpoint> saved;
+  matcher.run({}, nullptr, [&](const LevelCheckpoint& c) {
+    if (c.in_progress().empty() && !c.first_chain_ahead() && c.done() == 3) saved.push_back(c);
+  });
+  REQUIRE(saved.size() == 1);
+  REQUIRE(saved[0].chains.size() == 2);
+  o.rounding.max_rounds = 1;
+  const CoarseToFineMatcher once(dx, dy, o);
+  const CoarseToFineResult plain = once.run({}, &saved[0]);
+  REQUIRE(plain.levels.size() == 5);
+  const LevelReport& d = plain.levels[3];
+  REQUIRE(std::isfinite(d.lookahead_other_energy));  // both chains found a Γ at level 4
+  REQUIRE_FALSE(d.lookahead_switched);               // the first chain's, round once
+  CHECK(d.stuck_widenings == 0);
+
+  o.lookahead_drop_stuck = true;
+  const CoarseToFineMatcher dropping(dx, dy, o);
+  // The second chain drops out at level 4: the first goes on alone, with the same Γ.
+  const CoarseToFineResult r = dropping.run({}, &saved[0]);
+  REQUIRE(r.levels.size() == 5);
+  CHECK(std::isnan(r.levels[3].lookahead_other_energy));
+  CHECK_FALSE(r.levels[3].lookahead_switched);
+  for (int l : {3, 4}) {
+    CHECK(r.levels[l].gamma == plain.levels[l].gamma);
+    CHECK(r.levels[l].energy == doctest::Approx(plain.levels[l].energy).epsilon(1e-12));
+  }
+  CHECK(check_graph_surface(r.finest.space, r.rounding.gamma).ok());
+  CHECK(satisfies_exactly(r.finest.lp, r.rounding.gamma));
+
+  // The stuck chain first: it drops out and the other goes on, as above.
+  LevelCheckpoint swapped = saved[0];
+  std::swap(swapped.chains[0], swapped.chains[1]);
+  const CoarseToFineResult s = dropping.run({}, &swapped);
+  REQUIRE(s.levels.size() == 5);
+  CHECK(std::isnan(s.levels[3].lookahead_other_energy));
+  CHECK(s.levels[3].gamma == plain.levels[3].gamma);
+  CHECK(s.rounding.energy == doctest::Approx(plain.rounding.energy).epsilon(1e-12));
+
+  // Where the other chain then finds no Γ (a Γ of one product triangle leaves no surface near
+  // it at any ring), the stuck chain solves level 4 again without dropping: widened, as without
+  // lookahead_drop_stuck, to the Γ that was the other energy above.
+  // (Stopped after level 4: the finest level, rounded once per LP, then widens for a minute.)
+  LevelCheckpoint broken = swapped;
+  broken.chains[1].pending.back().gamma.resize(1);
+  struct Stop {};
+  std::optional<LevelCheckpoint> after;
+  CHECK_THROWS_AS(dropping.run({}, &broken,
+                               [&](const LevelCheckpoint& c) {
+                                 if (c.done() < 4 || !c.in_progress().empty()) return;
+                                 after = c;
+                                 throw Stop{};
+                               }),
+                  Stop);
+  REQUIRE(after);
+  REQUIRE(after->levels.size() == 4);
+  const LevelReport& a = after->levels[3];
+  CHECK(a.stuck_widenings > 0);
+  CHECK(a.energy == doctest::Approx(d.lookahead_other_energy).epsilon(1e-12));
+  CHECK(a.lookahead_switched);  // the chain that did not lead at level 2
+  CHECK(std::isnan(a.lookahead_other_energy));
 }

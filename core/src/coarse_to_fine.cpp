@@ -562,13 +562,11 @@ CoarseToFineResult CoarseToFineMatcher::run(const Progress& progress, const Leve
     const bool second_start = l == 1 && second_level_;
     std::vector<Chain> next;
     std::exception_ptr failure;
-    for (size_t i = 0; i < chains.size(); ++i) {
+    bool stuck = false;  // the last chain that dropped out was stuck
+    // Chain i at this level; false where it found no Γ (or, with `may_drop`, got stuck) and
+    // drops out.
+    auto solve_chain = [&](size_t i, bool may_drop) {
       Chain& c = chains[i];
-      if (result.levels.size() + c.pending.size() > size_t(l)) {  // done before the checkpoint gone on from
-        c.carried = true;
-        next.push_back(std::move(c));
-        continue;
-      }
       // Each attempt of a level after the first is a checkpoint: of the level, or inside
       // lookahead of both chains, those before this one having done the level (not where one of
       // them dropped out at it: no file holds that state).
@@ -582,13 +580,18 @@ CoarseToFineResult CoarseToFineMatcher::run(const Progress& progress, const Leve
       const LevelAttempt* attempt = l == start && !c.resume.empty() ? &c.resume : nullptr;
       LevelReport rep = header;
       try {
-        solve_refined(l, model, rep, c.gamma, result, progress, c.widened, attempt, attempted);
+        solve_refined(l, model, rep, c.gamma, result, progress, c.widened, attempt, attempted, may_drop);
       } catch (const InfeasibleError& e) {
         if (!second_start && chains.size() == 1) throw;
-        spdlog::warn("level {}: no Γ in the refined space ({}); {}", l + 1, e.what(),
-                     second_start ? "trying the full space" : "that chain drops out");
+        stuck = dynamic_cast<const StuckError*>(&e) != nullptr;
+        if (may_drop && stuck)
+          spdlog::warn("level {}: the {} lookahead chain drops out, its rounding stuck ({})", l + 1,
+                       i == 0 ? "first" : "second", e.what());
+        else
+          spdlog::warn("level {}: no Γ in the refined space ({}); {}", l + 1, e.what(),
+                       second_start ? "trying the full space" : "that chain drops out");
         failure = std::current_exception();
-        continue;
+        return false;
       }
       // Its own time so far: a run gone on from inside this level adds its own to it.
       rep.seconds = clock.seconds();
@@ -597,6 +600,25 @@ CoarseToFineResult CoarseToFineMatcher::run(const Progress& progress, const Leve
       next.push_back(std::move(c));
       // Inside lookahead, the first chain done: a checkpoint before the second starts the level.
       if (checkpoint && i == 0 && chains.size() == 2 && next.size() == 1) save_chains(next[0], chains[1], nullptr, {});
+      return true;
+    };
+    // lookahead_drop_stuck: the first chain may drop out when stuck (the second, or the first
+    // again without dropping, still finds a Γ), the second only where the first has one.
+    size_t stuck_dropped = chains.size();
+    for (size_t i = 0; i < chains.size(); ++i) {
+      Chain& c = chains[i];
+      if (result.levels.size() + c.pending.size() > size_t(l)) {  // done before the checkpoint gone on from
+        c.carried = true;
+        next.push_back(std::move(c));
+        continue;
+      }
+      const bool may_drop = options_.lookahead_drop_stuck && chains.size() == 2 && next.size() == i;
+      if (!solve_chain(i, may_drop) && may_drop && stuck) stuck_dropped = i;
+    }
+    if (next.empty() && stuck_dropped == 0) {
+      spdlog::warn("level {}: neither lookahead chain found a Γ; the first, dropped out when stuck, solves the "
+                   "level again without dropping", l + 1);
+      solve_chain(0, false);
     }
     if (second_start) {
       Chain s;
@@ -853,7 +875,8 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
                                         std::vector<ProductTriangle>& gamma, CoarseToFineResult& result,
                                         const Progress& progress, std::vector<int>& widened,
                                         const LevelAttempt* resume,
-                                        const std::function<void(const LevelAttempt&)>& attempted) const {
+                                        const std::function<void(const LevelAttempt&)>& attempted,
+                                        bool drop_when_stuck) const {
   const MeshLevel& lx = hx_.levels[l];
   const MeshLevel& ly = hy_.levels[l];
   const int base_ring = ring_at(l);
@@ -1309,6 +1332,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
       // from its fixings but those over the faces just widened (what failed there). Where nothing
       // could widen there, on as below (without trying the same place again).
       const auto* s = dynamic_cast<const StuckError*>(&e);
+      if (s && drop_when_stuck) throw;
       // First (stuck_restarts) start its rounding again here from its fixings, its state afresh.
       if (s && restarts < options_.stuck_restarts && !s->ones().empty() && rounds_so_far > 0 &&
           std::isfinite(first_bound)) {

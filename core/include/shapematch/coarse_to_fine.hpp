@@ -250,6 +250,13 @@ struct CoarseToFineOptions {
   // one won, and the finest energy went 16.51 → 13.07, the error 0.035 → 0.028. 0: decide at the
   // second level by its energy.
   int lookahead_levels = 2;
+  // Inside lookahead, a chain whose rounding at a level gets stuck (stuck_after) drops out there
+  // instead of widening and solving the level again, while the other chain goes on: it is an
+  // alternative, not the only Γ. Where the other chain then finds no Γ at that level either, the
+  // dropped one solves the level again as usual. Why: FAUST_r 016-026 with WKS at μ = 10 (45th
+  // session) spent 2 h 24 min in level 4's first chain, stuck and widened three times (2.9 M to
+  // 4.7 M variables, 5-11 min per first LP on one core), and did not finish.
+  bool lookahead_drop_stuck = false;
   // A directory: every first LP that a rounding solves is written there (write_lp) as
   // level<L>-<NNN>.smlp, NNN counting all first LPs of the run, for solving it again on its own
   // (`shapematch lp --from`). Empty: none.
@@ -450,11 +457,13 @@ private:
   // `widened`: on entry the coarser level's extra rings per X face (inherit_widening; empty:
   // none), on return this level's.
   // `resume`: an attempt of this level to start from (null: none); `attempted`: called before
-  // every attempt after the first, with the state it starts from.
+  // every attempt after the first, with the state it starts from. `drop_when_stuck`: a stuck
+  // rounding throws its StuckError instead of widening (lookahead_drop_stuck).
   void solve_refined(int l, const EnergyModel& model, LevelReport& rep, std::vector<ProductTriangle>& gamma,
                      CoarseToFineResult& result, const Progress& progress, std::vector<int>& widened,
                      const LevelAttempt* resume = nullptr,
-                     const std::function<void(const LevelAttempt&)>& attempted = {}) const;
+                     const std::function<void(const LevelAttempt&)>& attempted = {},
+                     bool drop_when_stuck = false) const;
   // The second start at level l: the full product space, rounded. Fills `rep` (a copy of the
   // level's, with the second start's numbers), `gamma`, and at the finest level `finest`'s LP
   // and rounding; false where it found no Γ.
