@@ -85,6 +85,7 @@ struct MatchArgs {
   int price_widenings = CoarseToFineOptions{}.price_widenings;
   int lookahead_levels = CoarseToFineOptions{}.lookahead_levels;
   bool lookahead_drop_stuck = CoarseToFineOptions{}.lookahead_drop_stuck;
+  bool lookahead_bound_drop = CoarseToFineOptions{}.lookahead_bound_drop;
   double price_threshold = CoarseToFineOptions{}.price_threshold;
   double price_tolerance = CoarseToFineOptions{}.price_tolerance;
 };
@@ -174,6 +175,7 @@ int run_match(const MatchArgs& args) {
   co.price_widenings = args.price_widenings;
   co.lookahead_levels = args.lookahead_levels;
   co.lookahead_drop_stuck = args.lookahead_drop_stuck;
+  co.lookahead_bound_drop = args.lookahead_bound_drop;
   co.price_threshold = args.price_threshold;
   co.price_tolerance = args.price_tolerance;
   co.matching = matching_options(args.pair, p);
@@ -448,6 +450,7 @@ int run_match(const MatchArgs& args) {
                               .set("second_faces", args.hierarchy.second_faces)
                               .set("lookahead_levels", args.lookahead_levels)
                               .set("lookahead_drop_stuck", args.lookahead_drop_stuck)
+                              .set("lookahead_bound_drop", args.lookahead_bound_drop)
                               .set("surface_parents", args.hierarchy.surface_parents)
                               .set("level_ratio", args.hierarchy.ratio)
                               .set("ring", args.ring)
@@ -515,6 +518,7 @@ int run_match(const MatchArgs& args) {
                       .set("second_start_energy", l.second_start_energy)
                       .set("second_start_kept", l.second_start_kept)
                       .set("lookahead_other_energy", l.lookahead_other_energy)
+                      .set("lookahead_other_bound", l.lookahead_other_bound)
                       .set("lookahead_switched", l.lookahead_switched)
                       .set("seconds", l.seconds)
                       .set("peak_rss_mb", l.peak_rss_mb));
@@ -669,6 +673,10 @@ Action add_match_command(CLI::App& app) {
   app.add_flag("--lookahead-drop-stuck", a->lookahead_drop_stuck,
                "inside lookahead, a chain whose rounding gets stuck at a level drops out there instead of widening "
                "(the other chain goes on; where it finds no Γ either, the first solves the level again)");
+  app.add_flag("--lookahead-bound-drop,!--no-lookahead-bound-drop", a->lookahead_bound_drop,
+               "at the level where lookahead decides, the chain solving it second stops after a first LP whose "
+               "bound is at or above the first chain's energy there (it cannot win)")
+      ->capture_default_str();
   app.add_option("--ring", a->ring, "neighbourhood rings of the reduced product space (eq. 17)")
       ->check(CLI::Range(0, 8))
       ->capture_default_str();

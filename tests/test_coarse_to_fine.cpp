@@ -647,6 +647,7 @@ TEST_CASE("coarse to fine: lookahead refines both Γ of the second level and kee
   const CoarseToFineResult refined = refined_matcher.run();
   o.second_start = true;
   o.lookahead_levels = 2;
+  o.lookahead_bound_drop = false;  // (level 4's second chain, bound above the first's energy, rounds too)
   const CoarseToFineMatcher matcher = dolphin_matcher(o);
   const CoarseToFineResult r = matcher.run();
   REQUIRE(r.levels.size() == 5);
@@ -672,6 +673,66 @@ TEST_CASE("coarse to fine: lookahead refines both Γ of the second level and kee
   CHECK(r.levels[1].second_start_kept == (plain.levels[1].second_start_kept != d.lookahead_switched));
   if (!d.lookahead_switched)
     for (int l : {1, 2}) CHECK(r.levels[l].energy == doctest::Approx(plain.levels[l].energy).epsilon(1e-12));
+}
+
+TEST_CASE("coarse to fine: at the deciding level a second chain whose first LP cannot win drops out after it") {
+  // The dolphins of the lookahead test: at level 4, where lookahead decides, the first chain's
+  // energy is below the second chain's first LP bound. A checkpoint after every round.
+  const Mesh dx = decimate(shapes::dolphin(20, 0), 80), dy = decimate(shapes::dolphin(-20, 40), 90);
+  CoarseToFineOptions o = small_levels();
+  o.lookahead_levels = 2;
+  o.rounding.alternative_thresholds = {};  // (with them a level's rounding is not saved)
+  o.rounding_checkpoint_seconds = 0.0;
+  o.lookahead_bound_drop = false;
+  const CoarseToFineMatcher both(dx, dy, o);
+  std::vector<LevelCheckpoint> inside;  // inside the second chain's rounding of level 4
+  const CoarseToFineResult whole = both.run({}, nullptr, [&](const LevelCheckpoint& c) {
+    if (c.done() == 3 && c.first_chain_ahead() && !c.in_progress().rounding.empty()) inside.push_back(c);
+  });
+  const LevelReport& d = whole.levels[3];
+  REQUIRE(std::isfinite(d.lookahead_other_energy));
+  REQUIRE_FALSE(d.lookahead_switched);
+  REQUIRE_FALSE(inside.empty());
+
+  o.lookahead_bound_drop = true;
+  const CoarseToFineMatcher dropping(dx, dy, o);
+  std::optional<LevelCheckpoint> after;  // after level 4
+  const CoarseToFineResult r = dropping.run({}, nullptr, [&](const LevelCheckpoint& c) {
+    if (c.done() == 4 && c.in_progress().empty()) after = c;
+  });
+  REQUIRE(r.levels.size() == whole.levels.size());
+  const LevelReport& k = r.levels[3];
+  REQUIRE(std::isfinite(k.lookahead_other_bound));
+  CHECK(std::isnan(k.lookahead_other_energy));
+  CHECK(k.lookahead_other_bound >= k.energy);
+  // The bound held: rounded on, that chain's Γ was no lower, and the same chain went on.
+  CHECK(d.lookahead_other_energy >= k.lookahead_other_bound * (1 - 1e-9));
+  MESSAGE("level 4: first chain ", k.energy, ", second chain's bound ", k.lookahead_other_bound, ", its energy ",
+          d.lookahead_other_energy);
+  for (size_t l = 0; l < r.levels.size(); ++l) {
+    CHECK(r.levels[l].gamma == whole.levels[l].gamma);
+    CHECK(r.levels[l].energy == doctest::Approx(whole.levels[l].energy).epsilon(1e-12));
+    if (l != 3) CHECK(std::isnan(r.levels[l].lookahead_other_bound));
+  }
+  CHECK(r.rounding.energy == doctest::Approx(whole.rounding.energy).epsilon(1e-12));
+
+  // Gone on from inside that chain's rounding: it drops out at once, on the saved bound.
+  const LevelCheckpoint& c = inside.back();
+  const double saved = c.chains[1].attempt.rounding.lower_bound;
+  const CoarseToFineResult g = dropping.run({}, &c);
+  CHECK(g.levels[3].lookahead_other_bound == saved);
+  CHECK(g.levels[3].gamma == whole.levels[3].gamma);
+  CHECK(g.rounding.energy == doctest::Approx(whole.rounding.energy).epsilon(1e-12));
+
+  // Kept by a checkpoint (version 7), not by a version-6 one.
+  REQUIRE(after);
+  REQUIRE(after->levels.size() == 4);
+  test::TempDir tmp;
+  const std::string file = (tmp.path / "bound.ckpt").string();
+  save_checkpoint(file, *after);
+  CHECK(load_checkpoint(file).levels[3].lookahead_other_bound == k.lookahead_other_bound);
+  detail::save_checkpoint_as(file, *after, 6);
+  CHECK(std::isnan(load_checkpoint(file).levels[3].lookahead_other_bound));
 }
 
 TEST_CASE("coarse to fine: two lookahead chains that reach the same Γ go on as one, with the same result") {
@@ -703,6 +764,7 @@ TEST_CASE("coarse to fine: a run gone on from a checkpoint inside lookahead ends
   const Mesh dx = decimate(shapes::dolphin(20, 0), 80), dy = decimate(shapes::dolphin(-20, 40), 90);
   CoarseToFineOptions o = small_levels();
   o.lookahead_levels = 2;
+  o.lookahead_bound_drop = false;  // (level 4's second chain, bound above the first's energy, rounds too)
   const CoarseToFineMatcher matcher(dx, dy, o);
   REQUIRE(matcher.x_levels().size() == 5);
   std::vector<LevelCheckpoint> saved;
@@ -792,6 +854,7 @@ TEST_CASE("coarse to fine: a run gone on from inside a level of lookahead goes o
   const Mesh dx = decimate(shapes::dolphin(20, 0), 80), dy = decimate(shapes::dolphin(-20, 40), 90);
   CoarseToFineOptions o = small_levels();
   o.lookahead_levels = 2;
+  o.lookahead_bound_drop = false;  // (level 4's second chain, bound above the first's energy, rounds too)
   o.rounding.alternative_thresholds = {};  // (with them a level's rounding is not saved)
   o.rounding_checkpoint_seconds = 0.0;
   const CoarseToFineMatcher matcher(dx, dy, o);
@@ -1498,6 +1561,7 @@ TEST_CASE("coarse to fine: with lookahead_drop_stuck a chain stuck inside lookah
   const Mesh dx = decimate(shapes::dolphin(20, 0), 80), dy = decimate(shapes::dolphin(-20, 40), 90);
   CoarseToFineOptions o = small_levels();
   o.lookahead_levels = 2;
+  o.lookahead_bound_drop = false;  // (level 4's second chain, bound above the first's energy, rounds too)
   const CoarseToFineMatcher matcher(dx, dy, o);
   std::vector<LevelCheckpoint> saved;
   matcher.run({}, nullptr, [&](const LevelCheckpoint& c) {

@@ -22,6 +22,12 @@
 namespace shapematch {
 namespace {
 
+// A lookahead chain's attempt whose first LP's bound could not win the decision
+// (CoarseToFineOptions::lookahead_bound_drop).
+struct Outmatched {
+  double bound;
+};
+
 std::array<int, 3> rotated(const std::array<int, 3>& f, int r) { return {f[r % 3], f[(r + 1) % 3], f[(r + 2) % 3]}; }
 
 void sort_unique(std::vector<int>& v) {
@@ -565,7 +571,7 @@ CoarseToFineResult CoarseToFineMatcher::run(const Progress& progress, const Leve
     bool stuck = false;  // the last chain that dropped out was stuck
     // Chain i at this level; false where it found no Γ (or, with `may_drop`, got stuck) and
     // drops out.
-    auto solve_chain = [&](size_t i, bool may_drop) {
+    auto solve_chain = [&](size_t i, const ChainRules& rules) {
       Chain& c = chains[i];
       // Each attempt of a level after the first is a checkpoint: of the level, or inside
       // lookahead of both chains, those before this one having done the level (not where one of
@@ -580,11 +586,19 @@ CoarseToFineResult CoarseToFineMatcher::run(const Progress& progress, const Leve
       const LevelAttempt* attempt = l == start && !c.resume.empty() ? &c.resume : nullptr;
       LevelReport rep = header;
       try {
-        solve_refined(l, model, rep, c.gamma, result, progress, c.widened, attempt, attempted, may_drop);
+        solve_refined(l, model, rep, c.gamma, result, progress, c.widened, attempt, attempted, rules);
+      } catch (const Outmatched& o) {
+        LevelReport& kept = next.front().pending.back();
+        spdlog::info("level {}: the second lookahead chain's LP bound {:.6g} is at or above the first chain's energy "
+                     "{:.6g}: it cannot win, and drops out",
+                     l + 1, o.bound, kept.energy);
+        kept.lookahead_other_bound = o.bound;
+        stuck = false;
+        return false;
       } catch (const InfeasibleError& e) {
         if (!second_start && chains.size() == 1) throw;
         stuck = dynamic_cast<const StuckError*>(&e) != nullptr;
-        if (may_drop && stuck)
+        if (rules.drop_when_stuck && stuck)
           spdlog::warn("level {}: the {} lookahead chain drops out, its rounding stuck ({})", l + 1,
                        i == 0 ? "first" : "second", e.what());
         else
@@ -612,13 +626,17 @@ CoarseToFineResult CoarseToFineMatcher::run(const Progress& progress, const Leve
         next.push_back(std::move(c));
         continue;
       }
-      const bool may_drop = options_.lookahead_drop_stuck && chains.size() == 2 && next.size() == i;
-      if (!solve_chain(i, may_drop) && may_drop && stuck) stuck_dropped = i;
+      ChainRules rules;
+      rules.drop_when_stuck = options_.lookahead_drop_stuck && chains.size() == 2 && next.size() == i;
+      // The second chain at the deciding level, the first having its Γ there.
+      if (options_.lookahead_bound_drop && chains.size() == 2 && i == 1 && next.size() == 1 && l == decide_at)
+        rules.beat = next.front().pending.back().energy;
+      if (!solve_chain(i, rules) && rules.drop_when_stuck && stuck) stuck_dropped = i;
     }
     if (next.empty() && stuck_dropped == 0) {
       spdlog::warn("level {}: neither lookahead chain found a Γ; the first, dropped out when stuck, solves the "
                    "level again without dropping", l + 1);
-      solve_chain(0, false);
+      solve_chain(0, {});
     }
     if (second_start) {
       Chain s;
@@ -876,7 +894,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
                                         const Progress& progress, std::vector<int>& widened,
                                         const LevelAttempt* resume,
                                         const std::function<void(const LevelAttempt&)>& attempted,
-                                        bool drop_when_stuck) const {
+                                        const ChainRules& rules) const {
   const MeshLevel& lx = hx_.levels[l];
   const MeshLevel& ly = hy_.levels[l];
   const int base_ring = ring_at(l);
@@ -1258,6 +1276,21 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
           attempted(a);
           since_saved.reset();
         };
+      // A lookahead chain that cannot win: out after the first LP (once pricing has not widened).
+      // Gone on from inside the rounding, the first LP's bound is the saved one; a carried start's
+      // round 1 solves only what its fixings leave, no bound of the space.
+      if (std::isfinite(rules.beat) && !carrying) {
+        if (going_on) {
+          if (going_on->lower_bound >= rules.beat) throw Outmatched{going_on->lower_bound};
+        } else {
+          ro.decided = [inner = std::move(ro.decided), beat = rules.beat](const RoundingRound& r,
+                                                                          const std::vector<int64_t>& ones,
+                                                                          double bound) {
+            if (inner) inner(r, ones, bound);
+            if (r.round == 1 && bound >= beat) throw Outmatched{bound};
+          };
+        }
+      }
       // Where rounding gets stuck, widen around it (as for an infeasible LP) and solve again.
       if (l > 0 && options_.local_widening && local < options_.max_local_widenings)
         ro.stuck_after = options_.stuck_after;
@@ -1332,7 +1365,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
       // from its fixings but those over the faces just widened (what failed there). Where nothing
       // could widen there, on as below (without trying the same place again).
       const auto* s = dynamic_cast<const StuckError*>(&e);
-      if (s && drop_when_stuck) throw;
+      if (s && rules.drop_when_stuck) throw;
       // First (stuck_restarts) start its rounding again here from its fixings, its state afresh.
       if (s && restarts < options_.stuck_restarts && !s->ones().empty() && rounds_so_far > 0 &&
           std::isfinite(first_bound)) {

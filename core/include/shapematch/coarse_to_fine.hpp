@@ -257,6 +257,14 @@ struct CoarseToFineOptions {
   // session) spent 2 h 24 min in level 4's first chain, stuck and widened three times (2.9 M to
   // 4.7 M variables, 5-11 min per first LP on one core), and did not finish.
   bool lookahead_drop_stuck = false;
+  // At the level where lookahead decides, the chain that solves it second stops after the first
+  // LP of an attempt whose certified bound is at or above the first chain's energy there: no Γ
+  // in that attempt's space could win the decision (ties keep the first), and its rounding would
+  // be spent for nothing. Why: FAUST_r 016-026 at μ = 10, level 4: the first chain's Γ had
+  // energy 2.916 in 2 minutes; the second chain's LP bound was 4.05, and its rounding ran for over
+  // two hours (stuck, widened three times). Not a bound over a space widened later (the
+  // attempt's only; widenings move it little: 4.09, 4.047, 4.046 over its three attempts there).
+  bool lookahead_bound_drop = true;
   // A directory: every first LP that a rounding solves is written there (write_lp) as
   // level<L>-<NNN>.smlp, NNN counting all first LPs of the run, for solving it again on its own
   // (`shapematch lp --from`). Empty: none.
@@ -324,6 +332,10 @@ struct LevelReport {
   // chain of higher energy at the second level won.
   double lookahead_other_energy = std::numeric_limits<double>::quiet_NaN();
   bool lookahead_switched = false;
+  // There too, where the other chain stopped after its first LP because that LP's bound was at or
+  // above this chain's energy (CoarseToFineOptions::lookahead_bound_drop): that bound (NaN
+  // elsewhere; lookahead_other_energy is then NaN).
+  double lookahead_other_bound = std::numeric_limits<double>::quiet_NaN();
   // The level's Γ, the one that went on (on the level's meshes, x_levels()/y_levels()): match
   // writes a vertex map per level from it, so that eval can say at which level an error arose.
   std::vector<ProductTriangle> gamma;
@@ -452,18 +464,23 @@ private:
   RoundingOptions rounding_for(int l) const;
   // Level l's ring before any widening: coarse_ring at the small levels below the finest.
   int ring_at(int l) const;
+  // Inside lookahead: drop_when_stuck, a stuck rounding throws its StuckError instead of
+  // widening (lookahead_drop_stuck); where `beat` is finite, an attempt whose first LP's bound is
+  // at or above it throws instead of rounding (lookahead_bound_drop).
+  struct ChainRules {
+    bool drop_when_stuck = false;
+    double beat = std::numeric_limits<double>::quiet_NaN();
+  };
   // Level l from the coarser level's Γ (the full space at l = 0), widening where it is
   // infeasible; throws InfeasibleError when the largest ring is. Replaces `gamma` with level l's.
   // `widened`: on entry the coarser level's extra rings per X face (inherit_widening; empty:
   // none), on return this level's.
   // `resume`: an attempt of this level to start from (null: none); `attempted`: called before
-  // every attempt after the first, with the state it starts from. `drop_when_stuck`: a stuck
-  // rounding throws its StuckError instead of widening (lookahead_drop_stuck).
+  // every attempt after the first, with the state it starts from. `rules`: a lookahead chain's.
   void solve_refined(int l, const EnergyModel& model, LevelReport& rep, std::vector<ProductTriangle>& gamma,
                      CoarseToFineResult& result, const Progress& progress, std::vector<int>& widened,
-                     const LevelAttempt* resume = nullptr,
-                     const std::function<void(const LevelAttempt&)>& attempted = {},
-                     bool drop_when_stuck = false) const;
+                     const LevelAttempt* resume, const std::function<void(const LevelAttempt&)>& attempted,
+                     const ChainRules& rules) const;
   // The second start at level l: the full product space, rounded. Fills `rep` (a copy of the
   // level's, with the second start's numbers), `gamma`, and at the finest level `finest`'s LP
   // and rounding; false where it found no Γ.
