@@ -1473,7 +1473,7 @@ TEST_CASE("coarse to fine: a run gone on from an attempt of a level in progress 
   CHECK(v3.attempt.report.widened_faces == a.report.widened_faces);
   CHECK(v3.attempt.report.stuck_restarts == 0);
   CHECK(v3.levels.back().gamma == last.levels.back().gamma);
-  CHECK_THROWS_AS(detail::save_checkpoint_as(file, marked, 7), InvalidInputError);
+  CHECK_THROWS_AS(detail::save_checkpoint_as(file, marked, 8), InvalidInputError);
 }
 
 TEST_CASE("coarse to fine: a run gone on from a checkpoint inside a rounding fixes its decisions and keeps its bound") {
