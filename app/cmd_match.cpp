@@ -519,6 +519,7 @@ int run_match(const MatchArgs& args) {
                       .set("second_start_kept", l.second_start_kept)
                       .set("lookahead_other_energy", l.lookahead_other_energy)
                       .set("lookahead_other_bound", l.lookahead_other_bound)
+                      .set("lookahead_other_stuck", l.lookahead_other_stuck)
                       .set("lookahead_switched", l.lookahead_switched)
                       .set("seconds", l.seconds)
                       .set("peak_rss_mb", l.peak_rss_mb));

@@ -724,6 +724,16 @@ TEST_CASE("coarse to fine: at the deciding level a second chain whose first LP c
   CHECK(g.levels[3].gamma == whole.levels[3].gamma);
   CHECK(g.rounding.energy == doctest::Approx(whole.rounding.energy).epsilon(1e-12));
 
+  // With less lookahead, decided at level 3, where the second chain's Γ is the lower: its LP's
+  // bound is below the first chain's energy, and it rounds and wins.
+  o.lookahead_levels = 1;
+  const CoarseToFineMatcher shorter(dx, dy, o);
+  const CoarseToFineResult e = shorter.run();
+  CHECK(std::isfinite(e.levels[2].lookahead_other_energy));
+  CHECK(std::isnan(e.levels[2].lookahead_other_bound));
+  CHECK(e.levels[2].lookahead_switched);
+  CHECK(e.levels[2].energy < e.levels[2].lookahead_other_energy);
+
   // Kept by a checkpoint (version 7), not by a version-6 one.
   REQUIRE(after);
   REQUIRE(after->levels.size() == 4);
@@ -1584,6 +1594,8 @@ TEST_CASE("coarse to fine: with lookahead_drop_stuck a chain stuck inside lookah
   const CoarseToFineResult r = dropping.run({}, &saved[0]);
   REQUIRE(r.levels.size() == 5);
   CHECK(std::isnan(r.levels[3].lookahead_other_energy));
+  CHECK(r.levels[3].lookahead_other_stuck);
+  CHECK_FALSE(plain.levels[3].lookahead_other_stuck);
   CHECK_FALSE(r.levels[3].lookahead_switched);
   for (int l : {3, 4}) {
     CHECK(r.levels[l].gamma == plain.levels[l].gamma);
@@ -1598,6 +1610,7 @@ TEST_CASE("coarse to fine: with lookahead_drop_stuck a chain stuck inside lookah
   const CoarseToFineResult s = dropping.run({}, &swapped);
   REQUIRE(s.levels.size() == 5);
   CHECK(std::isnan(s.levels[3].lookahead_other_energy));
+  CHECK(s.levels[3].lookahead_other_stuck);
   CHECK(s.levels[3].gamma == plain.levels[3].gamma);
   CHECK(s.rounding.energy == doctest::Approx(plain.rounding.energy).epsilon(1e-12));
 
@@ -1605,12 +1618,16 @@ TEST_CASE("coarse to fine: with lookahead_drop_stuck a chain stuck inside lookah
   // it at any ring), the stuck chain solves level 4 again without dropping: widened, as without
   // lookahead_drop_stuck, to the Γ that was the other energy above.
   // (Stopped after level 4: the finest level, rounded once per LP, then widens for a minute.)
+  // Each chain, alone at level 4 once the other has dropped out, saves its attempts as the only
+  // chain.
   LevelCheckpoint broken = swapped;
   broken.chains[1].pending.back().gamma.resize(1);
   struct Stop {};
   std::optional<LevelCheckpoint> after;
+  std::vector<LevelCheckpoint> alone;
   CHECK_THROWS_AS(dropping.run({}, &broken,
                                [&](const LevelCheckpoint& c) {
+                                 if (c.done() == 3 && !c.in_progress().empty()) alone.push_back(c);
                                  if (c.done() < 4 || !c.in_progress().empty()) return;
                                  after = c;
                                  throw Stop{};
@@ -1623,4 +1640,27 @@ TEST_CASE("coarse to fine: with lookahead_drop_stuck a chain stuck inside lookah
   CHECK(a.energy == doctest::Approx(d.lookahead_other_energy).epsilon(1e-12));
   CHECK(a.lookahead_switched);  // the chain that did not lead at level 2
   CHECK(std::isnan(a.lookahead_other_energy));
+  CHECK_FALSE(a.lookahead_other_stuck);  // (it was the one stuck; the other found no Γ)
+  // (The first chain's attempts before it dropped out: both chains, the attempt on the first.)
+  const auto single = std::find_if(alone.begin(), alone.end(), [](const LevelCheckpoint& c) { return c.chains.empty(); });
+  REQUIRE(single != alone.end());
+  for (auto c = alone.begin(); c != single; ++c) CHECK_FALSE(c->chains[0].attempt.empty());
+  for (auto c = single; c != alone.end(); ++c) {
+    CHECK(c->chains.empty());
+    CHECK(c->levels.size() == 3);
+    CHECK(c->attempt.report.level == 3);
+  }
+  // The last: the stuck chain's widened attempt, gone on from, ends level 4 as above.
+  CHECK(alone.back().levels[2].gamma == swapped.chains[0].pending.back().gamma);
+  std::optional<LevelCheckpoint> again;
+  CHECK_THROWS_AS(dropping.run({}, &alone.back(),
+                               [&](const LevelCheckpoint& c) {
+                                 if (c.done() < 4 || !c.in_progress().empty()) return;
+                                 again = c;
+                                 throw Stop{};
+                               }),
+                  Stop);
+  REQUIRE(again);
+  CHECK(again->levels[3].gamma == a.gamma);
+  CHECK(again->levels[3].energy == doctest::Approx(a.energy).epsilon(1e-12));
 }

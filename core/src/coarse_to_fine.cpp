@@ -569,18 +569,22 @@ CoarseToFineResult CoarseToFineMatcher::run(const Progress& progress, const Leve
     std::vector<Chain> next;
     std::exception_ptr failure;
     bool stuck = false;  // the last chain that dropped out was stuck
-    // Chain i at this level; false where it found no Γ (or, with `may_drop`, got stuck) and
-    // drops out.
-    auto solve_chain = [&](size_t i, const ChainRules& rules) {
+    // Chain i at this level; false where it found no Γ (or, by `rules`, got stuck or could not
+    // win) and drops out. `alone`: the other chain has dropped out at this level.
+    auto solve_chain = [&](size_t i, const ChainRules& rules, bool alone) {
       Chain& c = chains[i];
       // Each attempt of a level after the first is a checkpoint: of the level, or inside
-      // lookahead of both chains, those before this one having done the level (not where one of
-      // them dropped out at it: no file holds that state).
+      // lookahead of both chains, those before this one having done the level. A chain alone at
+      // the level saves itself as the only chain, its levels since the split as levels (a run
+      // gone on from that has no other chain to fall back on).
       std::function<void(const LevelAttempt&)> attempted;
       if (checkpoint)
-        attempted = [&, i](const LevelAttempt& a) {
-          if (chains.size() == 1) return checkpoint(LevelCheckpoint{fingerprint(), result.levels, c.widened, a});
-          if (next.size() != i) return;
+        attempted = [&, i, alone](const LevelAttempt& a) {
+          if (chains.size() == 1 || alone) {
+            LevelCheckpoint single{fingerprint(), result.levels, c.widened, a};
+            single.levels.insert(single.levels.end(), c.pending.begin(), c.pending.end());
+            return checkpoint(single);
+          }
           save_chains(i == 0 ? chains[0] : next[0], chains[1], &c, a);
         };
       const LevelAttempt* attempt = l == start && !c.resume.empty() ? &c.resume : nullptr;
@@ -590,7 +594,7 @@ CoarseToFineResult CoarseToFineMatcher::run(const Progress& progress, const Leve
       } catch (const Outmatched& o) {
         LevelReport& kept = next.front().pending.back();
         spdlog::info("level {}: the second lookahead chain's LP bound {:.6g} is at or above the first chain's energy "
-                     "{:.6g}: it cannot win, and drops out",
+                     "{:.6g}: no Γ of its space can win, and it drops out",
                      l + 1, o.bound, kept.energy);
         kept.lookahead_other_bound = o.bound;
         stuck = false;
@@ -613,7 +617,8 @@ CoarseToFineResult CoarseToFineMatcher::run(const Progress& progress, const Leve
       c.pending.push_back(rep);
       next.push_back(std::move(c));
       // Inside lookahead, the first chain done: a checkpoint before the second starts the level.
-      if (checkpoint && i == 0 && chains.size() == 2 && next.size() == 1) save_chains(next[0], chains[1], nullptr, {});
+      if (checkpoint && i == 0 && chains.size() == 2 && next.size() == 1 && !alone)
+        save_chains(next[0], chains[1], nullptr, {});
       return true;
     };
     // lookahead_drop_stuck: the first chain may drop out when stuck (the second, or the first
@@ -631,12 +636,15 @@ CoarseToFineResult CoarseToFineMatcher::run(const Progress& progress, const Leve
       // The second chain at the deciding level, the first having its Γ there.
       if (options_.lookahead_bound_drop && chains.size() == 2 && i == 1 && next.size() == 1 && l == decide_at)
         rules.beat = next.front().pending.back().energy;
-      if (!solve_chain(i, rules) && rules.drop_when_stuck && stuck) stuck_dropped = i;
+      const bool alone = chains.size() == 2 && i == 1 && next.empty();
+      if (!solve_chain(i, rules, alone) && rules.drop_when_stuck && stuck) stuck_dropped = i;
     }
     if (next.empty() && stuck_dropped == 0) {
       spdlog::warn("level {}: neither lookahead chain found a Γ; the first, dropped out when stuck, solves the "
                    "level again without dropping", l + 1);
-      solve_chain(0, {});
+      solve_chain(0, {}, true);
+    } else if (stuck_dropped < chains.size() && next.size() == 1) {
+      next.front().pending.back().lookahead_other_stuck = true;
     }
     if (second_start) {
       Chain s;
@@ -1286,8 +1294,8 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
           ro.decided = [inner = std::move(ro.decided), beat = rules.beat](const RoundingRound& r,
                                                                           const std::vector<int64_t>& ones,
                                                                           double bound) {
+            if (r.round == 1 && bound >= beat) throw Outmatched{bound};  // (before a checkpoint of it)
             if (inner) inner(r, ones, bound);
-            if (r.round == 1 && bound >= beat) throw Outmatched{bound};
           };
         }
       }

@@ -1518,6 +1518,7 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
   for (double t : options.alternative_thresholds) {
     if (std::any_of(best.tried.begin(), best.tried.end(), [&](const auto& p) { return p.first == t; })) continue;
     RoundingOptions alt = options;
+    alt.decided = {};  // (the caller follows the main rounding, whose Γ this one only competes with)
     alt.threshold = t;
     alt.alternative_thresholds.clear();
     alt.first_iterate = {};

@@ -251,15 +251,17 @@ struct CoarseToFineOptions {
   // second level by its energy.
   int lookahead_levels = 2;
   // Inside lookahead, a chain whose rounding at a level gets stuck (stuck_after) drops out there
-  // instead of widening and solving the level again, while the other chain goes on: it is an
+  // instead of restarting (stuck_restarts) or widening and solving the level again, while the
+  // other chain goes on (its report there has lookahead_other_stuck): it is an
   // alternative, not the only Γ. Where the other chain then finds no Γ at that level either, the
   // dropped one solves the level again as usual. Why: FAUST_r 016-026 with WKS at μ = 10 (45th
   // session) spent 2 h 24 min in level 4's first chain, stuck and widened three times (2.9 M to
   // 4.7 M variables, 5-11 min per first LP on one core), and did not finish.
   bool lookahead_drop_stuck = false;
   // At the level where lookahead decides, the chain that solves it second stops after the first
-  // LP of an attempt whose certified bound is at or above the first chain's energy there: no Γ
-  // in that attempt's space could win the decision (ties keep the first), and its rounding would
+  // LP of an attempt (not a carried one, stuck_carry) whose certified bound is at or above the
+  // first chain's energy there: no Γ in that attempt's space could win the decision (ties keep
+  // the first), and its rounding would
   // be spent for nothing. Why: FAUST_r 016-026 at μ = 10, level 4: the first chain's Γ had
   // energy 2.916 in 2 minutes; the second chain's LP bound was 4.05, and its rounding ran for over
   // two hours (stuck, widened three times). Not a bound over a space widened later (the
@@ -336,6 +338,8 @@ struct LevelReport {
   // above this chain's energy (CoarseToFineOptions::lookahead_bound_drop): that bound (NaN
   // elsewhere; lookahead_other_energy is then NaN).
   double lookahead_other_bound = std::numeric_limits<double>::quiet_NaN();
+  // At the level where a lookahead chain dropped out stuck (lookahead_drop_stuck), the other's.
+  bool lookahead_other_stuck = false;
   // The level's Γ, the one that went on (on the level's meshes, x_levels()/y_levels()): match
   // writes a vertex map per level from it, so that eval can say at which level an error arose.
   std::vector<ProductTriangle> gamma;
