@@ -44,6 +44,21 @@ CoarseToFineOptions small_levels() {
   return o;
 }
 
+// Two dolphins whose lookahead chains still differ at the second level (five levels under
+// small_levels(); on the finger pair both chains find the same Γ there and go on as one).
+Mesh lookahead_dolphin_x() { return decimate(shapes::dolphin(20, 0), 80); }
+Mesh lookahead_dolphin_y() { return decimate(shapes::dolphin(-20, 40), 90); }
+
+// small_levels() with both chains refined to level 4's decision and both rounded there (the
+// second chain's LP bound there is above the first chain's energy: lookahead_bound_drop would
+// stop it after its first LP).
+CoarseToFineOptions both_chains_to_level_4() {
+  CoarseToFineOptions o = small_levels();
+  o.lookahead_levels = 2;
+  o.lookahead_bound_drop = false;
+  return o;
+}
+
 // The finger straight and bent, decimated to different triangulations.
 CoarseToFineMatcher finger_matcher(const CoarseToFineOptions& o) {
   return CoarseToFineMatcher(decimate(shapes::bent_finger(10, 8, 8), 80), decimate(shapes::bent_finger(60, 8, 8), 90), o);
@@ -635,7 +650,7 @@ TEST_CASE("coarse to fine: the second start solves the second level twice and ke
 TEST_CASE("coarse to fine: lookahead refines both Γ of the second level and keeps the lower energy further up") {
   // Two dolphins, whose chains still differ at the second level (on the finger pair both found
   // the same Γ there and went on as one).
-  const Mesh dx = decimate(shapes::dolphin(20, 0), 80), dy = decimate(shapes::dolphin(-20, 40), 90);
+  const Mesh dx = lookahead_dolphin_x(), dy = lookahead_dolphin_y();
   auto dolphin_matcher = [&](const CoarseToFineOptions& options) { return CoarseToFineMatcher(dx, dy, options); };
   CoarseToFineOptions o = small_levels();
   o.lookahead_levels = 0;
@@ -678,12 +693,10 @@ TEST_CASE("coarse to fine: lookahead refines both Γ of the second level and kee
 TEST_CASE("coarse to fine: at the deciding level a second chain whose first LP cannot win drops out after it") {
   // The dolphins of the lookahead test: at level 4, where lookahead decides, the first chain's
   // energy is below the second chain's first LP bound. A checkpoint after every round.
-  const Mesh dx = decimate(shapes::dolphin(20, 0), 80), dy = decimate(shapes::dolphin(-20, 40), 90);
-  CoarseToFineOptions o = small_levels();
-  o.lookahead_levels = 2;
+  const Mesh dx = lookahead_dolphin_x(), dy = lookahead_dolphin_y();
+  CoarseToFineOptions o = both_chains_to_level_4();
   o.rounding.alternative_thresholds = {};  // (with them a level's rounding is not saved)
   o.rounding_checkpoint_seconds = 0.0;
-  o.lookahead_bound_drop = false;
   const CoarseToFineMatcher both(dx, dy, o);
   std::vector<LevelCheckpoint> inside;  // inside the second chain's rounding of level 4
   const CoarseToFineResult whole = both.run({}, nullptr, [&](const LevelCheckpoint& c) {
@@ -771,10 +784,8 @@ TEST_CASE("coarse to fine: two lookahead chains that reach the same Γ go on as 
 
 TEST_CASE("coarse to fine: a run gone on from a checkpoint inside lookahead ends as the whole run") {
   // The dolphins of the lookahead test: both chains go on from level 2 to level 4's decision.
-  const Mesh dx = decimate(shapes::dolphin(20, 0), 80), dy = decimate(shapes::dolphin(-20, 40), 90);
-  CoarseToFineOptions o = small_levels();
-  o.lookahead_levels = 2;
-  o.lookahead_bound_drop = false;  // (level 4's second chain, bound above the first's energy, rounds too)
+  const Mesh dx = lookahead_dolphin_x(), dy = lookahead_dolphin_y();
+  CoarseToFineOptions o = both_chains_to_level_4();
   const CoarseToFineMatcher matcher(dx, dy, o);
   REQUIRE(matcher.x_levels().size() == 5);
   std::vector<LevelCheckpoint> saved;
@@ -861,10 +872,8 @@ TEST_CASE("coarse to fine: a run gone on from a checkpoint inside lookahead ends
 
 TEST_CASE("coarse to fine: a run gone on from inside a level of lookahead goes on in the chain that was at it") {
   // The dolphins of the lookahead test, with a checkpoint after every round of every rounding.
-  const Mesh dx = decimate(shapes::dolphin(20, 0), 80), dy = decimate(shapes::dolphin(-20, 40), 90);
-  CoarseToFineOptions o = small_levels();
-  o.lookahead_levels = 2;
-  o.lookahead_bound_drop = false;  // (level 4's second chain, bound above the first's energy, rounds too)
+  const Mesh dx = lookahead_dolphin_x(), dy = lookahead_dolphin_y();
+  CoarseToFineOptions o = both_chains_to_level_4();
   o.rounding.alternative_thresholds = {};  // (with them a level's rounding is not saved)
   o.rounding_checkpoint_seconds = 0.0;
   const CoarseToFineMatcher matcher(dx, dy, o);
@@ -1568,10 +1577,8 @@ TEST_CASE("coarse to fine: with lookahead_drop_stuck a chain stuck inside lookah
   // The dolphins of the lookahead test, gone on from after level 3 (both chains, decided at 4)
   // with one round per level: there the second chain's rounding cannot finish (stuck: out of
   // rounds) and, without dropping, widens and solves level 4 again; the first's finishes.
-  const Mesh dx = decimate(shapes::dolphin(20, 0), 80), dy = decimate(shapes::dolphin(-20, 40), 90);
-  CoarseToFineOptions o = small_levels();
-  o.lookahead_levels = 2;
-  o.lookahead_bound_drop = false;  // (level 4's second chain, bound above the first's energy, rounds too)
+  const Mesh dx = lookahead_dolphin_x(), dy = lookahead_dolphin_y();
+  CoarseToFineOptions o = both_chains_to_level_4();
   const CoarseToFineMatcher matcher(dx, dy, o);
   std::vector<LevelCheckpoint> saved;
   matcher.run({}, nullptr, [&](const LevelCheckpoint& c) {
