@@ -568,9 +568,9 @@ CoarseToFineResult CoarseToFineMatcher::run(const Progress& progress, const Leve
     const bool second_start = l == 1 && second_level_;
     std::vector<Chain> next;
     std::exception_ptr failure;
-    bool stuck = false;  // the last chain that dropped out was stuck
-    // Chain i at this level; false where it found no Γ (or, by `rules`, got stuck or could not
-    // win) and drops out. `alone`: the other chain has dropped out at this level.
+    // Chain i at this level: it found a Γ, or dropped out (no Γ, or by `rules` it could not win),
+    // or dropped out with its rounding stuck. `alone`: the other chain has dropped out here.
+    enum class ChainEnd { found, dropped, stuck };
     auto solve_chain = [&](size_t i, const ChainRules& rules, bool alone) {
       Chain& c = chains[i];
       // Each attempt of a level after the first is a checkpoint: of the level, or inside
@@ -597,11 +597,10 @@ CoarseToFineResult CoarseToFineMatcher::run(const Progress& progress, const Leve
                      "{:.6g}: no Γ of its space can win, and it drops out",
                      l + 1, o.bound, kept.energy);
         kept.lookahead_other_bound = o.bound;
-        stuck = false;
-        return false;
+        return ChainEnd::dropped;
       } catch (const InfeasibleError& e) {
         if (!second_start && chains.size() == 1) throw;
-        stuck = dynamic_cast<const StuckError*>(&e) != nullptr;
+        const bool stuck = dynamic_cast<const StuckError*>(&e) != nullptr;
         if (rules.drop_when_stuck && stuck)
           spdlog::warn("level {}: the {} lookahead chain drops out, its rounding stuck ({})", l + 1,
                        i == 0 ? "first" : "second", e.what());
@@ -609,7 +608,7 @@ CoarseToFineResult CoarseToFineMatcher::run(const Progress& progress, const Leve
           spdlog::warn("level {}: no Γ in the refined space ({}); {}", l + 1, e.what(),
                        second_start ? "trying the full space" : "that chain drops out");
         failure = std::current_exception();
-        return false;
+        return stuck ? ChainEnd::stuck : ChainEnd::dropped;
       }
       // Its own time so far: a run gone on from inside this level adds its own to it.
       rep.seconds = clock.seconds();
@@ -619,7 +618,7 @@ CoarseToFineResult CoarseToFineMatcher::run(const Progress& progress, const Leve
       // Inside lookahead, the first chain done: a checkpoint before the second starts the level.
       if (checkpoint && i == 0 && chains.size() == 2 && next.size() == 1 && !alone)
         save_chains(next[0], chains[1], nullptr, {});
-      return true;
+      return ChainEnd::found;
     };
     // lookahead_drop_stuck: the first chain may drop out when stuck (the second, or the first
     // again without dropping, still finds a Γ), the second only where the first has one.
@@ -637,7 +636,7 @@ CoarseToFineResult CoarseToFineMatcher::run(const Progress& progress, const Leve
       if (options_.lookahead_bound_drop && chains.size() == 2 && i == 1 && next.size() == 1 && l == decide_at)
         rules.beat = next.front().pending.back().energy;
       const bool alone = chains.size() == 2 && i == 1 && next.empty();
-      if (!solve_chain(i, rules, alone) && rules.drop_when_stuck && stuck) stuck_dropped = i;
+      if (solve_chain(i, rules, alone) == ChainEnd::stuck && rules.drop_when_stuck) stuck_dropped = i;
     }
     if (next.empty() && stuck_dropped == 0) {
       spdlog::warn("level {}: neither lookahead chain found a Γ; the first, dropped out when stuck, solves the "
