@@ -1,3 +1,4 @@
+#include "pinches.hpp"
 #include "test_helpers.hpp"
 
 #include "shapematch/constraints.hpp"
@@ -7,6 +8,10 @@
 #include "shapematch/rounding.hpp"
 
 #include <doctest/doctest.h>
+
+#include <algorithm>
+#include <map>
+#include <set>
 
 using namespace shapematch;
 
@@ -230,6 +235,93 @@ TEST_CASE("point map: untangling never collapses a map") {
   CHECK(after.flips > 0);
   CHECK(after.flips <= before.flips);
   CHECK(after.degenerate <= before.degenerate);
+}
+
+namespace {
+
+// A flat grid of w × h vertices, (i, j) at index j·w + i, each cell split along (i, j)-(i+1, j+1).
+// Open, so built by hand (make_mesh wants closed meshes).
+Mesh grid_mesh(int w, int h) {
+  Mesh m;
+  for (int j = 0; j < h; ++j)
+    for (int i = 0; i < w; ++i) m.vertices.emplace_back(i, j, 0.0);
+  for (int j = 0; j + 1 < h; ++j)
+    for (int i = 0; i + 1 < w; ++i) {
+      const int v00 = j * w + i, v10 = v00 + 1, v01 = v00 + w, v11 = v01 + 1;
+      m.faces.push_back({v00, v10, v11});
+      m.faces.push_back({v00, v11, v01});
+    }
+  return m;
+}
+
+struct RegionShape {
+  int euler = 0;         // V - E + F
+  int rims = 0;          // closed rim loops followed edge to edge
+  bool pinched = false;  // a vertex with two rim edges leaving it
+};
+
+// Counted from the faces alone, independently of close_pinches.
+RegionShape region_shape(const Mesh& m, const std::vector<int>& faces) {
+  std::set<std::pair<int, int>> directed;
+  std::set<int> verts;
+  for (int f : faces)
+    for (int i = 0; i < 3; ++i) {
+      directed.insert({m.faces[f][i], m.faces[f][(i + 1) % 3]});
+      verts.insert(m.faces[f][i]);
+    }
+  std::map<int, std::vector<int>> next;
+  int edges = 0;
+  for (const auto& [u, w] : directed) {
+    if (!directed.count({w, u})) {
+      next[u].push_back(w);
+      ++edges;
+    } else if (u < w) {
+      ++edges;
+    }
+  }
+  RegionShape shape;
+  shape.euler = static_cast<int>(verts.size()) - edges + static_cast<int>(faces.size());
+  for (const auto& [u, heads] : next) shape.pinched = shape.pinched || heads.size() > 1;
+  if (shape.pinched) return shape;
+  std::set<int> seen;
+  for (const auto& [start, heads] : next) {
+    if (seen.count(start)) continue;
+    ++shape.rims;
+    for (int v = start; seen.insert(v).second;) v = next.at(v).front();
+  }
+  return shape;
+}
+
+}  // namespace
+
+TEST_CASE("point map: a chart region pinched at a vertex is closed into a disc") {
+  const Mesh m = grid_mesh(7, 5);
+  const auto vf = vertex_face_table(m);
+  auto at = [](int i, int j) { return j * 7 + i; };
+  // The stars of (1, 2) and (3, 2) share the vertex (2, 2) and no face: their union's rim passes
+  // through (2, 2) twice.
+  std::vector<int> region = vf[at(1, 2)];
+  region.insert(region.end(), vf[at(3, 2)].begin(), vf[at(3, 2)].end());
+  REQUIRE(region_shape(m, region).pinched);
+
+  std::vector<int> stopped = region;
+  CHECK_FALSE(close_pinches(m, vf, stopped, 0));  // no step allowed: still pinched
+  CHECK(region_shape(m, stopped).pinched);
+
+  CHECK(close_pinches(m, vf, region));
+  const RegionShape shape = region_shape(m, region);
+  CHECK_FALSE(shape.pinched);
+  CHECK(shape.euler == 1);
+  CHECK(shape.rims == 1);
+  for (int f : vf[at(2, 2)]) CHECK(std::binary_search(region.begin(), region.end(), f));
+  CHECK(region.size() == 6 + 6 + 2);  // the middle star adds the two faces above and below (2, 2)
+
+  // A disc is left as it is.
+  std::vector<int> disc = vf[at(3, 2)];
+  std::vector<int> sorted = disc;
+  std::sort(sorted.begin(), sorted.end());
+  CHECK(close_pinches(m, vf, disc));
+  CHECK(disc == sorted);
 }
 
 TEST_CASE("point map: text round trip, and one clear line for a bad file") {
