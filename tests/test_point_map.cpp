@@ -260,7 +260,7 @@ struct RegionShape {
   bool pinched = false;  // a vertex with two rim edges leaving it
 };
 
-// Counted from the faces alone, independently of close_pinches.
+// Counted from the faces alone (the Euler number and the rims by another route than close_pinches).
 RegionShape region_shape(const Mesh& m, const std::vector<int>& faces) {
   std::set<std::pair<int, int>> directed;
   std::set<int> verts;
@@ -305,10 +305,10 @@ TEST_CASE("point map: a chart region pinched at a vertex is closed into a disc")
   REQUIRE(region_shape(m, region).pinched);
 
   std::vector<int> stopped = region;
-  CHECK_FALSE(close_pinches(m, vf, stopped, 0));  // no step allowed: still pinched
+  CHECK_FALSE(detail::close_pinches(m, vf, stopped, 0));  // no step allowed: still pinched
   CHECK(region_shape(m, stopped).pinched);
 
-  CHECK(close_pinches(m, vf, region));
+  CHECK(detail::close_pinches(m, vf, region));
   const RegionShape shape = region_shape(m, region);
   CHECK_FALSE(shape.pinched);
   CHECK(shape.euler == 1);
@@ -320,7 +320,7 @@ TEST_CASE("point map: a chart region pinched at a vertex is closed into a disc")
   std::vector<int> disc = vf[at(3, 2)];
   std::vector<int> sorted = disc;
   std::sort(sorted.begin(), sorted.end());
-  CHECK(close_pinches(m, vf, disc));
+  CHECK(detail::close_pinches(m, vf, disc));
   CHECK(disc == sorted);
 }
 

@@ -3,17 +3,19 @@
 #include "shapematch/mesh.hpp"
 
 #include <algorithm>
+#include <cstddef>
 #include <cstdint>
 #include <unordered_map>
 #include <vector>
 
-namespace shapematch {
+namespace shapematch::detail {
 
 // Adds to `faces` (sorted, unique on return) the star of every vertex where the region's rim
 // touches itself: two rim arcs through one vertex make it no disc, and a rim that cannot be
 // followed edge to edge hides the region's holes. The faces within a few rings of scattered
-// points are often pinched so. Stops after `max_steps` rounds or past twice the region's size;
-// returns whether no rim vertex is pinched.
+// points are often pinched so. Stops after `max_steps` rounds or once past twice the region's
+// size; returns whether no rim vertex is pinched (where not, `faces` stays grown: the caller's
+// disc test refuses it).
 inline bool close_pinches(const Mesh& mesh, const std::vector<std::vector<int>>& vertex_faces, std::vector<int>& faces,
                           int max_steps = 4) {
   auto sort_unique = [&faces] {
@@ -42,4 +44,4 @@ inline bool close_pinches(const Mesh& mesh, const std::vector<std::vector<int>>&
   }
 }
 
-}  // namespace shapematch
+}  // namespace shapematch::detail

@@ -288,7 +288,7 @@ private:
     bool laid_out = false;
     for (int grow = 2; grow >= 1 && !laid_out; --grow) {
       region = ring_faces(to_, to_faces_, supports, grow);
-      close_pinches(to_, to_faces_, region);
+      detail::close_pinches(to_, to_faces_, region);
       fill_holes(region);
       std::vector<int> near;
       for (int f : region) near.insert(near.end(), to_.faces[f].begin(), to_.faces[f].end());
