@@ -324,6 +324,37 @@ TEST_CASE("point map: a chart region pinched at a vertex is closed into a disc")
   CHECK(disc == sorted);
 }
 
+TEST_CASE("point map: a region's rim and inner edges") {
+  const Mesh m = grid_mesh(4, 3);  // 12 vertices, 12 faces, 23 edges of which 10 on the border
+  std::vector<int> all(m.num_faces());
+  for (int f = 0; f < m.num_faces(); ++f) all[f] = f;
+  const detail::RegionRim rim = detail::region_rim(m, all);
+  CHECK_FALSE(rim.repeated);
+  CHECK(rim.edges.size() == 10);
+  CHECK(rim.inner_edges == 13);
+  CHECK(std::is_sorted(rim.edges.begin(), rim.edges.end()));
+  // Every rim edge runs along the grid's border, in the direction a face holds it.
+  auto held = [&m](int u, int w) {
+    for (const auto& t : m.faces)
+      for (int i = 0; i < 3; ++i)
+        if (t[i] == u && t[(i + 1) % 3] == w) return true;
+    return false;
+  };
+  auto on_border = [](int v) { return v % 4 == 0 || v % 4 == 3 || v / 4 == 0 || v / 4 == 2; };
+  for (const auto& [u, w] : rim.edges) {
+    CHECK(held(u, w));
+    CHECK_FALSE(held(w, u));
+    CHECK((on_border(u) && on_border(w)));
+  }
+  // Two neighbouring faces: one inner edge, a rim of four.
+  const detail::RegionRim pair = detail::region_rim(m, {0, 1});
+  CHECK(pair.edges.size() == 4);
+  CHECK(pair.inner_edges == 1);
+  // A face listed twice is no oriented patch.
+  CHECK(detail::region_rim(m, {0, 1, 0}).repeated);
+  CHECK(detail::region_rim(m, {}).edges.empty());
+}
+
 TEST_CASE("point map: text round trip, and one clear line for a bad file") {
   const Mesh m = shapes::octahedron();
   const std::vector<SurfacePoint> map{{0, {1, 0, 0}}, {3, {0.25, 0.5, 0.25}}, {7, {0.1, 0.2, 0.7}}};

@@ -488,20 +488,13 @@ private:
   // Adds to `faces` (sorted) what its rims other than the longest enclose: the parts of `to` the
   // images skipped. Leaves `faces` as it was when a rim does not close or encloses too much.
   void fill_holes(std::vector<int>& faces) const {
-    std::unordered_map<int, int> next;
-    {
-      std::unordered_map<int64_t, int> directed;
-      const int64_t n = to_.num_vertices();
-      for (int f : faces)
-        for (int i = 0; i < 3; ++i) ++directed[int64_t(to_.faces[f][i]) * n + to_.faces[f][(i + 1) % 3]];
-      for (const auto& [key, count] : directed) {
-        const int u = static_cast<int>(key / n), w = static_cast<int>(key % n);
-        if (!directed.count(int64_t(w) * n + u) && !next.emplace(u, w).second) return;  // pinched
-      }
-    }
+    const auto rim_edges = detail::region_rim(to_, faces).edges;
+    std::unordered_map<int, int> next;  // rim: tail -> head
+    for (const auto& [u, w] : rim_edges)
+      if (!next.emplace(u, w).second) return;  // pinched
     std::vector<std::vector<int>> rims;
     std::unordered_map<int, int> seen;
-    for (const auto& [start, head] : next) {
+    for (const auto& [start, head] : rim_edges) {
       if (seen.count(start)) continue;
       std::vector<int> rim{start};
       seen[start] = 1;
@@ -554,25 +547,14 @@ private:
   // a disc.
   bool lay_out_disc(const std::vector<int>& faces, const std::vector<int>& verts,
                     std::unordered_map<int, Eigen::Vector2d>& chart) const {
-    std::unordered_map<int64_t, int> directed;  // directed edge -> count
-    const int64_t n = to_.num_vertices();
-    for (int f : faces)
-      for (int i = 0; i < 3; ++i) ++directed[int64_t(to_.faces[f][i]) * n + to_.faces[f][(i + 1) % 3]];
+    const auto region = detail::region_rim(to_, faces);
+    if (region.repeated || region.edges.empty()) return false;
     std::unordered_map<int, int> next;  // rim: tail -> head of the edges with no twin inside
-    int64_t edges = 0;
-    for (const auto& [key, count] : directed) {
-      const int u = static_cast<int>(key / n), w = static_cast<int>(key % n);
-      if (count != 1) return false;
-      if (!directed.count(int64_t(w) * n + u)) {
-        if (!next.emplace(u, w).second) return false;  // pinched rim
-        ++edges;
-      } else if (u < w) {
-        ++edges;
-      }
-    }
-    if (next.empty() || static_cast<int64_t>(verts.size()) - edges + static_cast<int64_t>(faces.size()) != 1)
-      return false;
-    std::vector<int> rim{next.begin()->first};
+    for (const auto& [u, w] : region.edges)
+      if (!next.emplace(u, w).second) return false;  // pinched rim
+    const int64_t edges = static_cast<int64_t>(region.edges.size()) + region.inner_edges;
+    if (static_cast<int64_t>(verts.size()) - edges + static_cast<int64_t>(faces.size()) != 1) return false;
+    std::vector<int> rim{region.edges.front().first};
     while (true) {
       const auto at = next.find(rim.back());
       if (at == next.end()) return false;
