@@ -282,6 +282,7 @@ TEST_CASE("cli: match --checkpoint goes on after the levels a stopped run finish
   CHECK(json_number(first, "resumed_after_level") == 0);
   CHECK(json_number(first, "rounding_checkpoint_seconds") == 2.5);  // echoed with the options
   CHECK(json_number(first, "suspicion_rings") == 2);                // the default
+  CHECK(json_number(first, "max_suspected_widenings") == 1);        // the default
   CHECK(first.find("\"stuck_restarts\": 1") != std::string::npos);
   CHECK(first.find("\"stuck_restarts\": 0") != std::string::npos);  // per level
   r = run("match " + dolphin + " " + swimming + " --stuck-restarts -1 -o " + (tmp.path / "d").string());

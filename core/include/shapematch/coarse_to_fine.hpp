@@ -111,8 +111,12 @@ struct CoarseToFineOptions {
   // stopped (a suspicion, no proof), the level's next first LPs run unwatched, to an optimum or a
   // proof. 0: no limit. Measured, TOSCA_r horse0-5 and centaur0-2 at R = 0.05 on an H200: 24
   // suspicions in a row each at their 1 414-face level (6.2 % → 21.6 % of the full space), and
-  // one such first LP, let run, was feasible (docs/results-log.md, thirty-fifth session).
-  int max_suspected_widenings = 3;
+  // one such first LP, let run, was feasible (docs/results-log.md, thirty-fifth session). 1 since
+  // the forty-ninth session: the local widenings of the second and third suspicions cured no
+  // measured LP (FAUST_r 029-063, TOSCA_r dog3-dog8 and centaur0-centaur2 at μ = 10), the region
+  // widening after them did; centaur0-centaur2's level 5 from level 4's checkpoint: 40:56 against
+  // 47:40 with 3, one watched LP against three, energy 3.96548 against 3.96513.
+  int max_suspected_widenings = 1;
   // Where max_suspected_widenings ends the watch, every X face within this many fine rings of the
   // faces widened so far at the level gets one more ring before the unwatched LP, each time. The
   // suspicions' own places (the window's dual growth) are narrow: measured, FAUST_r 029-063 at
