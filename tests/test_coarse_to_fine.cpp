@@ -1327,6 +1327,15 @@ TEST_CASE("coarse to fine: after N suspicions in a row the watch is off until a 
   s.distrust();  // nothing left to widen on a suspicion
   CHECK_FALSE(s.trusted());
 
+  detail::SuspicionCount one(1);  // the default: the first suspicion ends the trust
+  CHECK(one.suspicion());
+  CHECK_FALSE(one.trusted());
+  one.proof();
+  CHECK(one.trusted());
+  CHECK(one.suspicion());  // and so again after a proof
+  CHECK_FALSE(one.trusted());
+  CHECK(CoarseToFineOptions{}.max_suspected_widenings == 1);
+
   detail::SuspicionCount unlimited(0);
   for (int i = 0; i < 50; ++i) CHECK_FALSE(unlimited.suspicion());
   CHECK(unlimited.trusted());

@@ -1408,8 +1408,9 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
         if (e.certified()) {
           suspicions.proof();
         } else if (suspicions.suspicion()) {
-          spdlog::info("level {}: {} widenings in a row on a diverging PDHG, none proved: the next first LPs run "
-                       "unwatched", l + 1, suspicions.count());
+          spdlog::info("level {}: {} on a diverging PDHG, none proved: the next first LPs run unwatched", l + 1,
+                       suspicions.count() == 1 ? std::string("a widening")
+                                               : fmt::format("{} widenings in a row", suspicions.count()));
           // An unwatched LP costs what several watched ones do: give it room around every
           // suspicion first (CoarseToFineOptions::suspicion_rings says why).
           if (options_.suspicion_rings > 0 &&
