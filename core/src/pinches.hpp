@@ -39,6 +39,15 @@ inline RegionRim region_rim(const Mesh& mesh, const std::vector<int>& faces) {
   return rim;
 }
 
+// The rim as tail -> head, for walking it; false (and `next` partly filled) where a vertex has two
+// rim edges leaving it: a pinched rim cannot be followed edge to edge.
+inline bool rim_successors(const RegionRim& rim, std::unordered_map<int, int>& next) {
+  next.clear();
+  for (const auto& [u, w] : rim.edges)
+    if (!next.emplace(u, w).second) return false;
+  return true;
+}
+
 // Adds to `faces` (sorted, unique on return) the star of every vertex where the region's rim
 // touches itself: two rim arcs through one vertex make it no disc, and a rim that cannot be
 // followed edge to edge hides the region's holes. The faces within a few rings of scattered

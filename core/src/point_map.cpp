@@ -488,13 +488,12 @@ private:
   // Adds to `faces` (sorted) what its rims other than the longest enclose: the parts of `to` the
   // images skipped. Leaves `faces` as it was when a rim does not close or encloses too much.
   void fill_holes(std::vector<int>& faces) const {
-    const auto rim_edges = detail::region_rim(to_, faces).edges;
+    const auto region = detail::region_rim(to_, faces);
     std::unordered_map<int, int> next;  // rim: tail -> head
-    for (const auto& [u, w] : rim_edges)
-      if (!next.emplace(u, w).second) return;  // pinched
+    if (!detail::rim_successors(region, next)) return;  // pinched
     std::vector<std::vector<int>> rims;
     std::unordered_map<int, int> seen;
-    for (const auto& [start, head] : rim_edges) {
+    for (const auto& [start, head] : region.edges) {
       if (seen.count(start)) continue;
       std::vector<int> rim{start};
       seen[start] = 1;
@@ -550,8 +549,7 @@ private:
     const auto region = detail::region_rim(to_, faces);
     if (region.repeated || region.edges.empty()) return false;
     std::unordered_map<int, int> next;  // rim: tail -> head of the edges with no twin inside
-    for (const auto& [u, w] : region.edges)
-      if (!next.emplace(u, w).second) return false;  // pinched rim
+    if (!detail::rim_successors(region, next)) return false;  // pinched rim
     const int64_t edges = static_cast<int64_t>(region.edges.size()) + region.inner_edges;
     if (static_cast<int64_t>(verts.size()) - edges + static_cast<int64_t>(faces.size()) != 1) return false;
     std::vector<int> rim{region.edges.front().first};
