@@ -1,4 +1,5 @@
 #include "pinches.hpp"
+#include "untangle_layout.hpp"
 #include "test_helpers.hpp"
 
 #include "shapematch/constraints.hpp"
@@ -353,6 +354,87 @@ TEST_CASE("point map: a region's rim and inner edges") {
   // A face listed twice is no oriented patch.
   CHECK(detail::region_rim(m, {0, 1, 0}).repeated);
   CHECK(detail::region_rim(m, {}).edges.empty());
+}
+
+// Tutte's embedding folds where a disc's rim is concave: a 9 x 9 grid with a V cut 4 deep into
+// its top side, the inside where the grid had it, is folded over the cut; untangling opens it.
+TEST_CASE("point map: a layout folded over a concave rim is unfolded, the rim held") {
+  const Mesh m = grid_mesh(9, 9);
+  std::vector<std::array<int, 3>> triangles(m.faces.begin(), m.faces.end());
+  std::vector<Eigen::Vector2d> layout;
+  std::vector<char> free;
+  for (int v = 0; v < m.num_vertices(); ++v) {
+    const int i = v % 9, j = v / 9;
+    const bool rim = i == 0 || i == 8 || j == 0 || j == 8;
+    free.push_back(rim ? 0 : 1);
+    layout.emplace_back(i, j == 8 ? 8 - 4 * (1 - std::abs(i - 4) / 4.0) : j);
+  }
+  auto inverted = [&triangles](const std::vector<Eigen::Vector2d>& x) {
+    int count = 0;
+    for (const auto& t : triangles) {
+      const Eigen::Vector2d a = x[t[1]] - x[t[0]], b = x[t[2]] - x[t[0]];
+      count += a.x() * b.y() - a.y() * b.x() <= 0 ? 1 : 0;
+    }
+    return count;
+  };
+  const std::vector<Eigen::Vector2d> start = layout;
+  REQUIRE(inverted(start) > 0);
+  const detail::UntangleLayoutResult r = detail::untangle_layout(triangles, m.vertices, free, layout);
+  CHECK(r.inverted_before == inverted(start));
+  CHECK(r.inverted_after == 0);
+  CHECK(inverted(layout) == 0);
+  for (size_t v = 0; v < layout.size(); ++v)
+    if (!free[v]) CHECK(layout[v] == start[v]);
+  // Below the cut's reach the inside stays near the grid's (within half a cell).
+  for (size_t v = 0; v < layout.size(); ++v)
+    if (free[v] && v / 9 == 1) CHECK((layout[v] - start[v]).norm() < 0.5);
+
+  // A layout with nothing inverted is left as it is.
+  const std::vector<Eigen::Vector2d> open = layout;
+  const detail::UntangleLayoutResult again = detail::untangle_layout(triangles, m.vertices, free, layout);
+  CHECK(again.inverted_before == 0);
+  CHECK(again.rounds == 0);
+  CHECK(layout == open);
+
+  // A mirrored rim encloses no positive area: no layout is right, and nothing moves.
+  std::vector<Eigen::Vector2d> mirrored = start;
+  for (auto& x : mirrored) x.x() = -x.x();
+  const std::vector<Eigen::Vector2d> mirrored_start = mirrored;
+  const detail::UntangleLayoutResult none = detail::untangle_layout(triangles, m.vertices, free, mirrored);
+  CHECK(none.inverted_after == none.inverted_before);
+  CHECK(mirrored == mirrored_start);
+}
+
+// A disc whose rim's images are not convex: a 25 x 25 grid mapped onto itself by a squeeze that
+// pulls the middle column towards y = 0 (y -> y (1 - 0.6 exp(-(x - 12)^2 / 8)), no fold), except
+// the vertices within 2 of (12, 12), left where the grid has them: folded over the squeezed rim.
+// Tutte's embedding of such a rim folds, and its discs were refused (4 faces stayed inverted);
+// unfolded in the chart they are kept.
+TEST_CASE("point map: untangling a disc whose rim is not convex") {
+  constexpr int n = 25;
+  const Mesh m = grid_mesh(n, n);
+  // The point of the grid at (x, y): cell (i, j), then the half of it below or above its diagonal.
+  auto at = [](double x, double y) {
+    const int i = std::clamp(static_cast<int>(x), 0, n - 2), j = std::clamp(static_cast<int>(y), 0, n - 2);
+    const double u = x - i, w = y - j;
+    const int cell = 2 * (j * (n - 1) + i);
+    return u >= w ? SurfacePoint{cell, {1 - u, u - w, w}} : SurfacePoint{cell + 1, {1 - w, u, w - u}};
+  };
+  auto kept = [](int v) { return std::hypot(v % n - 12.0, v / n - 12.0) <= 2; };
+  std::vector<SurfacePoint> map;
+  for (int v = 0; v < m.num_vertices(); ++v) {
+    const double x = v % n, y = v / n;
+    map.push_back(at(x, kept(v) ? y : y * (1 - 0.6 * std::exp(-(x - 12) * (x - 12) / 8))));
+  }
+  for (int v = 0; v < m.num_vertices(); ++v)  // `at` puts a grid vertex where it is
+    if (kept(v)) REQUIRE(point_vertex(m, map[v]) == v);
+  const OrientationFlips before = count_orientation_flips(m, m, map);
+  REQUIRE(before.flips > 0);
+  std::vector<SurfacePoint> untangled = map;
+  CHECK(untangle_point_map(m, m, untangled, 4, 1.0) > 0);
+  const OrientationFlips after = count_orientation_flips(m, m, untangled);
+  CHECK(after.flips == 0);
+  CHECK(after.degenerate <= before.degenerate);
 }
 
 TEST_CASE("point map: text round trip, and one clear line for a bad file") {

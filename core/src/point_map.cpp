@@ -4,6 +4,7 @@
 #include "shapematch/hierarchy.hpp"
 
 #include "pinches.hpp"
+#include "untangle_layout.hpp"
 
 #include <Eigen/SparseLU>
 
@@ -329,7 +330,7 @@ private:
     a.setFromTriplets(entries.begin(), entries.end());
     Eigen::SparseLU<Eigen::SparseMatrix<double>> lu(a);
     if (lu.info() != Eigen::Success) return Disc::rejected;
-    const Eigen::MatrixXd u = lu.solve(rhs);
+    Eigen::MatrixXd u = lu.solve(rhs);
     if (lu.info() != Eigen::Success || !u.allFinite()) return Disc::rejected;
 
     // Back onto `to` through the chart's faces: the one q is deepest inside (ties at shared edges).
@@ -363,73 +364,117 @@ private:
       }
       return best >= -1e-9;
     };
-    std::vector<SurfacePoint> placed(m);
-    for (int i = 0; i < m; ++i)
-      if (!locate(u.row(i).transpose(), placed[i])) return Disc::rejected;
     std::vector<SurfacePoint> saved(m);
     for (int i = 0; i < m; ++i) saved[i] = p_[inside[i]];
-    auto put = [&](const std::vector<SurfacePoint>& points) {
-      for (int i = 0; i < m; ++i) p_[inside[i]] = points[i];
-    };
-    put(placed);
-    // Where the rim is concave, a face with two rim corners can fold over it: move the inside
-    // corners of inverted stars (back where they were, into their star's kernel in the chart, or
-    // nearby) while that unfolds their stars.
-    for (int sweep = 0; sweep < 5; ++sweep) {
-      bool changed = false;
-      for (int i = 0; i < m; ++i) {
-        const int v = inside[i];
-        std::pair<int, int> best = star_cost(v);
-        if (best.first == 0) continue;
-        std::vector<SurfacePoint> candidates{saved[i]};
-        near_points(p_[v], candidates);
-        if (SurfacePoint k; kernel_point(v, in_chart, chart_of, locate, k)) candidates.push_back(k);
-        const SurfacePoint current = p_[v];
-        SurfacePoint choice = current;
-        for (const SurfacePoint& q : candidates) {
-          p_[v] = q;
-          const std::pair<int, int> c = star_cost(v);
-          if (c < best) best = c, choice = q;
+    // Tutte's layout first; where that is refused and folds in the chart, unfolded (unfold).
+    auto settle = [&](const Eigen::MatrixXd& layout) {
+      std::vector<SurfacePoint> placed(m);
+      for (int i = 0; i < m; ++i)
+        if (!locate(layout.row(i).transpose(), placed[i])) return Disc::rejected;
+      auto put = [&](const std::vector<SurfacePoint>& points) {
+        for (int i = 0; i < m; ++i) p_[inside[i]] = points[i];
+      };
+      put(placed);
+      // Where the rim is concave, a face with two rim corners can fold over it: move the inside
+      // corners of inverted stars (back where they were, into their star's kernel in the chart, or
+      // nearby) while that unfolds their stars.
+      for (int sweep = 0; sweep < 5; ++sweep) {
+        bool changed = false;
+        for (int i = 0; i < m; ++i) {
+          const int v = inside[i];
+          std::pair<int, int> best = star_cost(v);
+          if (best.first == 0) continue;
+          std::vector<SurfacePoint> candidates{saved[i]};
+          near_points(p_[v], candidates);
+          if (SurfacePoint k; kernel_point(v, in_chart, chart_of, locate, k)) candidates.push_back(k);
+          const SurfacePoint current = p_[v];
+          SurfacePoint choice = current;
+          for (const SurfacePoint& q : candidates) {
+            p_[v] = q;
+            const std::pair<int, int> c = star_cost(v);
+            if (c < best) best = c, choice = q;
+          }
+          p_[v] = choice;
+          changed = changed || choice.face != current.face || choice.bary != current.bary;
         }
-        p_[v] = choice;
-        changed = changed || choice.face != current.face || choice.bary != current.bary;
+        if (!changed) break;
       }
-      if (!changed) break;
-    }
-    // Kept: fewer inverted and no more degenerate, or as many inverted and fewer degenerate (so a
-    // disc collapsed onto a curve never pays for an unfolded face).
-    // (Fewer degenerate alone counts only for small discs: a large one would move hundreds of
-    // points far from Γ for it.)
-    auto better = [&before, rings](const std::pair<int, int>& after) {
-      return (after.first < before.first && after.second <= before.second) ||
-             (rings <= 4 && after.first == before.first && after.second < before.second);
-    };
-    // A disc may move the points only so far in all: where Γ collapsed a whole part (a hand onto a
-    // curve), unfolding one face re-spreads hundreds of points far from their truth.
-    auto shift_ok = [&] {
-      double moved = 0;
-      for (int i = 0; i < m; ++i) moved += (point_position(to_, p_[inside[i]]) - point_position(to_, saved[i])).norm();
-      return moved <= shift_budget_;
-    };
-    if (!better(cost(faces))) {
+      // Kept: fewer inverted and no more degenerate, or as many inverted and fewer degenerate (so a
+      // disc collapsed onto a curve never pays for an unfolded face).
+      // (Fewer degenerate alone counts only for small discs: a large one would move hundreds of
+      // points far from Γ for it.)
+      auto better = [&before, rings](const std::pair<int, int>& after) {
+        return (after.first < before.first && after.second <= before.second) ||
+               (rings <= 4 && after.first == before.first && after.second < before.second);
+      };
+      // A disc may move the points only so far in all: where Γ collapsed a whole part (a hand onto a
+      // curve), unfolding one face re-spreads hundreds of points far from their truth.
+      auto shift_ok = [&] {
+        double moved = 0;
+        for (int i = 0; i < m; ++i) moved += (point_position(to_, p_[inside[i]]) - point_position(to_, saved[i])).norm();
+        return moved <= shift_budget_;
+      };
+      if (!better(cost(faces))) {
+        put(saved);
+        return Disc::rejected;
+      }
+      // Tutte's layout is needed only near the fold; elsewhere it moves points off where Γ put them
+      // (on FAUST_r, 24 rings of it nearly doubled the point map's error). So the inside goes back
+      // towards its old points wherever that inverts no more faces: first letting degenerate images
+      // come back too (Γ collapses faces where X is compressed), then, if that loses the disc, only
+      // where they do not.
+      std::vector<SurfacePoint> laid(m);
+      for (int i = 0; i < m; ++i) laid[i] = p_[inside[i]];
+      for (const bool strict : {false, true}) {
+        pull_back(inside, saved, strict, in_chart, chart_of, locate);
+        if (better(cost(faces)) && shift_ok()) return Disc::kept;
+        put(laid);
+      }
+      if (shift_ok()) return Disc::kept;
       put(saved);
       return Disc::rejected;
+    };
+    if (settle(u) == Disc::kept) return Disc::kept;
+    return unfold(faces, inside, index, chart_of, u) ? settle(u) : Disc::rejected;
+  }
+
+  // Tutte's layout `u` of the disc's inside folds where the rim's images are not convex (the
+  // forty-sixth and forty-ninth sessions' FAUST_r 016-020 and cat 0001-0005 flips): unfolded in
+  // the chart, the rim held.
+  template <class ChartOf>
+  bool unfold(const std::vector<int>& faces, const std::vector<int>& inside, const std::unordered_map<int, int>& index,
+              const ChartOf& chart_of, Eigen::MatrixXd& u) {
+    std::vector<Eigen::Vector2d> layout;
+    std::vector<Eigen::Vector3d> rest;
+    std::vector<char> free;
+    for (size_t i = 0; i < inside.size(); ++i) {
+      layout.push_back(u.row(static_cast<Eigen::Index>(i)).transpose());
+      rest.push_back(from_.vertices[inside[i]]);
+      free.push_back(1);
     }
-    // Tutte's layout is needed only near the fold; elsewhere it moves points off where Γ put them
-    // (on FAUST_r, 24 rings of it nearly doubled the point map's error). So the inside goes back
-    // towards its old points wherever that inverts no more faces: first letting degenerate images
-    // come back too (Γ collapses faces where X is compressed), then, if that loses the disc, only
-    // where they do not.
-    std::vector<SurfacePoint> laid(m);
-    for (int i = 0; i < m; ++i) laid[i] = p_[inside[i]];
-    for (const bool strict : {false, true}) {
-      pull_back(inside, saved, strict, in_chart, chart_of, locate);
-      if (better(cost(faces)) && shift_ok()) return Disc::kept;
-      put(laid);
+    std::unordered_map<int, int> rim;  // rim vertex -> its place after the inside's
+    auto local = [&](int v) {
+      if (const auto at = index.find(v); at != index.end()) return at->second;
+      const auto [at, added] = rim.emplace(v, static_cast<int>(layout.size()));
+      if (added) {
+        layout.push_back(chart_of(p_[v]));
+        rest.push_back(from_.vertices[v]);
+        free.push_back(0);
+      }
+      return at->second;
+    };
+    std::vector<std::array<int, 3>> triangles;
+    for (int f : faces) {
+      const auto& t = from_.faces[f];
+      triangles.push_back({local(t[0]), local(t[1]), local(t[2])});
     }
-    if (shift_ok()) return Disc::kept;
-    put(saved);
-    return Disc::rejected;
+    detail::UntangleLayoutOptions options;
+    options.max_work = kUnfoldWorkPerFace * static_cast<int64_t>(faces.size());
+    const detail::UntangleLayoutResult r = detail::untangle_layout(triangles, rest, free, layout, options);
+    work_ += r.work / kUnfoldWorkPerJudged;
+    if (r.inverted_after >= r.inverted_before) return false;
+    for (size_t i = 0; i < inside.size(); ++i) u.row(static_cast<Eigen::Index>(i)) = layout[i].transpose();
+    return true;
   }
 
   // Moves each vertex of `inside` to its old point, or a half, quarter or eighth of the way there
@@ -615,6 +660,9 @@ private:
   int64_t work_ = 0;
   static constexpr int64_t kWorkPerVertex = 4000;
   static constexpr int kRepairRings = 3;
+  // Unfolding a layout evaluates triangles (a 2 x 2 Jacobian each), cheaper than judging images.
+  static constexpr int64_t kUnfoldWorkPerFace = 20000;
+  static constexpr int64_t kUnfoldWorkPerJudged = 8;
 };
 
 class SideMap {
