@@ -154,7 +154,10 @@ UntangleLayoutResult untangle_layout(const std::vector<std::array<int, 3>>& tria
         alpha[k] = s.dot(direction) / y.dot(s);
         direction -= alpha[k] * y;
       }
-      if (!history.empty()) direction *= history.back().first.dot(history.back().second) / history.back().second.squaredNorm();
+      if (!history.empty()) {  // the initial Hessian guess: sᵀy / yᵀy of the last step
+        const auto& [s, y] = history.back();
+        direction *= s.dot(y) / y.squaredNorm();
+      }
       for (size_t k = 0; k < history.size(); ++k) {
         const auto& [s, y] = history[k];
         direction += (alpha[k] - y.dot(direction) / y.dot(s)) * s;
