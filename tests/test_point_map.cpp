@@ -401,6 +401,8 @@ TEST_CASE("point map: a layout folded over a concave rim is unfolded, the rim he
   for (auto& x : mirrored) x.x() = -x.x();
   const std::vector<Eigen::Vector2d> mirrored_start = mirrored;
   const detail::UntangleLayoutResult none = detail::untangle_layout(triangles, m.vertices, free, mirrored);
+  CHECK(none.inverted_before == inverted(mirrored_start));
+  CHECK(none.inverted_before > 100);  // of 128
   CHECK(none.inverted_after == none.inverted_before);
   CHECK(mirrored == mirrored_start);
 }

@@ -6,11 +6,14 @@
 #include <cmath>
 #include <deque>
 #include <limits>
+#include <utility>
 
 namespace shapematch::detail {
 namespace {
 
-double chi(double d, double eps) { return 0.5 * (d + std::sqrt(eps * eps + d * d)); }
+// The relaxed barrier's denominator; for d < 0 in the form that does not cancel to 0.
+double chi(double d, double eps, double root) { return d >= 0 ? 0.5 * (d + root) : 0.5 * eps * eps / (root - d); }
+double chi(double d, double eps) { return chi(d, eps, std::sqrt(eps * eps + d * d)); }
 
 // The energy of a layout for one ε, with its gradient in the free vertices' coordinates.
 class LayoutEnergy {
@@ -47,7 +50,7 @@ public:
     double energy = 0;
     for (size_t t = 0; t < triangles_.size(); ++t) {
       const Eigen::Matrix2d j = jacobian(t, layout);
-      const double d = j.determinant(), root = std::sqrt(eps * eps + d * d), c = 0.5 * (d + root);
+      const double d = j.determinant(), root = std::sqrt(eps * eps + d * d), c = chi(d, eps, root);
       const double dc = 0.5 * (1 + d / root);  // χ'(d)
       const double conformal = j.squaredNorm() / c, area = (d * d + 1) / c;
       energy += weight_[t] * ((1 - area_weight_) * conformal + area_weight_ * area);
@@ -97,16 +100,22 @@ UntangleLayoutResult untangle_layout(const std::vector<std::array<int, 3>>& tria
   // its signed areas, whatever the folds), so that det J = 1 is the ideal.
   std::vector<Eigen::Matrix2d> rest_edges(triangles.size());
   double rest_area = 0, layout_area = 0;
+  auto signed_area = [&layout](const std::array<int, 3>& tri) {
+    const Eigen::Vector2d a = layout[tri[1]] - layout[tri[0]], b = layout[tri[2]] - layout[tri[0]];
+    return 0.5 * (a.x() * b.y() - a.y() * b.x());
+  };
   for (size_t t = 0; t < triangles.size(); ++t) {
     const auto& tri = triangles[t];
     const Eigen::Vector3d e1 = rest[tri[1]] - rest[tri[0]], e2 = rest[tri[2]] - rest[tri[0]];
     const double l1 = e1.norm(), height = l1 > 0 ? e1.cross(e2).norm() / l1 : 0.0;
     rest_edges[t] << l1, (l1 > 0 ? e1.dot(e2) / l1 : 0.0), 0.0, height;
     rest_area += 0.5 * rest_edges[t].determinant();
-    const Eigen::Vector2d a = layout[tri[1]] - layout[tri[0]], b = layout[tri[2]] - layout[tri[0]];
-    layout_area += 0.5 * (a.x() * b.y() - a.y() * b.x());
+    const double area = signed_area(tri);
+    layout_area += area;
+    result.inverted_before += area > 0 ? 0 : 1;
   }
-  if (!(rest_area > 0) || !(layout_area > 0) || m == 0) return result;
+  result.inverted_after = result.inverted_before;
+  if (!(rest_area > 0) || !(layout_area > 0) || m == 0 || result.inverted_before == 0) return result;
   const double scale = std::sqrt(layout_area / rest_area);
   const double mean_area = layout_area / static_cast<double>(triangles.size());
   std::vector<Eigen::Matrix2d> inverse_rest(triangles.size());
@@ -122,9 +131,7 @@ UntangleLayoutResult untangle_layout(const std::vector<std::array<int, 3>>& tria
   }
   LayoutEnergy energy(triangles, std::move(inverse_rest), std::move(weight), unknown, options.area_weight);
 
-  double low = energy.min_det(layout, &result.inverted_before);
-  result.inverted_after = result.inverted_before;
-  if (result.inverted_before == 0) return result;
+  double low = energy.min_det(layout, nullptr);
 
   std::vector<Eigen::Vector2d> x = layout, trial = layout;
   auto set = [&](std::vector<Eigen::Vector2d>& to, const std::vector<Eigen::Vector2d>& from,
@@ -179,7 +186,11 @@ UntangleLayoutResult untangle_layout(const std::vector<std::array<int, 3>>& tria
           break;
         }
       }
-      if (!accepted) break;
+      if (!accepted) {
+        if (history.empty()) break;
+        history.clear();  // once more downhill, then give up
+        continue;
+      }
       history.emplace_back(s * direction, next_grad - grad);
       if (history.back().second.dot(history.back().first) <= 0) history.pop_back();
       if (history.size() > kHistory) history.pop_front();
@@ -201,8 +212,9 @@ UntangleLayoutResult untangle_layout(const std::vector<std::array<int, 3>>& tria
     // last minimisation gained (at least a tenth).
     const double gain = std::max(first > 0 ? 1 - e / first : 0.0, 0.1);
     mu = (1 - gain) * chi(low, eps);
-    if (!(mu > 0) || low >= mu) break;
-    eps = 2 * std::sqrt(mu * (mu - low));
+    if (!(mu > 0)) break;
+    // Every triangle right but not clearly: the barrier all but exact from here.
+    eps = low < mu ? 2 * std::sqrt(mu * (mu - low)) : 1e-9 * mu;
   }
   result.work = energy.work;
   return result;

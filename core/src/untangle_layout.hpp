@@ -26,9 +26,10 @@ struct UntangleLayoutResult {
 // right) has area <= 0, its other vertices held: a minimiser of a conformal plus area energy
 // whose barrier χ(det, ε) = (det + sqrt(ε² + det²)) / 2 is relaxed, so that it is finite at
 // inverted triangles, and ε is shrunk until none is left (after Garanzha et al., "Foldover-free
-// maps in 50 lines of code", SIGGRAPH 2021). Tutte's embedding cannot fold only on a convex rim;
-// this unfolds whatever a simple rim allows. `rest` gives each vertex's 3D position, the
-// triangles' shapes to keep. Leaves `layout` as it was unless that inverts fewer triangles.
+// maps in 50 lines of code", SIGGRAPH 2021). Tutte's embedding is sure not to fold only where the
+// rim is convex; this unfolds what a simple rim allows. `rest` gives each vertex's 3D position,
+// the triangles' shapes to keep. `layout` becomes the best layout seen, the one given included
+// (fewest inverted, then the largest worst det).
 UntangleLayoutResult untangle_layout(const std::vector<std::array<int, 3>>& triangles,
                                      const std::vector<Eigen::Vector3d>& rest, const std::vector<char>& free,
                                      std::vector<Eigen::Vector2d>& layout, const UntangleLayoutOptions& options = {});
