@@ -381,6 +381,8 @@ TEST_CASE("point map: a layout folded over a concave rim is unfolded, the rim he
   REQUIRE(inverted(start) > 0);
   const detail::UntangleLayoutResult r = detail::untangle_layout(triangles, m.vertices, free, layout);
   CHECK(r.inverted_before == inverted(start));
+  // Quasi-Newton steps: 11 776 triangle evaluations here, 85 888 by steepest descent.
+  CHECK(r.work < 30000);
   CHECK(r.inverted_after == 0);
   CHECK(inverted(layout) == 0);
   for (size_t v = 0; v < layout.size(); ++v)
