@@ -37,6 +37,7 @@ struct MatchArgs {
   int64_t alternatives_below = RoundingOptions{}.alternatives_below;
   int max_rounds = 50;
   double later_round_iterations = RoundingOptions{}.later_round_iterations;
+  bool carry_round_weights = RoundingOptions{}.carry_weights;
   double fractional_batch = RoundingOptions{}.fractional_batch;
   bool close_pockets = RoundingOptions{}.close_pockets;
   int untangle_rings = PointMapOptions{}.untangle_rings;
@@ -186,6 +187,7 @@ int run_match(const MatchArgs& args) {
   ro.alternatives_below = args.alternatives_below;
   ro.max_rounds = args.max_rounds;
   ro.later_round_iterations = args.later_round_iterations;
+  ro.carry_weights = args.carry_round_weights;
   ro.fractional_batch = args.fractional_batch;
   ro.close_pockets = args.close_pockets;
   ro.split_parts = !args.whole_lp;
@@ -426,6 +428,7 @@ int run_match(const MatchArgs& args) {
                               .set("alternatives_below", args.alternatives_below)
                               .set("fractional_batch", args.fractional_batch)
                               .set("later_round_iterations", args.later_round_iterations)
+                              .set("carry_round_weights", args.carry_round_weights)
                               .set("close_pockets", args.close_pockets)
                               .set("untangle_rings", args.untangle_rings)
                               .set("untangle_max_shift", args.untangle_max_shift)
@@ -620,6 +623,10 @@ Action add_match_command(CLI::App& app) {
                  "LP iterations of a rounding round after the first, at most this many times the first LP's (at "
                  "least 2000; then it fixes from its iterate); 0: no limit")
       ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  app.add_flag("--carry-round-weights,!--no-carry-round-weights", a->carry_round_weights,
+               "rounding rounds after the first start each PDHG part from the primal weight its columns' last "
+               "solve ended with (default: the solver's own start)")
       ->capture_default_str();
   app.add_option("--greedy-above", a->greedy_above,
                  "where a round's candidates clash and its LP has more free variables than this, fix each candidate "

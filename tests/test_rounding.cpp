@@ -1206,3 +1206,88 @@ TEST_CASE("rounding: trims in a row count only while the same part fails after e
   f.trimmed();
   CHECK(f.failed({}) == 0);  // nothing failed in parts: nothing to release around
 }
+
+namespace {
+// The first-order solver, noting the primal weight each solve was asked to start from.
+class WeightNoting final : public LpSolver {
+public:
+  std::string name() const override { return "pdhg-cpu"; }
+  LpResult solve(const LpProblem& lp, const SolverParams& params) override {
+    asked.push_back(params.initial_primal_weight);
+    return inner->solve(lp, params);
+  }
+  std::unique_ptr<LpSolver> inner = make_solver("pdhg-cpu");
+  std::vector<double> asked;
+};
+
+// Two copies of an LP side by side: two independent parts.
+LpProblem twice(const LpProblem& p) {
+  LpProblem q;
+  q.a.rows = 2 * p.a.rows;
+  q.a.cols = 2 * p.a.cols;
+  q.a.row_ptr = p.a.row_ptr;
+  q.a.entry = p.a.entry;
+  for (int64_t i = 1; i <= p.a.rows; ++i) q.a.row_ptr.push_back(p.a.row_ptr.back() + p.a.row_ptr[i]);
+  for (uint32_t e : p.a.entry) q.a.entry.push_back(e + static_cast<uint32_t>(p.a.cols));  // the sign bit stays
+  q.at = transpose(q.a);
+  q.b = p.b;
+  q.b.insert(q.b.end(), p.b.begin(), p.b.end());
+  q.c = p.c;
+  q.c.insert(q.c.end(), p.c.begin(), p.c.end());
+  q.objective_scale = p.objective_scale;
+  q.check();
+  return q;
+}
+}  // namespace
+
+TEST_CASE("rounding: a later round's parts start from the primal weight their columns' last solve ended with") {
+  const MatchingLp& m = dolphins_60();
+  const LpProblem lp = twice(m.lp);
+  const int64_t n = m.lp.cols();
+  SolverParams params;
+  params.tolerance = 1e-4;
+  WeightNoting pdhg;
+  // No weights given: every part starts from the solver's own; each part's columns get the ω its
+  // solve ended with.
+  const detail::JoinedSolve a = detail::solve_in_parts(lp, params, pdhg, nullptr, 0, params, true);
+  REQUIRE(a.parts == 2);
+  REQUIRE(pdhg.asked.size() == 2);
+  CHECK(pdhg.asked[0] == 0.0);
+  CHECK(pdhg.asked[1] == 0.0);
+  REQUIRE(a.weight.size() == size_t(lp.cols()));
+  CHECK(a.weight[0] > 0.0);
+  CHECK(a.weight[0] != 1.0);  // it moved from the solver's start
+  CHECK(a.weight[n - 1] == a.weight[0]);
+  CHECK(a.weight[n] > 0.0);
+  // Given per column: the first part's columns 2 and 8 (half each), zeros ignored; the second's 5.
+  std::vector<double> w(lp.cols(), 0.0);
+  for (int64_t j = 0; j < n; ++j) w[j] = j % 3 == 0 ? 0.0 : j % 3 == 1 ? 2.0 : 8.0;
+  for (int64_t j = n; j < 2 * n; ++j) w[j] = 5.0;
+  const int64_t ones = (n + 1) / 3, twos = n / 3;  // j % 3 == 1 and j % 3 == 2 below n
+  pdhg.asked.clear();
+  detail::solve_in_parts(lp, params, pdhg, nullptr, 0, params, true, 0.0, nullptr, &w);
+  REQUIRE(pdhg.asked.size() == 2);
+  CHECK(pdhg.asked[0] == doctest::Approx(std::exp((ones * std::log(2.0) + twos * std::log(8.0)) / double(ones + twos))));
+  CHECK(pdhg.asked[1] == doctest::Approx(5.0));
+  // The whole LP as one part (not split): the mean over all its columns.
+  pdhg.asked.clear();
+  std::vector<double> w1(n, 3.0);
+  detail::solve_in_parts(m.lp, params, pdhg, nullptr, 0, params, false, 0.0, nullptr, &w1);
+  REQUIRE(pdhg.asked.size() == 1);
+  CHECK(pdhg.asked[0] == doctest::Approx(3.0));
+}
+
+TEST_CASE("rounding: later rounds carrying their parts' primal weights end in a verified graph surface") {
+  // Every round on PDHG (as in the capped-rounds test), its parts started from the carried ω.
+  const MatchingLp& m = dolphins_60();
+  RoundingOptions o;
+  o.solver = "pdhg-cpu";
+  o.exact_below = 0;
+  o.threshold = 0.0;
+  o.carry_weights = true;
+  const RoundingResult r = round_to_graph_surface(m.space, m.lp, m.energy, o);
+  REQUIRE(r.rounds.size() >= 2);
+  CHECK(r.rounds[1].parts > 1);
+  CHECK(satisfies_exactly(m.lp, r.gamma));
+  CHECK(check_graph_surface(m.space, r.gamma).ok());
+}

@@ -233,6 +233,19 @@ Part whole_part(const LpProblem& lp) {
   return p;
 }
 
+// The geometric mean of the positive weights among `cols` (0 where none is): a part whose
+// columns came from several parts of the last round starts between their primal weights.
+double part_weight(const std::vector<double>& weight, const std::vector<int64_t>& cols) {
+  double sum = 0.0;
+  int64_t count = 0;
+  for (int64_t j : cols)
+    if (weight[j] > 0.0 && std::isfinite(weight[j])) {
+      sum += std::log(weight[j]);
+      ++count;
+    }
+  return count > 0 ? std::exp(sum / double(count)) : 0.0;
+}
+
 // Empty where the LP is a single part.
 std::vector<Part> split_into_parts(const LpProblem& lp) {
   const int64_t m = lp.rows(), n = lp.cols();
@@ -291,7 +304,8 @@ bool looks_infeasible(const LpResult& r) {
 
 JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpSolver& solver, LpSolver* exact,
                                    int64_t exact_below, const SolverParams& exact_params, bool split,
-                                   double exact_pivots_per_column, ExactCache* cache) {
+                                   double exact_pivots_per_column, ExactCache* cache,
+                                   const std::vector<double>* warm_weight) {
   JoinedSolve out;
   std::vector<Part> parts;
   if (split) parts = split_into_parts(lp);
@@ -305,6 +319,8 @@ JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpS
   r.x.assign(lp.cols(), 0.0);
   r.y.assign(lp.rows(), 0.0);
   out.proof.assign(lp.rows(), 0.0);
+  out.weight.assign(lp.cols(), 0.0);
+  const bool weighted = warm_weight && warm_weight->size() == size_t(lp.cols());
   std::vector<double> suspect_proof(lp.rows(), 0.0);
   bool infeasible = false;
   int64_t exactly = 0, largest = 0, reused = 0;
@@ -326,8 +342,13 @@ JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpS
     // only where that solver runs).
     SolverParams own;
     auto first_order = [&]() -> const SolverParams& {
-      if (whole) return params;
+      const double w = weighted ? part_weight(*warm_weight, part.cols) : 0.0;
+      if (whole) {
+        if (w > 0.0) params.initial_primal_weight = w;
+        return params;
+      }
       own = params;
+      if (w > 0.0) own.initial_primal_weight = w;
       if (!warm_x.empty()) {
         for (int64_t j : part.cols) own.initial_x.push_back(warm_x[j]);
         for (int64_t i : part.rows) own.initial_y.push_back(warm_y[i]);
@@ -403,6 +424,8 @@ JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpS
     }
     for (size_t j = 0; j < part.cols.size(); ++j) r.x[part.cols[j]] = s.x[j];
     for (size_t i = 0; i < part.rows.size() && i < s.y.size(); ++i) r.y[part.rows[i]] = s.y[i];
+    if (std::isfinite(s.primal_weight) && s.primal_weight > 0.0)
+      for (int64_t j : part.cols) out.weight[j] = s.primal_weight;
     r.objective += s.objective;
     r.lower_bound += s.lower_bound;
   }
@@ -917,6 +940,9 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
     throw InfeasibleError("rounding: the matching LP is infeasible (found before any fixing)", {fixer.failed_row()});
 
   std::vector<double> x_full(lp.cols(), 0.0), y_full(lp.rows(), 0.0);
+  // Per column, the primal weight of the last first-order solve that had it (0: none yet), for
+  // the next round's parts (carry_weights).
+  std::vector<double> w_full(options.carry_weights ? lp.cols() : 0, 0.0);
   struct Step {
     size_t mark = 0;  // the fixer's mark before this fixing
     int64_t ones = 0, zeros = 0;
@@ -1151,9 +1177,17 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
     return StuckError(what, std::move(rows), decisions(), x_full, y_full);
   };
   // The round's iterate over the whole LP, the next round's warm start.
-  const auto keep_iterate = [&](const Reduced& red, const LpResult& r) {
+  const auto keep_iterate = [&](const Reduced& red, const JoinedSolve& joined) {
+    const LpResult& r = joined.r;
     for (size_t j = 0; j < red.cols.size(); ++j) x_full[red.cols[j]] = r.x[j];
     for (size_t i = 0; i < red.rows.size(); ++i) y_full[red.rows[i]] = i < r.y.size() ? r.y[i] : 0.0;
+    if (w_full.empty()) return;
+    if (joined.weight.size() == red.cols.size()) {
+      for (size_t j = 0; j < red.cols.size(); ++j)
+        if (joined.weight[j] > 0.0) w_full[red.cols[j]] = joined.weight[j];
+    } else if (std::isfinite(r.primal_weight) && r.primal_weight > 0.0) {  // round 1: one solve
+      for (int64_t j : red.cols) w_full[j] = r.primal_weight;
+    }
   };
   for (int round = 1, forward = 0; fixer.state().unsatisfied > 0; ++round) {
     // Out of rounds: no binary solution found in this space. An InfeasibleError with the open
@@ -1259,9 +1293,14 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
       }
       if (joined.r.status == LpStatus::Infeasible) joined.proof = joined.r.y;
     } else {
+      std::vector<double> warm_weight;
+      if (!w_full.empty()) {
+        warm_weight.resize(red.cols.size());
+        for (size_t j = 0; j < red.cols.size(); ++j) warm_weight[j] = w_full[red.cols[j]];
+      }
       joined = detail::solve_in_parts(red.lp, std::move(params), *solver, exact ? exact_solver.get() : nullptr,
                               options.exact_below, exact_params, options.split_parts,
-                              options.exact_pivots_per_column, &exact_cache);
+                              options.exact_pivots_per_column, &exact_cache, &warm_weight);
     }
     const LpResult& r = joined.r;
     // Round 1's iterate over the whole LP, for first_iterate and (an optimum) for the alternatives.
@@ -1355,7 +1394,7 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
         spdlog::debug("round {}: a part at its cap looks infeasible, away from the last fixing: it goes on from its "
                       "iterate, the cap {}x",
                       round, cap_scale);
-        keep_iterate(red, r);
+        keep_iterate(red, joined);
         info.undone = false;
         ++forward;
       } else if ((touched == 0 || again) && !failed.empty() && failed.size() < red.rows.size()) {
@@ -1399,7 +1438,7 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
     failing_again.solved();
     if (r.status == LpStatus::NumericalTrouble || r.x.size() != size_t(red.lp.cols()))
       throw SolverError(std::string("rounding: LP solve failed (") + to_string(r.status) + ")");
-    keep_iterate(red, r);
+    keep_iterate(red, joined);
 
     // Candidates above the threshold, largest first; if none, the single largest.
     std::vector<int64_t> order(red.cols.size());

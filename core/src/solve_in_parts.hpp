@@ -16,7 +16,8 @@ namespace shapematch::detail {
 // (numerical trouble) goes to the other (`exact` up to 10 × exact_below columns); where both
 // fail, so does the join. With `exact_pivots_per_column` > 0 the exact solver stops after that
 // many pivots per column of the part (at least 1 000 columns' worth), and the part goes to
-// `solver` as where it gives up.
+// `solver` as where it gives up. With `warm_weight` (one value per column, 0: none) a part solved
+// by `solver` starts from the geometric mean of its columns' positive values as its primal weight.
 struct JoinedSolve {
   LpResult r;
   std::vector<double> proof;
@@ -27,6 +28,9 @@ struct JoinedSolve {
   std::vector<int64_t> failed_rows;
   // 1 for the columns of parts that stopped at their iteration (or time) limit; empty where none did.
   std::vector<char> capped_cols;
+  // Per column, the primal weight ω its part's first-order solve ended with (0 where the exact
+  // solver, or none, solved it): the next round's parts start from it (`warm_weight`).
+  std::vector<double> weight;
 };
 // The exact solver's results on the parts of the last call, for the next one: a part whose LP has
 // not changed since (no fixing reached it) gets its result again instead of a new solve. The
@@ -52,7 +56,8 @@ struct ExactCache {
 
 JoinedSolve solve_in_parts(const LpProblem& lp, SolverParams params, LpSolver& solver, LpSolver* exact,
                            int64_t exact_below, const SolverParams& exact_params, bool split,
-                           double exact_pivots_per_column = 0.0, ExactCache* cache = nullptr);
+                           double exact_pivots_per_column = 0.0, ExactCache* cache = nullptr,
+                           const std::vector<double>* warm_weight = nullptr);
 
 }  // namespace shapematch::detail
 

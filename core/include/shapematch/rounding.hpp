@@ -47,6 +47,12 @@ struct RoundingOptions {
   // capped LP whose certified bound is over 50 % above its objective is undone as infeasible.
   double later_round_iterations = 2.0;
   int64_t later_round_min_iterations = 2000;
+  // Later rounds' first-order parts start from the primal weight ω that the last solve of their
+  // columns ended with (the geometric mean over the part's columns), instead of the solver's
+  // own start. Those rounds start from the last iterate, but a first-order solve's ω starts at 1
+  // each time, while the LPs of a full-resolution level settle at ω 5-200 (its first LP's log):
+  // a capped round spends its iterations climbing back to it.
+  bool carry_weights = false;
   // A round whose LP stopped at its cap in some parts fixes only from the parts that converged;
   // the others go on from their iterate next round, and are fixed from an unconverged iterate
   // only after one round more with nothing else left. Off: measured on FAUST_r 020-024 at full
