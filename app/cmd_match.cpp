@@ -370,6 +370,8 @@ int run_match(const MatchArgs& args) {
                       .set("undone", r.undone)
                       .set("parts", r.parts)
                       .set("exact_parts", r.exact_parts)
+                      .set("start_primal_weight", r.start_primal_weight)
+                      .set("primal_weight", r.primal_weight)
                       .set("search", r.search)
                       .set("searched_parts", r.searched_parts)
                       .set("released", r.released)

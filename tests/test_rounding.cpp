@@ -1290,4 +1290,15 @@ TEST_CASE("rounding: later rounds carrying their parts' primal weights end in a 
   CHECK(r.rounds[1].parts > 1);
   CHECK(satisfies_exactly(m.lp, r.gamma));
   CHECK(check_graph_surface(m.space, r.gamma).ok());
+  // Round 2's parts hold only round 1's columns: each starts from round 1's final ω.
+  CHECK(r.rounds[0].start_primal_weight == 0.0);
+  REQUIRE(std::isfinite(r.rounds[0].primal_weight));
+  CHECK(r.rounds[0].primal_weight != 1.0);
+  CHECK(r.rounds[1].start_primal_weight == doctest::Approx(r.rounds[0].primal_weight));
+  // Without it, the solver's own start.
+  o.carry_weights = false;
+  const RoundingResult u = round_to_graph_surface(m.space, m.lp, m.energy, o);
+  REQUIRE(u.rounds.size() >= 2);
+  CHECK(u.rounds[1].start_primal_weight == 0.0);
+  CHECK(std::isfinite(u.rounds[1].primal_weight));
 }

@@ -9,8 +9,10 @@ defaults have covered.
 
 With --update the table between the markers `<!-- matrix begin -->` and `<!-- matrix end -->` in
 RESULTS_MD is replaced; otherwise it is printed. Only the data sets' pair lists are read.
-A row's setting is read from its first cell: "R = 0.05" (or `--curvature-radius 0.05`, or a
-session from the thirty-fourth on, when it became the default) and "μ = 10".
+Only the table after the heading "### Every run" is read. A row's setting is read from its first
+cell: "R = …" or `--curvature-radius …` (else 0.05 from the thirty-fourth session on, when it
+became the default, 0 before) and "μ = …" (else 10 from the forty-fourth on, 1 before); its
+session is the last number of its session cell (where it finished).
 """
 import os
 import re
@@ -53,9 +55,11 @@ def test_pairs(datasets):
 
 
 def table_rows(text):
+    if "### Every run" in text:
+        text = text.split("### Every run", 1)[1]
     for line in text.split("\n"):
         cells = [c.strip() for c in line.strip().strip("|").split("|")]
-        if not line.startswith("| ") or len(cells) != 10 or not re.match(r"\d+", cells[2]):
+        if not line.startswith("| ") or len(cells) != 10 or not re.search(r"\d+", cells[2]):
             continue
         yield cells
 
@@ -63,14 +67,16 @@ def table_rows(text):
 def newest_rows(text, names):
     best = {}
     for cells in table_rows(text):
-        first, wks, session = cells[0], cells[1], int(re.match(r"\d+", cells[2]).group())
+        first, wks, session = cells[0], cells[1], int(re.findall(r"\d+", cells[2])[-1])
         name = next((n for n in names if first.startswith(n) and first[len(n):len(n) + 1] in ("", ",", " ")), None)
         error = re.match(r"\**([\d.]+)", cells[8])
         flips = re.match(r"(\d+) \((\d+)\)", cells[9])
         if name is None or error is None or flips is None:
             continue
-        r = "0.05" if ("R = 0.05" in first or "curvature-radius 0.05" in first or session >= 34) else "0"
-        mu = "10" if "μ = 10" in first else "1"
+        stated_r = re.search(r"(?:R = |curvature-radius )(\d+(?:\.\d+)?)", first)
+        r = format(float(stated_r.group(1)), "g") if stated_r else "0.05" if session >= 34 else "0"
+        stated_mu = re.search(r"μ = (\d+(?:\.\d+)?)", first)
+        mu = format(float(stated_mu.group(1)), "g") if stated_mu else "10" if session >= 44 else "1"
         key = (name, (wks, r, mu))
         if key not in best or session >= best[key]["session"]:
             best[key] = {"session": session, "error": float(error.group(1)), "vertex": int(flips.group(1)),

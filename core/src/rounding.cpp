@@ -323,7 +323,7 @@ JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpS
   const bool weighted = warm_weight && warm_weight->size() == size_t(lp.cols());
   std::vector<double> suspect_proof(lp.rows(), 0.0);
   bool infeasible = false;
-  int64_t exactly = 0, largest = 0, reused = 0;
+  int64_t exactly = 0, largest = 0, reused = 0, first_order_largest = 0;
   std::vector<ExactCache::Entry> kept;  // this call's new exact results, for the next calls (cache)
   // A part's parameters: `params` with its own slice of the whole LP's warm start, which is
   // moved out first so that copying `params` per part does not copy it.
@@ -355,6 +355,12 @@ JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpS
       }
       return own;
     };
+    double asked = 0.0;  // the ω this part's first-order solve was asked to start from
+    auto first_order_solve = [&]() {
+      const SolverParams& p = first_order();
+      asked = p.initial_primal_weight;
+      return solver.solve(plp, p);
+    };
     exactly += use_exact;
     // The exact solver's parameters: with a pivot cap where asked (its iterations are pivots).
     SolverParams capped_exact;
@@ -372,7 +378,7 @@ JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpS
           same = &e;
           break;
         }
-    LpResult s = same ? same->r : use_exact ? exact->solve(plp, exact_own) : solver.solve(plp, first_order());
+    LpResult s = same ? same->r : use_exact ? exact->solve(plp, exact_own) : first_order_solve();
     if (same) {
       same->unused = -1;  // seen in this call (0 after the call's ageing below)
       ++reused;
@@ -388,7 +394,7 @@ JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpS
       spdlog::warn("rounding: {} failed on a part of {} variables ({}); trying {}", use_exact ? exact->name() : solver.name(),
                    plp.cols(), to_string(s.status), use_exact ? solver.name() : exact->name());
       const int64_t before = s.iterations;
-      s = use_exact ? solver.solve(plp, first_order()) : exact->solve(plp, exact_params);
+      s = use_exact ? first_order_solve() : exact->solve(plp, exact_params);
       s.iterations = std::max(s.iterations, before);
       exactly += use_exact ? -1 : 1;
     } else if (use_exact && cache && !same) {
@@ -424,8 +430,14 @@ JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpS
     }
     for (size_t j = 0; j < part.cols.size(); ++j) r.x[part.cols[j]] = s.x[j];
     for (size_t i = 0; i < part.rows.size() && i < s.y.size(); ++i) r.y[part.rows[i]] = s.y[i];
-    if (std::isfinite(s.primal_weight) && s.primal_weight > 0.0)
+    if (std::isfinite(s.primal_weight) && s.primal_weight > 0.0) {
       for (int64_t j : part.cols) out.weight[j] = s.primal_weight;
+      if (plp.cols() > first_order_largest) {
+        first_order_largest = plp.cols();
+        out.start_weight = asked;
+        out.end_weight = s.primal_weight;
+      }
+    }
     r.objective += s.objective;
     r.lower_bound += s.lower_bound;
   }
@@ -1267,7 +1279,9 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
       return x;
     };
     JoinedSolve joined;
+    double round_one_weight = 0.0;  // the ω round 1's (first) solve was asked to start from
     if (!after_fixing) {
+      round_one_weight = params.initial_primal_weight;
       if (options.first_lp) options.first_lp(red.lp);
       if (options.probe && options.probe_tolerance > params.tolerance) {
         SolverParams loose = params;
@@ -1338,6 +1352,13 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
     info.iterations = r.iterations;
     info.parts = joined.parts;
     info.exact_parts = joined.exact_parts;
+    if (after_fixing) {
+      info.start_primal_weight = joined.start_weight;
+      info.primal_weight = joined.end_weight;
+    } else {
+      info.start_primal_weight = round_one_weight;
+      info.primal_weight = r.primal_weight;
+    }
     info.objective = r.objective + lp.objective_scale * red.fixed_cost;
     if (round == 1) {  // in the units of the full LP: add what propagation fixed to 1 before it
       first_seconds = options.reference_seconds > 0.0 ? options.reference_seconds : clock.seconds();

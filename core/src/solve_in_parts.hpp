@@ -3,6 +3,7 @@
 #include "shapematch/lp.hpp"
 
 #include <cstdint>
+#include <limits>
 #include <vector>
 
 namespace shapematch::detail {
@@ -29,8 +30,13 @@ struct JoinedSolve {
   // 1 for the columns of parts that stopped at their iteration (or time) limit; empty where none did.
   std::vector<char> capped_cols;
   // Per column, the primal weight ω its part's first-order solve ended with (0 where the exact
-  // solver, or none, solved it): the next round's parts start from it (`warm_weight`).
+  // solver solved it, or the part was infeasible): the rounding keeps the last positive one per
+  // column for the next round's parts (`warm_weight`).
   std::vector<double> weight;
+  // The largest first-order part's ω: what it was asked to start from (0: the solver's own) and
+  // where it ended (NaN: no first-order part).
+  double start_weight = 0.0;
+  double end_weight = std::numeric_limits<double>::quiet_NaN();
 };
 // The exact solver's results on the parts of the last call, for the next one: a part whose LP has
 // not changed since (no fixing reached it) gets its result again instead of a new solve. The

@@ -78,8 +78,8 @@ PointMaps point_maps(const ProductSpace& space, const std::vector<int64_t>& gamm
 // fold in the chart (Floater 2003), but orientation is judged on `to` (image_orientation) and rims
 // need not be convex, hence the check. A disc that holds the whole of f's component (no rim) is
 // never laid out. Every inverted face gets its 1-ring disc, then every face still inverted its
-// 2-ring disc, and so on; up to three such passes, and no new disc once 4 000 · |V(from)| faces
-// have been judged. `map` must have one point per vertex of `from` on a face of `to`; `max_shift`
+// 2-ring disc, and so on; up to three such passes, and no new disc once max(4 000 · |V(from)|,
+// 20 M) faces have been judged. `map` must have one point per vertex of `from` on a face of `to`; `max_shift`
 // >= 0. Returns the number of discs kept.
 int untangle_point_map(const Mesh& from, const Mesh& to, std::vector<SurfacePoint>& map, int max_rings = 24,
                        double max_shift = 1e-3);

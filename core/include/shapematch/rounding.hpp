@@ -48,10 +48,11 @@ struct RoundingOptions {
   double later_round_iterations = 2.0;
   int64_t later_round_min_iterations = 2000;
   // Later rounds' first-order parts start from the primal weight ω that the last solve of their
-  // columns ended with (the geometric mean over the part's columns), instead of the solver's
-  // own start. Those rounds start from the last iterate, but a first-order solve's ω starts at 1
-  // each time, while the LPs of a full-resolution level settle at ω 5-200 (its first LP's log):
-  // a capped round spends its iterations climbing back to it.
+  // columns ended with (the geometric mean over the part's columns), instead of lp's own
+  // (initial_primal_weight; PDHG's start at 1 where that is 0). Those rounds start from the last
+  // iterate, while the LPs of a full-resolution level settle at ω 5-200 (its first LP's log):
+  // a capped round may spend its iterations climbing back. Measured at 2 000 faces only, no
+  // gain (docs/results-log.md, fifty-first session): off.
   bool carry_weights = false;
   // A round whose LP stopped at its cap in some parts fixes only from the parts that converged;
   // the others go on from their iterate next round, and are fixed from an unconverged iterate
@@ -206,6 +207,10 @@ struct RoundingRound {
   int64_t iterations = 0;
   int64_t parts = 1;           // independent parts its LP was solved in (split_parts)
   int64_t exact_parts = 0;     // of those, solved by the exact solver
+  // PDHG's primal weight ω in the round's largest first-order solve: asked to start from (0: the
+  // solver's own; round 1: its first solve's, before any probe) and ended with (NaN: none).
+  double start_primal_weight = 0.0;
+  double primal_weight = std::numeric_limits<double>::quiet_NaN();
   double objective = 0.0;      // of this round's LP, including the fixed part
   double seconds = 0.0;
   bool undone = false;         // the fixing made the LP infeasible and was replaced by a smaller one
