@@ -45,6 +45,7 @@ struct MatchArgs {
   bool whole_lp = !RoundingOptions{}.split_parts;
   int64_t greedy_above = RoundingOptions{}.greedy_above;
   int greedy_margin = RoundingOptions{}.greedy_margin;
+  double greedy_fallback = RoundingOptions{}.greedy_fallback;
   int64_t search_below = RoundingOptions{}.search_below;
   bool converged_first = RoundingOptions{}.converged_first;
   double exact_pivots_per_column = RoundingOptions{}.exact_pivots_per_column;
@@ -193,6 +194,7 @@ int run_match(const MatchArgs& args) {
   ro.split_parts = !args.whole_lp;
   ro.greedy_above = args.greedy_above;
   ro.greedy_margin = args.greedy_margin;
+  ro.greedy_fallback = args.greedy_fallback;
   ro.search_below = args.search_below;
   ro.stuck_stalled = args.stuck_stalled;
   ro.converged_first = args.converged_first;
@@ -436,6 +438,7 @@ int run_match(const MatchArgs& args) {
                               .set("untangle_max_shift", args.untangle_max_shift)
                               .set("greedy_above", args.greedy_above)
                               .set("greedy_margin", args.greedy_margin)
+                              .set("greedy_fallback", args.greedy_fallback)
                               .set("search_below", args.search_below)
                               .set("converged_first", args.converged_first)
                               .set("exact_pivots_per_column", args.exact_pivots_per_column)
@@ -639,6 +642,11 @@ Action add_match_command(CLI::App& app) {
                  "those rounds fix only candidates with no undecided variable (valued in (0.1, 0.9)) in their rows "
                  "or within this many - 1 closedness steps of them; 0: every candidate")
       ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  app.add_option("--greedy-fallback", a->greedy_fallback,
+                 "where no candidate of such a round stands away from the undecided part, fix the largest this share of "
+                 "them (at least one; 1: all)")
+      ->check(CLI::Range(0.0, 1.0))
       ->capture_default_str();
   app.add_flag("--whole-lp", a->whole_lp,
                "solve each rounding LP after the first as one, not as its independent parts (small parts exactly)");

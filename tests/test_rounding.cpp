@@ -1302,3 +1302,29 @@ TEST_CASE("rounding: later rounds carrying their parts' primal weights end in a 
   CHECK(u.rounds[1].start_primal_weight == 0.0);
   CHECK(std::isfinite(u.rounds[1].primal_weight));
 }
+
+TEST_CASE("rounding: where no candidate of a big round stands away, only the largest share of them is fixed, if asked") {
+  // x1 + … + x5 = 3 at equal costs: PDHG from 0 ends at 3/5 each, every candidate undecided
+  // itself. The whole batch goes in as far as it fits (three); a share of 0.2 fixes one.
+  const LpProblem lp = test::dense_lp({{1, 1, 1, 1, 1}}, {3}, {1, 1, 1, 1, 1});
+  const Mesh sphere = shapes::icosphere(1);
+  const auto id = identity_matching(sphere);
+  const ProductSpace space = ProductSpace::from_list(sphere, sphere, {id.begin(), id.begin() + lp.cols()});
+  const std::vector<double> cost(lp.cols(), 1.0);
+  RoundingOptions options;
+  options.solver = "pdhg-cpu";
+  options.exact_below = 0;
+  options.greedy_above = 0;
+  options.alternative_thresholds = {};
+  const RoundingResult whole = round_to_graph_surface(space, lp, cost, options);
+  REQUIRE(!whole.rounds.empty());
+  CHECK(whole.rounds[0].fixed_to_one == 3);
+  options.greedy_fallback = 0.2;
+  const RoundingResult share = round_to_graph_surface(space, lp, cost, options);
+  REQUIRE(share.rounds.size() >= 2);
+  CHECK(share.rounds[0].fixed_to_one == 1);
+  for (const RoundingResult* r : {&whole, &share}) {
+    CHECK(satisfies_exactly(lp, r->gamma));
+    CHECK(r->gamma.size() == 3);
+  }
+}

@@ -618,11 +618,11 @@ std::vector<std::pair<int64_t, int>> fixings_away_from(const LpProblem& lp, cons
 // Why: a candidate next to a split region fixes that region's boundary to one of the LP's mixed
 // alternatives, which the narrow reduced space often cannot complete; propagation does not see
 // it, the next LP is infeasible, and every infeasibility proof costs a solve. The whole batch
-// where nothing would be left.
+// (or its largest `fallback` share) where nothing would be left.
 std::vector<std::pair<int64_t, int>> away_from_undecided(const LpProblem& lp, const Reduced& red,
                                                          const std::vector<int8_t>& value, const std::vector<double>& x,
                                                          const std::vector<std::pair<int64_t, int>>& batch,
-                                                         double unsure, int margin) {
+                                                         double unsure, int margin, double fallback) {
   if (margin <= 0 || batch.empty()) return batch;
   const auto away = [&](double band) {
     std::vector<char> undecided(lp.rows(), 0);
@@ -673,7 +673,11 @@ std::vector<std::pair<int64_t, int>> away_from_undecided(const LpProblem& lp, co
   auto kept = away(unsure);
   if (4 * kept.size() >= batch.size()) return kept;
   if (unsure < 0.3) kept = away(0.3);
-  return kept.empty() ? batch : kept;
+  if (!kept.empty()) return kept;
+  // Nothing stands away: the largest share of the batch (it is sorted largest first).
+  const size_t take = std::clamp<size_t>(static_cast<size_t>(std::ceil(fallback * double(batch.size()))), 1, batch.size());
+  if (take < batch.size()) spdlog::debug("rounding: none stands away; the largest {} of {} candidates", take, batch.size());
+  return {batch.begin(), batch.begin() + static_cast<std::ptrdiff_t>(take)};
 }
 
 // How a depth-first search for a binary solution of one part ended.
@@ -1513,7 +1517,7 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
       const bool greedy = red.lp.cols() > options.greedy_above;
       if (greedy)
         batch = away_from_undecided(lp, red, fixer.state().value, r.x, batch, options.greedy_unsure,
-                                    options.greedy_margin);
+                                    options.greedy_margin, options.greedy_fallback);
       step.batch = shrink_and_fix(fixer, batch, step.mark, greedy);
       info.undone = step.batch != batch;
       history.push_back(std::move(step));
