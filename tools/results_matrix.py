@@ -77,6 +77,8 @@ def newest_rows(text, names):
         r = format(float(stated_r.group(1)), "g") if stated_r else "0.05" if session >= 34 else "0"
         stated_mu = re.search(r"μ = (\d+(?:\.\d+)?)", first)
         mu = format(float(stated_mu.group(1)), "g") if stated_mu else "10" if session >= 44 else "1"
+        if wks == "off":
+            mu = "1"  # no features: μ weighs nothing (the column stands for every μ)
         key = (name, (wks, r, mu))
         if key not in best or session >= best[key]["session"]:
             best[key] = {"session": session, "error": float(error.group(1)), "vertex": int(flips.group(1)),
