@@ -552,15 +552,21 @@ LpProblem cycle_behind_a_fixing(std::vector<double>& cost, bool linked = false) 
   return test::dense_lp(rows, b, cost);
 }
 
-// Rounds cycle_behind_a_fixing on a stand-in space of its size (only for the sizes) with
-// PDHG, whose infeasibility proof is a dual point (Clp's names no rows), and checks A x = b.
+// A product space with as many elements as `lp` has columns, for roundings of hand-made LPs
+// (rounding reads only its size there).
+ProductSpace stand_in_space(const LpProblem& lp) {
+  const Mesh sphere = shapes::icosphere(1);
+  const auto id = identity_matching(sphere);
+  return ProductSpace::from_list(sphere, sphere, {id.begin(), id.begin() + lp.cols()});
+}
+
+// Rounds cycle_behind_a_fixing on a stand-in space of its size with PDHG, whose infeasibility
+// proof is a dual point (Clp's names no rows), and checks A x = b.
 RoundingResult round_cycle(RoundingOptions options, bool linked = false,
                            const std::function<void(const RoundingRound&)>& progress = {}) {
   std::vector<double> cost;
   const LpProblem lp = cycle_behind_a_fixing(cost, linked);
-  const Mesh sphere = shapes::icosphere(1);
-  const auto id = identity_matching(sphere);
-  const ProductSpace space = ProductSpace::from_list(sphere, sphere, {id.begin(), id.begin() + lp.cols()});
+  const ProductSpace space = stand_in_space(lp);
   options.solver = "pdhg-cpu";
   options.exact_below = 0;
   RoundingResult r = round_to_graph_surface(space, lp, cost, options, progress);
@@ -1307,9 +1313,7 @@ TEST_CASE("rounding: where no candidate of a big round stands away, only the lar
   // x1 + … + x5 = 3 at equal costs: PDHG from 0 ends at 3/5 each, every candidate undecided
   // itself. The whole batch goes in as far as it fits (three); a share of 0.2 fixes one.
   const LpProblem lp = test::dense_lp({{1, 1, 1, 1, 1}}, {3}, {1, 1, 1, 1, 1});
-  const Mesh sphere = shapes::icosphere(1);
-  const auto id = identity_matching(sphere);
-  const ProductSpace space = ProductSpace::from_list(sphere, sphere, {id.begin(), id.begin() + lp.cols()});
+  const ProductSpace space = stand_in_space(lp);
   const std::vector<double> cost(lp.cols(), 1.0);
   RoundingOptions options;
   options.solver = "pdhg-cpu";
