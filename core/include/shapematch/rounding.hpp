@@ -81,13 +81,15 @@ struct RoundingOptions {
   double greedy_unsure = 0.1;
   int greedy_margin = 1;
   // Where no candidate qualifies even then, the largest this share of the batch (at least one)
-  // instead of the whole batch (1: the whole batch). Counted in the -v logs of eighteen
-  // full-resolution runs or segments (tools/greedy_rounds.py; docs/results-log.md, fifty-first
-  // session): the LP after such a round was infeasible 16 times in 30 (from an optimal LP) and
-  // 5 in 5 (from one at its cap), against 0-7 % after rounds whose candidates stood away from
-  // (0.1, 0.9) and 3-17 % from (0.3, 0.7). Not yet run with a share below 1: the default keeps
-  // the whole batch.
-  double greedy_fallback = 1.0;
+  // instead of the whole batch (1: the whole batch, the default up to the fifty-first session).
+  // Counted in the -v logs of eighteen full-resolution runs or segments (tools/greedy_rounds.py;
+  // docs/results-log.md, fifty-first session): after a whole-batch fallback the next LP was
+  // infeasible 16 times in 30 (from an optimal LP) and 5 in 5 (from one at its cap), against
+  // 0-7 % after rounds whose candidates stood away from (0.1, 0.9). With 0.125 (fifty-second
+  // session, one thread each): 0 of 30 such rounds in three pairs; centaur2-4 13 min against 23,
+  // FAUST_r 016-020 36 min against 60+ (the whole batch got stuck twice in its level 6), and
+  // FAUST_r 024-043, which had never finished, in 23 min.
+  double greedy_fallback = 0.125;
   // Rounds after the first solve each connected component of their LP (rows joined through a
   // shared column) on its own: the parts below exact_below exactly, the others with the
   // first-order solver and their own cap, and an infeasible part's proof blames only the
