@@ -87,9 +87,8 @@ struct RoundingOptions {
   // infeasible 16 times in 30 (from an optimal LP) and 5 in 5 (from one at its cap), against
   // 0-7 % after rounds whose candidates stood away from (0.1, 0.9). With 0.125 (fifty-second
   // session, one thread each): 0 of 26 such rounds in three pairs; TOSCA_r centaur2-4 13 min
-  // against 23, FAUST_r 016-020 36 min against over 100 (the whole batch: stuck twice in its
-  // level 6 and thrashing in its third attempt), and FAUST_r 024-043, which had never finished,
-  // in 23 min.
+  // against 23, FAUST_r 016-020 36 min against over 100 (the whole batch: stuck three times in
+  // its level 6 and not finished), and FAUST_r 024-043, which had never finished, in 23 min.
   double greedy_fallback = 0.125;
   // Rounds after the first solve each connected component of their LP (rows joined through a
   // shared column) on its own: the parts below exact_below exactly, the others with the
