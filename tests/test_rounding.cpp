@@ -851,6 +851,43 @@ TEST_CASE("rounding: a stalled remainder is finished by search, releasing the fi
   for (const RoundingRound& k : b.rounds) CHECK(k.searched_parts == 0);
 }
 
+TEST_CASE("rounding: the rounds after a search released fixings are not counted as stalled") {
+  // odd_cycle_behind_a with search only up to 3 variables: round 1 fixes a, round 2 searches the
+  // odd cycle and releases a, round 3 has 5 free variables again, more than round 2's low. With
+  // the stall rule at its tightest (one round, any time), that round must still run its LP (the
+  // release starts the rule afresh): it fixes a again, and round 4's search finds the cycle again
+  // with no release left (max_releases 1), an InfeasibleError that is not a StuckError.
+  const LpProblem lp = odd_cycle_behind_a();
+  const ProductSpace space = five_variables();
+  RoundingOptions options;
+  options.solver = "clp-dual";
+  options.max_backtracks = 0;
+  options.search_stall = 0;
+  options.search_below = 3;
+  options.max_releases = 1;
+  options.stuck_after = 1e-12;
+  options.stuck_rounds = 100;
+  options.stuck_stalled = 1;
+  std::vector<RoundingRound> seen;
+  bool stuck = false;
+  try {
+    round_to_graph_surface(space, lp, {0, 10, 0, 0, 0}, options, [&](const RoundingRound& r) { seen.push_back(r); });
+    FAIL("no InfeasibleError");
+  } catch (const StuckError& e) {
+    stuck = true;
+    MESSAGE(std::string(e.what()));
+  } catch (const InfeasibleError& e) {
+    CHECK(std::string(e.what()).find("releases") != std::string::npos);
+  }
+  CHECK(!stuck);
+  REQUIRE(seen.size() == 3);  // round 4 threw before reporting
+  CHECK(seen[1].search);
+  CHECK(seen[1].released == 1);
+  CHECK(!seen[2].search);
+  CHECK(seen[2].variables == 5);
+  CHECK(seen[2].fixed_to_one == 1);
+}
+
 TEST_CASE("rounding: a searched part with no binary solution and no fixing near it ends in InfeasibleError") {
   // a + a' = 1 (a' costs 10) beside an odd cycle x0 + x1 = x1 + x2 = x2 + x0 = 1 that shares no
   // row with it: round 1 fixes a, the search of round 2 proves the cycle has no binary solution,

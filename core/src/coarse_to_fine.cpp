@@ -1386,6 +1386,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
       if (s) {
         std::vector<int> before = extra;
         before.resize(lx.mesh.num_faces(), 0);
+        spdlog::info("level {}: {}", l + 1, e.what());  // which rule: the widening's line does not say
         if (widen_at(m, proof, "stuck in rounding")) {
           ++rep.stuck_widenings;
           carried_ones.clear();

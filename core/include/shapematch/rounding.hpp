@@ -153,7 +153,8 @@ struct RoundingOptions {
   // and are undone in turn never fail stuck_rounds times in a row). Measured at full resolution:
   // FAUST_r 020-024 without WKS, level 5, 41 rounds and 6 minutes between 20 k and 50 k free
   // variables after a low of 11 k; the longest such stall in runs that finished, 12 rounds and
-  // 15 s against a 113 s first LP. 0: off.
+  // 15 s against a 113 s first LP. Counted afresh after every release of fixings (a failed LP's
+  // or a search's). 0: off.
   int stuck_stalled = 12;
   // Give up (StuckError) once the rounds after round 1 have done over this many times round 1's
   // work in all, whatever they did: a budget for a rounding whose Γ is optional (coarse to fine's
