@@ -1308,6 +1308,28 @@ TEST_CASE("coarse to fine: the divergence watch stops first LPs with widenings l
   CHECK_FALSE(watch_divergence(s));
 }
 
+TEST_CASE("coarse to fine: where the watch is no longer trusted, the first LPs are watched patiently") {
+  using detail::FirstLpState;
+  using detail::watch_patiently;
+  const FirstLpState untrusted{.refined = true, .widenings_left = true, .trusted = false};
+  CHECK(watch_patiently(untrusted));
+  FirstLpState s = untrusted;
+  s.trusted = true;  // watched as before, not patiently
+  CHECK_FALSE(watch_patiently(s));
+  CHECK(detail::watch_divergence(s));
+  s = untrusted;
+  s.widenings_left = false;  // the last attempts still wait for a proof
+  CHECK_FALSE(watch_patiently(s));
+  s = untrusted;
+  s.refined = false;
+  CHECK_FALSE(watch_patiently(s));
+  s = untrusted;
+  s.warm_resolve = true;
+  CHECK_FALSE(watch_patiently(s));
+  s.watch_resolve = true;
+  CHECK(watch_patiently(s));
+}
+
 TEST_CASE("coarse to fine: after N suspicions in a row the watch is off until a proof") {
   detail::SuspicionCount s(3);
   CHECK(s.trusted());

@@ -539,8 +539,8 @@ TEST_CASE("pdhg: the divergence watch on the windows of measured full-resolution
   struct Window {
     double primal, gap, objective, bound;
   };
-  auto first_stop = [](const std::vector<Window>& windows, double tolerance = 3e-3) {
-    detail::DivergenceWatch watch(tolerance);
+  auto first_stop = [](const std::vector<Window>& windows, double tolerance = 3e-3, bool patient = false) {
+    detail::DivergenceWatch watch(tolerance, patient);
     for (size_t w = 0; w < windows.size(); ++w)
       if (watch.diverging(windows[w].primal, windows[w].gap, windows[w].objective, windows[w].bound)) return int(w);
     return -1;
@@ -595,4 +595,30 @@ TEST_CASE("pdhg: the divergence watch on the windows of measured full-resolution
   // A flat residual with the bound far above and rising stops whatever the gap (made-up first
   // window; the second is FAUST_r 021-024's at 1 536 iterations with a smaller gap).
   CHECK(first_stop({{1.20e-2, 2.0e-2, 44.80, 46.0}, {1.16e-2, 2.5e-2, 45.56, 58.84}}) == 1);
+
+  // Patient (a level that no longer trusts the watch): TOSCA_r dog3-dog8's finest LP of 12.7 M
+  // variables (fifty-fourth session), 4 608 to 9 728 iterations: the residual flat at 3.65e-3,
+  // the gap over the tolerance from the third window and growing, the bound rising. The watch
+  // stops it at the creeping rule's fourth window; patient, after eight (9 216 iterations).
+  const std::vector<Window> dog = {
+      {3.705e-3, 2.442e-3, 2.1709, 2.1815}, {3.673e-3, 2.646e-3, 2.1733, 2.1848}, {3.652e-3, 3.592e-3, 2.1746, 2.1903},
+      {3.652e-3, 4.778e-3, 2.1756, 2.1965}, {3.651e-3, 6.057e-3, 2.1764, 2.2029}, {3.655e-3, 7.323e-3, 2.1770, 2.2091},
+      {3.661e-3, 8.373e-3, 2.1783, 2.2151}, {3.667e-3, 1.063e-2, 2.1793, 2.2261}, {3.671e-3, 1.347e-2, 2.1800, 2.2395},
+      {3.674e-3, 1.646e-2, 2.1805, 2.2535}, {3.676e-3, 1.945e-2, 2.1810, 2.2675}};
+  CHECK(first_stop(dog) == 5);
+  CHECK(first_stop(dog, 3e-3, true) == 9);
+  // A window that breaks the climb (the residual falling 30 %) starts the count again.
+  std::vector<Window> broken = dog;
+  broken[6].primal = 2.4e-3;
+  CHECK(first_stop(broken, 3e-3, true) == -1);
+  // Patient, the windows above that stop impatiently do not stop: the gap rule's, the far bound's,
+  // horse0-5's slow climb (five windows).
+  CHECK(first_stop({{2.55e-2, 1.74e-2, 21.31, 22.06}, {1.22e-2, 3.67e-2, 23.21, 24.98},
+                    {8.25e-3, 6.45e-2, 24.24, 27.58}, {7.53e-3, 1.14e-1, 24.79, 31.15}},
+                   3e-3, true) == -1);
+  CHECK(first_stop({{1.20e-2, 2.0e-2, 44.80, 46.0}, {1.16e-2, 2.5e-2, 45.56, 58.84}}, 3e-3, true) == -1);
+  CHECK(first_stop({{1.54e-3, 4.07e-3, 62.05, 62.56}, {1.27e-3, 6.30e-3, 62.24, 63.03},
+                    {1.16e-3, 9.16e-3, 62.34, 63.49}, {1.12e-3, 1.31e-2, 62.41, 64.07},
+                    {1.10e-3, 1.69e-2, 62.46, 64.60}},
+                   3e-3, true) == -1);
 }

@@ -1177,12 +1177,14 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
       RoundingOptions ro = rounding_for(l);
       const bool carrying = l > 0 && !carried_ones.empty();
       const bool warm_resolve = price_warm && !carrying;
-      ro.lp.stop_on_divergence = detail::watch_divergence(
-          {.refined = l > 0,
-           .widenings_left = options_.local_widening && local < options_.max_local_widenings,
-           .trusted = suspicions.trusted(),
-           .warm_resolve = warm_resolve,
-           .watch_resolve = options_.watch_resolve});
+      const detail::FirstLpState first_state{.refined = l > 0,
+                                             .widenings_left =
+                                                 options_.local_widening && local < options_.max_local_widenings,
+                                             .trusted = suspicions.trusted(),
+                                             .warm_resolve = warm_resolve,
+                                             .watch_resolve = options_.watch_resolve};
+      ro.lp.patient_divergence_watch = detail::watch_patiently(first_state);
+      ro.lp.stop_on_divergence = detail::watch_divergence(first_state) || ro.lp.patient_divergence_watch;
       if (l > 0 && options_.warm_widening && !carrying && !going_on) {  // (a restart starts cold)
         if (!warm.empty()) warm.apply(m, ro.lp);
       }
@@ -1421,7 +1423,9 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
         }
         continue;
       }
-      if (!e.certified()) {  // nothing left to widen locally on a suspicion: solve for a proof
+      // Nothing left to widen locally on a suspicion: solve for a proof, or where the patient
+      // watch (not trusted) stopped it, on to the wider widenings below as on a proof.
+      if (!e.certified() && suspicions.trusted()) {
         suspicions.distrust();
         continue;
       }

@@ -23,6 +23,14 @@ inline bool watch_divergence(const FirstLpState& s) {
   return !s.warm_resolve || s.watch_resolve;
 }
 
+// Where the watch is no longer trusted, it still watches, patiently (SolverParams::
+// patient_divergence_watch): unwatched, an infeasible LP runs to its iteration cap, 10⁶ (TOSCA_r
+// dog3-dog8 at full resolution: its finest LP was still climbing after 45 minutes).
+inline bool watch_patiently(const FirstLpState& s) {
+  if (!s.refined || !s.widenings_left || s.trusted) return false;
+  return !s.warm_resolve || s.watch_resolve;
+}
+
 // Whether a level still trusts the watch: after `limit` widenings in a row on suspicions
 // (first LPs the watch stopped, no proof) it does not, until a proof of infeasibility. Measured
 // (thirty-fifth session): at the curvature radius 0.05, TOSCA_r horse0-5's 1 414-face level

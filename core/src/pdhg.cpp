@@ -160,7 +160,7 @@ LpResult PdhgSolver::solve(const LpProblem& problem, const SolverParams& params)
   double restart_base = -1.0, previous = std::numeric_limits<double>::infinity();
   // Divergence watch (params.stop_on_divergence); the dual at the start of each window gives
   // the growth returned as the ray.
-  detail::DivergenceWatch watch(params.tolerance);
+  detail::DivergenceWatch watch(params.tolerance, params.patient_divergence_watch);
   int64_t window_end = detail::DivergenceWatch::kWindow;
   std::vector<double> window_y;
   int restarts = 0;
