@@ -1236,8 +1236,8 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
         // A release frees far more than the rounds after it fix at once: the stall rule starts
         // afresh, as after a release on a failed LP (below). Measured, TOSCA_r horse0-horse5 at
         // full resolution: a search released 2 955 fixings, the stall clock ran on from the low
-        // before it, and 55 rounds later the first round after another release (a 5.6 M-variable
-        // LP, 22 minutes) was called stuck, widening 3 498 of 3 758 faces.
+        // before it, and 57 rounds later, right after the first round after another release (a
+        // 5.6 M-variable LP, 22 minutes), the rounding was called stuck: 3 498 of 3 758 faces widened.
         fewest_free = std::numeric_limits<int64_t>::max();
         stalled = 0;
         since_low.reset();
