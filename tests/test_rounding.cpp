@@ -792,6 +792,16 @@ ProductSpace five_variables() {
   return ProductSpace::from_list(o, o, {id[0], id[1], id[2], id[3], id[4]});
 }
 
+// Exact LPs, no backtracking over rounds, search as soon as the free variables are few enough:
+// odd_cycle_behind_a's fixing of a can only go by a release.
+RoundingOptions search_without_backtracking() {
+  RoundingOptions options;
+  options.solver = "clp-dual";
+  options.max_backtracks = 0;
+  options.search_stall = 0;
+  return options;
+}
+
 }  // namespace
 
 TEST_CASE("rounding: a fixing of an earlier round that leaves no binary solution is undone") {
@@ -821,10 +831,7 @@ TEST_CASE("rounding: a stalled remainder is finished by search, releasing the fi
   // is off), and the search over the whole LP then branches past x = 1/2 to a' = 1.
   const LpProblem lp = odd_cycle_behind_a();
   const ProductSpace space = five_variables();
-  RoundingOptions options;
-  options.solver = "clp-dual";
-  options.max_backtracks = 0;
-  options.search_stall = 0;
+  RoundingOptions options = search_without_backtracking();
   const RoundingResult r = round_to_graph_surface(space, lp, {0, 10, 0, 0, 0}, options);
   CHECK(r.gamma == std::vector<int64_t>{1});
   CHECK(r.energy == 10.0);
@@ -859,10 +866,7 @@ TEST_CASE("rounding: the rounds after a search released fixings are not counted 
   // with no release left (max_releases 1), an InfeasibleError that is not a StuckError.
   const LpProblem lp = odd_cycle_behind_a();
   const ProductSpace space = five_variables();
-  RoundingOptions options;
-  options.solver = "clp-dual";
-  options.max_backtracks = 0;
-  options.search_stall = 0;
+  RoundingOptions options = search_without_backtracking();
   options.search_below = 3;
   options.max_releases = 1;
   options.stuck_after = 1e-12;

@@ -52,11 +52,12 @@ public:
       // the objective, the gap growing, the residual flat (TOSCA_r horse0-5's finest LP: residual
       // 1.2e-3 → 1.0e-3 while the gap grew 4.3e-3 → 3.8e-2 over 3 600 iterations, its bound rising
       // about 1.1 per window against an objective of 63).
-      creeping_ = flat && bound > objective && gap > tolerance_ && gap > gap_ ? creeping_ + 1 : 0;
+      const bool creep = flat && bound > objective && gap > tolerance_ && gap > gap_;
+      creeping_ = creep ? creeping_ + 1 : 0;
       stop = stop || creeping_ >= kCreepingWindows;
       // Patient: the bound must also rise each window, and the rules above and below do not count
       // (the LP the thirty-fifth session let run, feasible, had its residual falling 30x).
-      climbing_ = flat && bound > objective && bound > bound_ && gap > tolerance_ && gap > gap_ ? climbing_ + 1 : 0;
+      climbing_ = creep && bound > bound_ ? climbing_ + 1 : 0;
       if (patient_) stop = climbing_ >= kPatientWindows;
       // The bound pulling away from the objective for three windows in a row, whatever the
       // residual does once near feasible: above it and further each window, at the last more than
