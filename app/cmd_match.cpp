@@ -749,7 +749,7 @@ Action add_match_command(CLI::App& app) {
       ->capture_default_str();
   app.add_option("--max-suspected-widenings", a->max_suspected_widenings,
                  "widenings in a row at a level on first LPs that the divergence watch stopped (no proof) before "
-                 "the level's next first LPs run unwatched, to an optimum or a proof (0: no limit)")
+                 "the level's next first LPs are watched patiently, stopped only by a long climb (0: no limit)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   app.add_option("--suspicion-rings", a->suspicion_rings,

@@ -1308,7 +1308,7 @@ TEST_CASE("coarse to fine: the divergence watch stops first LPs with widenings l
   CHECK_FALSE(watch_divergence(s));
 }
 
-TEST_CASE("coarse to fine: where the watch is no longer trusted, the first LPs are watched patiently") {
+TEST_CASE("coarse to fine: where the watch is no longer trusted or out of local widenings, the first LPs are watched patiently") {
   using detail::FirstLpState;
   using detail::watch_patiently;
   const FirstLpState untrusted{.refined = true, .widenings_left = true, .trusted = false};
@@ -1318,16 +1318,38 @@ TEST_CASE("coarse to fine: where the watch is no longer trusted, the first LPs a
   CHECK_FALSE(watch_patiently(s));
   CHECK(detail::watch_divergence(s));
   s = untrusted;
-  s.widenings_left = false;  // the last attempts still wait for a proof
+  s.widenings_left = false;  // nothing left to widen at all: it waits for a proof or an optimum
+  CHECK_FALSE(watch_patiently(s));
+  s.ring_left = true;  // out of local widenings, a ring left: its stop widens by the ring
+  CHECK(watch_patiently(s));
+  s.trusted = true;  // so too where no suspicion came before (the quick watch needs widenings left)
+  CHECK(watch_patiently(s));
+  CHECK_FALSE(detail::watch_divergence(s));
+  s.ring_left = false;
   CHECK_FALSE(watch_patiently(s));
   s = untrusted;
   s.refined = false;
   CHECK_FALSE(watch_patiently(s));
+  s.ring_left = true;  // the coarsest level is the full space
+  CHECK_FALSE(watch_patiently(s));
   s = untrusted;
   s.warm_resolve = true;
   CHECK_FALSE(watch_patiently(s));
+  s.widenings_left = false;
+  s.ring_left = true;
+  CHECK_FALSE(watch_patiently(s));
   s.watch_resolve = true;
   CHECK(watch_patiently(s));
+  // Never both watches: one LP, one rule.
+  for (int bits = 0; bits < 64; ++bits) {
+    const FirstLpState t{.refined = bool(bits & 1),
+                         .widenings_left = bool(bits & 2),
+                         .ring_left = bool(bits & 4),
+                         .trusted = bool(bits & 8),
+                         .warm_resolve = bool(bits & 16),
+                         .watch_resolve = bool(bits & 32)};
+    CHECK_FALSE((watch_patiently(t) && detail::watch_divergence(t)));
+  }
 }
 
 TEST_CASE("coarse to fine: after N suspicions in a row the watch is off until a proof") {

@@ -1173,6 +1173,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
         if (widen_around(options_.widen_around, "infeasible nearby (pre-emptively)")) continue;
       }
     }
+    bool watched_patiently = false;  // this attempt's first LP (its stop is not a suspicion to re-solve)
     try {
       RoundingOptions ro = rounding_for(l);
       const bool carrying = l > 0 && !carried_ones.empty();
@@ -1180,10 +1181,11 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
       const detail::FirstLpState first_state{.refined = l > 0,
                                              .widenings_left =
                                                  options_.local_widening && local < options_.max_local_widenings,
+                                             .ring_left = ring < options_.max_ring,
                                              .trusted = suspicions.trusted(),
                                              .warm_resolve = warm_resolve,
                                              .watch_resolve = options_.watch_resolve};
-      ro.lp.patient_divergence_watch = detail::watch_patiently(first_state);
+      ro.lp.patient_divergence_watch = watched_patiently = detail::watch_patiently(first_state);
       ro.lp.stop_on_divergence = detail::watch_divergence(first_state) || ro.lp.patient_divergence_watch;
       if (l > 0 && options_.warm_widening && !carrying && !going_on) {  // (a restart starts cold)
         if (!warm.empty()) warm.apply(m, ro.lp);
@@ -1411,7 +1413,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
         if (e.certified()) {
           suspicions.proof();
         } else if (suspicions.suspicion()) {
-          spdlog::info("level {}: {} on a diverging PDHG, none proved: the next first LPs run unwatched", l + 1,
+          spdlog::info("level {}: {} on a diverging PDHG, none proved: the next first LPs are watched patiently", l + 1,
                        suspicions.count() == 1 ? std::string("a widening")
                                                : fmt::format("{} widenings in a row", suspicions.count()));
           // An unwatched LP costs what several watched ones do: give it room around every
@@ -1424,8 +1426,8 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
         continue;
       }
       // Nothing left to widen locally on a suspicion: solve for a proof, or where the patient
-      // watch (not trusted) stopped it, on to the wider widenings below as on a proof.
-      if (!e.certified() && suspicions.trusted()) {
+      // watch stopped it, on to the wider widenings below as on a proof.
+      if (!e.certified() && suspicions.trusted() && !watched_patiently) {
         suspicions.distrust();
         continue;
       }

@@ -13,7 +13,8 @@ public:
   static constexpr long kWindow = 512;
 
   // `patient`: only the creeping climb below counts, and for kPatientWindows windows in a row: for
-  // a first LP whose earlier suspicions came to nothing (coarse to fine then let it run unwatched;
+  // a first LP whose earlier suspicions came to nothing, or one out of local widenings
+  // (detail::watch_patiently; coarse to fine used to let those run unwatched:
   // measured, TOSCA_r dog3-dog8 at full resolution: a 12.7 M-variable LP, residual flat at
   // 3.65-3.69e-3 against a tolerance of 3e-3 from 5 000 to 16 000 iterations while its bound rose
   // 2.19 → 2.78 above an objective of 2.18, 45 minutes on one thread, under a cap of 10⁶).

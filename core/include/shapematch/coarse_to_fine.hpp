@@ -108,21 +108,22 @@ struct CoarseToFineOptions {
   // cold first LP's iterations anyway (detail::watch_divergence says why).
   bool watch_resolve = false;
   // Where this many widenings in a row at a level came from a first LP that the divergence watch
-  // stopped (a suspicion, no proof), the level's next first LPs run unwatched, to an optimum or a
-  // proof. 0: no limit. Measured, TOSCA_r horse0-5 and centaur0-2 at R = 0.05 on an H200: 24
-  // suspicions in a row each at their 1 414-face level (6.2 % → 21.6 % of the full space), and
-  // one such first LP, let run, was feasible (docs/results-log.md, thirty-fifth session). 1 since
-  // the forty-ninth session: the local widenings of the second and third suspicions cured no
-  // measured LP (FAUST_r 029-063, TOSCA_r dog3-dog8 and centaur0-centaur2 at μ = 10), the region
-  // widening after them did; centaur0-centaur2's level 5 from level 4's checkpoint: 40:56 against
-  // 47:40 with 3, one watched LP against three, energy 3.96548 against 3.96513.
+  // stopped (a suspicion, no proof), the level's next first LPs are watched patiently (only a long
+  // climb stops them; detail::watch_patiently), until a proof. 0: no limit. Measured, TOSCA_r
+  // horse0-5 and centaur0-2 at R = 0.05 on an H200: 24 suspicions in a row each at their 1 414-face
+  // level (6.2 % → 21.6 % of the full space), and one such first LP, let run, was feasible
+  // (docs/results-log.md, thirty-fifth session). 1 since the forty-ninth session: the local
+  // widenings of the second and third suspicions cured no measured LP (FAUST_r 029-063, TOSCA_r
+  // dog3-dog8 and centaur0-centaur2 at μ = 10), the region widening after them did;
+  // centaur0-centaur2's level 5 from level 4's checkpoint: 40:56 against 47:40 with 3, one watched
+  // LP against three, energy 3.96548 against 3.96513.
   int max_suspected_widenings = 1;
   // Where max_suspected_widenings ends the watch, every X face within this many fine rings of the
-  // faces widened so far at the level gets one more ring before the unwatched LP, each time. The
-  // suspicions' own places (the window's dual growth) are narrow: measured, FAUST_r 029-063 at
-  // μ = 10, level 6: suspicions widened 497, 24, 47, 9, 17, 14, 15 faces, mostly faces widened
-  // already, while the two unwatched LPs' Farkas proofs named 13 and 853; 100 minutes on one core
-  // without a round (forty-fourth session). With 2 (forty-fifth session, from level 5's
+  // faces widened so far at the level gets one more ring before the patiently watched LP, each
+  // time. The suspicions' own places (the window's dual growth) are narrow: measured, FAUST_r
+  // 029-063 at μ = 10, level 6: suspicions widened 497, 24, 47, 9, 17, 14, 15 faces, mostly faces
+  // widened already, while the two unwatched LPs' Farkas proofs named 13 and 853; 100 minutes on
+  // one core without a round (forty-fourth session). With 2 (forty-fifth session, from level 5's
   // checkpoint): after the same first three suspicions it widened 1 334 faces, the unwatched LP
   // (11.2 M variables) was optimal in 4.4 minutes, and level 6 ended in 31 minutes, gap 1.12 %,
   // error 0.0221 (0.0317 at μ = 1). 0: off.
