@@ -1408,15 +1408,15 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
       }
       carried_ones.clear();  // the widenings below start afresh
       if (!s && widen_at(m, proof, e.certified() ? "infeasible" : "probably infeasible (PDHG diverging)")) {
-        // A suspicion that keeps coming back is checked: the next first LPs run to an optimum or
-        // a proof. A proof restores the watch.
+        // A suspicion that keeps coming back is checked: the next first LPs are watched patiently.
+        // A proof restores the watch.
         if (e.certified()) {
           suspicions.proof();
         } else if (suspicions.suspicion()) {
           spdlog::info("level {}: {} on a diverging PDHG, none proved: the next first LPs are watched patiently", l + 1,
                        suspicions.count() == 1 ? std::string("a widening")
                                                : fmt::format("{} widenings in a row", suspicions.count()));
-          // An unwatched LP costs what several watched ones do: give it room around every
+          // A patiently watched LP costs what several quickly watched ones do: room around every
           // suspicion first (CoarseToFineOptions::suspicion_rings says why).
           if (options_.suspicion_rings > 0 &&
               widen_around(options_.suspicion_rings, "probably infeasible around its widenings"))

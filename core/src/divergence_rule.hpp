@@ -13,16 +13,17 @@ struct FirstLpState {
   bool watch_resolve = false;   // CoarseToFineOptions::watch_resolve
 };
 
+// Either watch: a refined level's first LP (the coarsest is the full space), not the re-solve
+// after pricing unless asked for (why: below).
+inline bool watchable(const FirstLpState& s) { return s.refined && (!s.warm_resolve || s.watch_resolve); }
+
 // A diverging first LP is reason enough to widen while local widenings remain (it only adds
-// variables); the last attempts wait for a proof. Not the re-solve after pricing: its space only
+// variables); past that, watch_patiently below. Not the re-solve after pricing: its space only
 // grew from one whose LP ended optimal, so a feasible point of about that residual is in it, and
 // its iteration cap (the cold first LP's) bounds what it costs. Measured, FAUST_r 065-069 at full
 // resolution (twenty-fifth session): the watch stopped such a re-solve at a primal residual under
 // the tolerance; the widening it led to cost a 1 136-face rebuild and a 924 s cold LP.
-inline bool watch_divergence(const FirstLpState& s) {
-  if (!s.refined || !s.widenings_left || !s.trusted) return false;
-  return !s.warm_resolve || s.watch_resolve;
-}
+inline bool watch_divergence(const FirstLpState& s) { return watchable(s) && s.widenings_left && s.trusted; }
 
 // Where the watch is not used as above, it still watches, patiently (SolverParams::
 // patient_divergence_watch), as long as something is left to widen when it stops: locally after a
@@ -31,9 +32,7 @@ inline bool watch_divergence(const FirstLpState& s) {
 // iteration cap, 10⁶ (TOSCA_r dog3-dog8 at full resolution: its finest LP was still climbing
 // after 45 minutes; at 4.9 iterations a second on one core, 10⁶ is 57 hours).
 inline bool watch_patiently(const FirstLpState& s) {
-  if (!s.refined || (s.warm_resolve && !s.watch_resolve)) return false;
-  if (s.trusted && s.widenings_left) return false;  // watch_divergence's
-  return s.widenings_left || s.ring_left;
+  return watchable(s) && !watch_divergence(s) && (s.widenings_left || s.ring_left);
 }
 
 // Whether a level still trusts the watch: after `limit` widenings in a row on suspicions
