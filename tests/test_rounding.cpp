@@ -532,9 +532,10 @@ namespace {
 
 // Variables a, a', c, y1..y5, w1, w2, b1, b1', b2, b2'. a + a' = 1; a' = c; y_i + y_{i+1} + c = 1
 // around a 5-cycle; y1 + ... + y5 + w1 + w2 = 2; b_k + b_k' = 1. a' and b_k' cost 10 (`cost`).
-LpProblem cycle_behind_a_fixing(std::vector<double>& cost, bool linked = false) {
-  const int n = linked ? 15 : 14;
-  std::vector<std::vector<int>> rows(linked ? 11 : 10, std::vector<int>(n, 0));
+// `links` 1: b1 = 1 forces a = 1 too; 2: b1 and b2 force each other, and together a = 1.
+LpProblem cycle_behind_a_fixing(std::vector<double>& cost, int links = 0) {
+  const int n = 14 + links + (links == 2);
+  std::vector<std::vector<int>> rows(10 + links + (links == 2), std::vector<int>(n, 0));
   rows[0][0] = rows[0][1] = 1;
   rows[1][1] = 1;
   rows[1][2] = -1;
@@ -543,9 +544,17 @@ LpProblem cycle_behind_a_fixing(std::vector<double>& cost, bool linked = false) 
   rows[8][10] = rows[8][11] = 1;
   rows[9][12] = rows[9][13] = 1;
   std::vector<double> b{1, 0, 1, 1, 1, 1, 1, 2, 1, 1};
-  if (linked) {  // b1 + a' + s = 1 with a slack s: b1 = 1 forces a' = 0, hence a = 1
+  if (links == 1) {  // b1 + a' + s = 1 with a slack s: b1 = 1 forces a' = 0, hence a = 1
     rows[10][10] = rows[10][1] = rows[10][14] = 1;
     b.push_back(1);
+  } else if (links == 2) {
+    // b1 + b2' + s = 1 and b2 + b1' + s' = 1: b1 = b2; b1 + b2 + a' + s'' = 2: both 1 force
+    // a' = 0. The LP has b1 = b2 = 0.9 above a = 0.8 (cost 10 a' + 20 (1 - b), b <= 1 - a'/2,
+    // a' >= 1/5).
+    rows[10][10] = rows[10][13] = rows[10][14] = 1;
+    rows[11][12] = rows[11][11] = rows[11][15] = 1;
+    rows[12][10] = rows[12][12] = rows[12][1] = rows[12][16] = 1;
+    b.insert(b.end(), {1, 1, 2});
   }
   cost.assign(n, 0.0);
   cost[1] = cost[11] = cost[13] = 10.0;
@@ -562,10 +571,10 @@ ProductSpace stand_in_space(const LpProblem& lp) {
 
 // Rounds cycle_behind_a_fixing on a stand-in space of its size with PDHG, whose infeasibility
 // proof is a dual point (Clp's names no rows), and checks A x = b.
-RoundingResult round_cycle(RoundingOptions options, bool linked = false,
+RoundingResult round_cycle(RoundingOptions options, int links = 0,
                            const std::function<void(const RoundingRound&)>& progress = {}) {
   std::vector<double> cost;
-  const LpProblem lp = cycle_behind_a_fixing(cost, linked);
+  const LpProblem lp = cycle_behind_a_fixing(cost, links);
   const ProductSpace space = stand_in_space(lp);
   options.solver = "pdhg-cpu";
   options.exact_below = 0;
@@ -1050,13 +1059,32 @@ TEST_CASE("rounding: an undone fixing whose blamed part comes back by propagatio
   // 5 zeros again) and the same LP is solved twice.
   RoundingOptions options;
   options.lp.threads = 1;  // the same iterates on any machine
-  const RoundingResult r = round_cycle(options, true);
+  const RoundingResult r = round_cycle(options, 1);
   REQUIRE(r.rounds.size() >= 3);
   CHECK(r.rounds[0].fixed_to_one == 3);
   CHECK(r.rounds[1].status == LpStatus::Infeasible);
   CHECK(r.rounds[1].undone);
   CHECK(r.rounds[1].fixed_to_one + r.rounds[1].fixed_to_zero < r.rounds[0].fixed_to_one + r.rounds[0].fixed_to_zero);
   CHECK(r.rounds[2].status == LpStatus::Optimal);  // another LP than round 2's
+}
+
+TEST_CASE("rounding: an undone fixing whose every half comes back by propagation is not solved again") {
+  // cycle_behind_a_fixing with two links: b1 and b2 force each other, and both a' = 0, a = 1.
+  // Round 1 fixes b1, b2 and a; the next LP is infeasible and its proof blames a, which b1 and
+  // b2 bring back; so does half the batch (b1 or b2 alone): the failed state, whose LP was
+  // solved again before the rule. Now the single b cannot be 1: both go to 0, which forces
+  // a' = 1 and with it everything left.
+  RoundingOptions options;
+  options.lp.threads = 1;
+  const RoundingResult r = round_cycle(options, 2);
+  REQUIRE(r.rounds.size() >= 2);
+  CHECK(r.rounds[0].fixed_to_one == 3);
+  CHECK(r.rounds[1].status == LpStatus::Infeasible);
+  CHECK(r.rounds[1].undone);
+  int infeasible = 0;
+  for (const auto& k : r.rounds) infeasible += k.status == LpStatus::Infeasible;
+  CHECK(infeasible == 1);  // before: 2, the second the same LP as the first
+  CHECK(r.energy == 30.0);  // a' = b1' = b2' = 1: a = 1 leaves the cycle nothing, either b = 1 a = 1
 }
 
 TEST_CASE("rounding: a part at its iteration cap goes on from its iterate before it is fixed from it") {

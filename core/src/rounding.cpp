@@ -1050,15 +1050,36 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
       if (shrinkable) {
         try {
           auto kept = shrink_and_fix(fixer, smaller, step.mark, false);  // if still infeasible, shrink further
-          // The fixings the proof left propagate to those it blamed (the state, a subset of the
-          // infeasible one, has as many fixings): the same LP again. Halve the batch instead
-          // (measured, FAUST_r 021-029 at full resolution: the same round, 1 208 fixings to 1
-          // and an infeasible LP, five times in a row at 75 s each).
-          if (by_proof && fixer.state().ones == ones_before && fixer.state().zeros == zeros_before) {
+          // The failed state again: fixings of this step as it was applied there (a subset of
+          // that state) that propagate to as many assignments; its LP is the one just proved
+          // infeasible.
+          const std::set<std::pair<int64_t, int>> applied(step.batch.begin(), step.batch.end());
+          const auto as_failed = [&] {
+            if (fixer.state().ones != ones_before || fixer.state().zeros != zeros_before) return false;
+            for (const auto& a : kept)
+              if (!applied.count(a)) return false;
+            return true;
+          };
+          // The fixings the proof left propagate to those it blamed: halve the whole batch
+          // instead (measured, FAUST_r 021-029 at full resolution: the same round, 1 208 fixings
+          // to 1 and an infeasible LP, five times in a row at 75 s each).
+          if (by_proof && as_failed()) {
             fixer.undo_to(step.mark);
             smaller = step.batch;
             smaller.resize(std::max<size_t>(1, smaller.size() / 2));
             kept = shrink_and_fix(fixer, smaller, step.mark, false);
+          }
+          // Halves can bring it back too: trim on until the state differs (measured,
+          // deformation-transfer gallop 0001-0017 without WKS at full resolution: after a trim
+          // to 6 fixings the next LP had the failed one's 3 270 575 variables and iterations,
+          // and took another 257 s to be proved infeasible again). A single fixing to 1 that
+          // brings it back cannot be 1; one to 0 means an earlier step must go (the catch below).
+          while (as_failed()) {
+            fixer.undo_to(step.mark);
+            if (kept.size() > 1) kept.resize(kept.size() / 2);
+            else if (kept.front().second == 1) kept.front().second = 0;
+            else throw InfeasibleError("rounding: the step brings back the failed state whole");
+            kept = shrink_and_fix(fixer, kept, step.mark, false);
           }
           step.batch = std::move(kept);
           return false;
