@@ -1069,11 +1069,11 @@ TEST_CASE("rounding: an undone fixing whose blamed part comes back by propagatio
 }
 
 TEST_CASE("rounding: an undone fixing whose every half comes back by propagation is not solved again") {
-  // cycle_behind_a_fixing with two links: b1 and b2 force each other, and both a' = 0, a = 1.
-  // Round 1 fixes b1, b2 and a; the next LP is infeasible and its proof blames a, which b1 and
-  // b2 bring back; so does half the batch (b1 or b2 alone): the failed state, whose LP was
-  // solved again before the rule. Now the single b cannot be 1: both go to 0, which forces
-  // a' = 1 and with it everything left.
+  // cycle_behind_a_fixing with two links: b1 and b2 force each other, and together a' = 0,
+  // hence a = 1. Round 1 fixes b1, b2 and a (0.9, 0.9, 0.8); the next LP is infeasible (a = 1
+  // leaves the cycle nothing). What a trim keeps, b1 and b2 or the larger half b1, brings back
+  // all three: the failed state, whose LP was solved again before the rule. Now the single b1
+  // cannot be 1: both b go to 0, which forces a' = 1 and with it everything left.
   RoundingOptions options;
   options.lp.threads = 1;
   const RoundingResult r = round_cycle(options, 2);
@@ -1084,7 +1084,7 @@ TEST_CASE("rounding: an undone fixing whose every half comes back by propagation
   int infeasible = 0;
   for (const auto& k : r.rounds) infeasible += k.status == LpStatus::Infeasible;
   CHECK(infeasible == 1);  // before: 2, the second the same LP as the first
-  CHECK(r.energy == 30.0);  // a' = b1' = b2' = 1: a = 1 leaves the cycle nothing, either b = 1 a = 1
+  CHECK(r.energy == 30.0);  // a' = b1' = b2' = 1: either b = 1 forces a = 1
 }
 
 TEST_CASE("rounding: a part at its iteration cap goes on from its iterate before it is fixed from it") {
