@@ -465,6 +465,15 @@ JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpS
 
 namespace {
 
+// One step of shrinking a batch that cannot stay: halve it; a single fixing to 1 becomes one to
+// 0. False where nothing is left to shrink (a single fixing to 0).
+bool shrink_once(std::vector<std::pair<int64_t, int>>& batch) {
+  if (batch.size() > 1) batch.resize(batch.size() / 2);
+  else if (batch.front().second == 1) batch.front().second = 0;
+  else return false;
+  return true;
+}
+
 // Fixes the batch (largest first); a fixing that propagation proves infeasible is undone and
 // replaced by fixing fewer: with `greedy`, every candidate that does not clash with the larger
 // ones fixed before it (one propagation each); otherwise halving the batch down to the single
@@ -493,22 +502,12 @@ std::vector<std::pair<int64_t, int>> shrink_and_fix(Fixer& fixer, std::vector<st
     if (!kept.empty()) return kept;
     batch.resize(1);  // not even the largest alone: it must be 0
     batch.front().second = 0;
-  } else if (batch.size() > 1) {
-    batch.resize(batch.size() / 2);
-  } else if (batch.front().second == 1) {
-    batch.front().second = 0;
-  } else {
+  } else if (!shrink_once(batch)) {
     throw InfeasibleError("rounding: no consistent fixing exists (no binary solution)");
   }
   while (!fix_each(batch)) {
     fixer.undo_to(mark);
-    if (batch.size() > 1) {
-      batch.resize(batch.size() / 2);
-    } else if (batch.front().second == 1) {
-      batch.front().second = 0;
-    } else {
-      throw InfeasibleError("rounding: no consistent fixing exists (no binary solution)");
-    }
+    if (!shrink_once(batch)) throw InfeasibleError("rounding: no consistent fixing exists (no binary solution)");
   }
   return batch;
 }
@@ -1044,9 +1043,7 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
           if (a.second == 1 && !kept.count(a.first)) refuted.insert(a.first);
         smaller = std::move(away_from_proof);
       }
-      else if (smaller.size() > 1) smaller.resize(smaller.size() / 2);
-      else if (smaller.front().second == 1) smaller.front().second = 0;  // the single variable cannot be 1
-      else shrinkable = false;
+      else shrinkable = shrink_once(smaller);  // (a single variable that cannot be 1 must be 0)
       if (shrinkable) {
         try {
           auto kept = shrink_and_fix(fixer, smaller, step.mark, false);  // if still infeasible, shrink further
@@ -1076,9 +1073,7 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
           // brings it back cannot be 1; one to 0 means an earlier step must go (the catch below).
           while (as_failed()) {
             fixer.undo_to(step.mark);
-            if (kept.size() > 1) kept.resize(kept.size() / 2);
-            else if (kept.front().second == 1) kept.front().second = 0;
-            else throw InfeasibleError("rounding: the step brings back the failed state whole");
+            if (!shrink_once(kept)) throw InfeasibleError("rounding: the step brings back the failed state whole");
             kept = shrink_and_fix(fixer, kept, step.mark, false);
           }
           step.batch = std::move(kept);
