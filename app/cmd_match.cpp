@@ -76,6 +76,7 @@ struct MatchArgs {
   bool warm_widening = CoarseToFineOptions{}.warm_widening;
   bool carry_primal_weight = CoarseToFineOptions{}.carry_primal_weight;
   std::string dump_first_lps;
+  std::string dump_slow_parts;
   std::string checkpoint;
   int inherit_widening = CoarseToFineOptions{}.inherit_widening;
   int price_dual_sweeps = CoarseToFineOptions{}.price_dual_sweeps;
@@ -163,11 +164,13 @@ int run_match(const MatchArgs& args) {
   co.warm_widening = args.warm_widening;
   co.carry_primal_weight = args.carry_primal_weight;
   co.dump_first_lps = args.dump_first_lps;
-  if (!co.dump_first_lps.empty()) {
-    std::error_code ec;
-    fs::create_directories(co.dump_first_lps, ec);
-    if (ec) throw IoError(co.dump_first_lps + ": cannot create the directory (" + ec.message() + ")");
-  }
+  co.dump_slow_parts = args.dump_slow_parts;
+  for (const std::string& dir : {co.dump_first_lps, co.dump_slow_parts})
+    if (!dir.empty()) {
+      std::error_code ec;
+      fs::create_directories(dir, ec);
+      if (ec) throw IoError(dir + ": cannot create the directory (" + ec.message() + ")");
+    }
   co.inherit_widening = args.inherit_widening;
   co.price_dual_sweeps = args.price_dual_sweeps;
   co.stuck_after = args.stuck_after;
@@ -734,6 +737,9 @@ Action add_match_command(CLI::App& app) {
   app.add_option("--dump-first-lps", a->dump_first_lps,
                  "write every first LP of a rounding to this directory (level<L>-<NNN>.smlp), to solve it again "
                  "with `shapematch lp --from`");
+  app.add_option("--dump-slow-parts", a->dump_slow_parts,
+                 "write every later round's part that Clp took 10 s or more on to this directory "
+                 "(level<L>-slow-<NNN>.smlp), to solve it again with `shapematch lp --from`");
   app.add_option("--price-dual-sweeps", a->price_dual_sweeps,
                  "with --price-widenings: the re-solve starts the new rows' duals where this many sweeps of "
                  "coordinate ascent on the Lagrangian bound put them, not at 0 (0: off)")

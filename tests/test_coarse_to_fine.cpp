@@ -229,6 +229,37 @@ TEST_CASE("coarse to fine: every level's first LP can be written out and solved 
   }
 }
 
+TEST_CASE("coarse to fine: the later rounds' parts Clp was slow on can be written out and solved again") {
+  // slow_part_seconds 0: every part Clp solves in a later round counts as slow. Each file is
+  // named after its level and solves again to an optimum or a proof, as in the run.
+  const Mesh x = shapes::bent_finger(10, 8, 8), y = shapes::bent_finger(60, 8, 8);
+  CoarseToFineOptions o;
+  o.hierarchy.levels = 2;
+  o.hierarchy.coarsest_faces = 16;
+  o.rounding.solver = "pdhg-cpu";
+  o.rounding.slow_part_seconds = 0.0;
+  const test::TempDir dir;
+  o.dump_slow_parts = dir.path.string();
+  const CoarseToFineResult r = CoarseToFineMatcher(decimate(x, 50), decimate(y, 60), o).run();
+  REQUIRE(r.levels.size() == 2);
+  std::vector<std::string> names;
+  for (const auto& e : std::filesystem::directory_iterator(dir.path)) names.push_back(e.path().filename().string());
+  std::sort(names.begin(), names.end());
+  REQUIRE(!names.empty());
+  for (size_t k = 0; k < names.size(); ++k) {
+    CAPTURE(names[k]);
+    CHECK((names[k].rfind("level1-slow-", 0) == 0 || names[k].rfind("level2-slow-", 0) == 0));
+    const LpProblem lp = read_lp((dir.path / names[k]).string());
+    CHECK(lp.cols() > 0);
+    const LpResult again = solve_lp(lp, "clp-dual");
+    CHECK((again.status == LpStatus::Optimal || again.status == LpStatus::Infeasible));
+  }
+  // Numbered over the run: no two files share a number.
+  std::set<std::string> numbers;
+  for (const std::string& n : names) numbers.insert(n.substr(n.size() - 9));
+  CHECK(numbers.size() == names.size());
+}
+
 TEST_CASE("coarse to fine: a deformed pair with different triangulations ends verified") {
   const Mesh x = shapes::bent_finger(10, 8, 8), y = shapes::bent_finger(60, 8, 8);
   CoarseToFineOptions o;

@@ -1259,6 +1259,39 @@ TEST_CASE("rounding: a part solved exactly in one of the last rounds takes that 
   CHECK(clp.calls == 4);
 }
 
+TEST_CASE("rounding: a part the exact solver was slow on is handed out as solved, once") {
+  // Two independent parts (x0 + x1 = 1 and x2 + x3 = 1); `slow_part_seconds` 0 makes every exact
+  // solve slow. Each part goes to the callback as the exact solver saw it; a part that takes its
+  // result from the cache was not solved, so it is not handed out again. Above the threshold
+  // nothing is.
+  const LpProblem lp = test::dense_lp({{1, 1, 0, 0}, {0, 0, 1, 1}}, {1, 1}, {1, 2, 3, 1});
+  SolverParams params;
+  const auto pdhg = make_solver("pdhg-cpu");
+  CountingClp clp;
+  detail::ExactCache cache;
+  std::vector<LpProblem> seen;
+  const std::function<void(const LpProblem&)> keep = [&](const LpProblem& part) { seen.push_back(part); };
+  const detail::JoinedSolve a =
+      detail::solve_in_parts(lp, params, *pdhg, &clp, 10, params, true, 0.0, &cache, nullptr, keep, 0.0);
+  REQUIRE(a.r.status == LpStatus::Optimal);
+  CHECK(a.r.objective == doctest::Approx(2.0));
+  CHECK(clp.calls == 2);
+  REQUIRE(seen.size() == 2);
+  for (const LpProblem& part : seen) {
+    CHECK(part.rows() == 1);
+    CHECK(part.cols() == 2);
+  }
+  CHECK(((seen[0].c == std::vector<double>{1, 2} && seen[1].c == std::vector<double>{3, 1}) ||
+         (seen[0].c == std::vector<double>{3, 1} && seen[1].c == std::vector<double>{1, 2})));
+  detail::solve_in_parts(lp, params, *pdhg, &clp, 10, params, true, 0.0, &cache, nullptr, keep, 0.0);
+  CHECK(clp.calls == 2);  // both from the cache
+  CHECK(seen.size() == 2);
+  detail::ExactCache fresh;
+  detail::solve_in_parts(lp, params, *pdhg, &clp, 10, params, true, 0.0, &fresh, nullptr, keep, 3600.0);
+  CHECK(clp.calls == 4);
+  CHECK(seen.size() == 2);
+}
+
 TEST_CASE("rounding: trims in a row count only while the same part fails after each") {
   // The count behind release_after_trims: a failure continues the streak where it shares a row
   // with the failure just before it and that one trimmed the last fixing.

@@ -893,6 +893,12 @@ RoundingOptions CoarseToFineMatcher::rounding_for(int l) const {
       write_lp(lp, path);
       spdlog::info("level {}: wrote its first LP ({} x {}) to {}", l + 1, lp.rows(), lp.cols(), path);
     };
+  if (!options_.dump_slow_parts.empty())
+    ro.slow_part = [dir = options_.dump_slow_parts, l, count = dumped_slow_](const LpProblem& lp) {
+      const std::string path = fmt::format("{}/level{}-slow-{:03d}.smlp", dir, l + 1, (*count)++);
+      write_lp(lp, path);
+      spdlog::info("level {}: wrote a slow part ({} x {}) to {}", l + 1, lp.rows(), lp.cols(), path);
+    };
   return ro;
 }
 

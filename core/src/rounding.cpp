@@ -305,7 +305,8 @@ bool looks_infeasible(const LpResult& r) {
 JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpSolver& solver, LpSolver* exact,
                                    int64_t exact_below, const SolverParams& exact_params, bool split,
                                    double exact_pivots_per_column, ExactCache* cache,
-                                   const std::vector<double>* warm_weight) {
+                                   const std::vector<double>* warm_weight,
+                                   const std::function<void(const LpProblem&)>& slow_part, double slow_part_seconds) {
   JoinedSolve out;
   std::vector<Part> parts;
   if (split) parts = split_into_parts(lp);
@@ -382,6 +383,16 @@ JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpS
     if (same) {
       same->unused = -1;  // seen in this call (0 after the call's ageing below)
       ++reused;
+    } else if (use_exact) {
+      // The exact solver's work per part, for sizing its pivot cap (exact_pivots_per_column):
+      // every part in -v logs, a slow one (seconds to minutes of simplex on a part of its size)
+      // in any log.
+      const double per_column = double(s.iterations) / double(std::max<int64_t>(plp.cols(), 1));
+      const bool slow = s.seconds >= slow_part_seconds;
+      spdlog::log(slow ? spdlog::level::info : spdlog::level::debug,
+                  "rounding: {} on a part of {} variables: {} in {} pivots ({:.2f} per column, {:.1f} s)",
+                  exact->name(), plp.cols(), to_string(s.status), s.iterations, per_column, s.seconds);
+      if (slow && slow_part) slow_part(plp);
     }
     // One solver's numerical trouble on a part is the other's to try: measured, Clp gave up on a
     // part of FAUST_r 043-063's finest rounding (round 19 of a 24-minute run), which ended it.
@@ -1344,7 +1355,8 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
       }
       joined = detail::solve_in_parts(red.lp, std::move(params), *solver, exact ? exact_solver.get() : nullptr,
                               options.exact_below, exact_params, options.split_parts,
-                              options.exact_pivots_per_column, &exact_cache, &warm_weight);
+                              options.exact_pivots_per_column, &exact_cache, &warm_weight, options.slow_part,
+                              options.slow_part_seconds);
     }
     const LpResult& r = joined.r;
     // Round 1's iterate over the whole LP, for first_iterate and (an optimum) for the alternatives.

@@ -3,6 +3,7 @@
 #include "shapematch/lp.hpp"
 
 #include <cstdint>
+#include <functional>
 #include <limits>
 #include <vector>
 
@@ -63,7 +64,9 @@ struct ExactCache {
 JoinedSolve solve_in_parts(const LpProblem& lp, SolverParams params, LpSolver& solver, LpSolver* exact,
                            int64_t exact_below, const SolverParams& exact_params, bool split,
                            double exact_pivots_per_column = 0.0, ExactCache* cache = nullptr,
-                           const std::vector<double>* warm_weight = nullptr);
+                           const std::vector<double>* warm_weight = nullptr,
+                           const std::function<void(const LpProblem&)>& slow_part = {},
+                           double slow_part_seconds = 10.0);
 
 }  // namespace shapematch::detail
 

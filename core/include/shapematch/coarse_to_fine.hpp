@@ -276,6 +276,9 @@ struct CoarseToFineOptions {
   // level<L>-<NNN>.smlp, NNN counting all first LPs of the run, for solving it again on its own
   // (`shapematch lp --from`). Empty: none.
   std::string dump_first_lps;
+  // A directory: every later round's part that Clp took RoundingOptions::slow_part_seconds or
+  // more on is written there as level<L>-slow-<NNN>.smlp (write_lp). Empty: none.
+  std::string dump_slow_parts;
   // With a checkpoint (run's `checkpoint`), where a level's rounding has got is saved after its
   // rounds at most this often (LevelAttempt::rounding): each save writes every level's Γ, a few
   // hundred kB at full resolution, and the last rounds take hundredths of a second each.
@@ -501,6 +504,7 @@ private:
   bool second_level_ = false;  // level 1 is HierarchyOptions::second_faces on both shapes
   Eigen::MatrixXd fx_, fy_;
   std::shared_ptr<std::atomic<int>> dumped_ = std::make_shared<std::atomic<int>>(0);  // dump_first_lps
+  std::shared_ptr<std::atomic<int>> dumped_slow_ = std::make_shared<std::atomic<int>>(0);  // dump_slow_parts
 };
 
 }  // namespace shapematch

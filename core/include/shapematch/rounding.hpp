@@ -176,6 +176,10 @@ struct RoundingOptions {
   // Called with round 1's LP (what propagation left free, as solved; not its warm start) just
   // before it is solved, where round 1 is a first LP (not one from carried fixings).
   std::function<void(const LpProblem& lp)> first_lp;
+  // Called with each later round's part that the exact solver took slow_part_seconds or more on
+  // (as solved), for solving it again on its own with other solvers or settings.
+  std::function<void(const LpProblem& part)> slow_part;
+  double slow_part_seconds = 10.0;
   // Called after each round (after `progress`) with the decisions so far, the fixings to 1 that
   // rounding chose (sorted; not what propagation forced, which follows from them), and round 1's
   // certified bound: where the rounding has got, for a checkpoint (coarse to fine) that a later
