@@ -1259,6 +1259,40 @@ TEST_CASE("rounding: a part solved exactly in one of the last rounds takes that 
   CHECK(clp.calls == 4);
 }
 
+TEST_CASE("rounding: a part the exact solver failed on in one of the last rounds goes to the first-order one at once") {
+  // The dolphins at 30 faces with a cap of one pivot: Clp stops at its cap and PDHG solves the
+  // part. The same part again: PDHG at once, without Clp's attempt (before: Clp's cap reached
+  // once more, which on a hard part of a full-resolution run cost 10 minutes a round).
+  static const Mesh x = decimate(shapes::dolphin(0, 5), 30), y = decimate(shapes::dolphin(-40, 45), 30);
+  static const MatchingLp m = build_matching_lp(x, compute_geometry(x), y, compute_geometry(y));
+  const LpResult exact = solve_lp(m.lp, "clp-dual");
+  REQUIRE(exact.status == LpStatus::Optimal);
+  REQUIRE(exact.iterations > 2);  // else a cap of one pivot would not bite
+  SolverParams params;
+  params.tolerance = 1e-6;
+  params.threads = 1;  // the same iterates both times
+  const auto pdhg = make_solver("pdhg-cpu");
+  CountingClp clp;
+  detail::ExactCache cache;
+  const int64_t n = m.lp.cols();
+  const double one = 1.0 / double(std::max<int64_t>(n, 1000));
+  const detail::JoinedSolve a = detail::solve_in_parts(m.lp, params, *pdhg, &clp, n + 1, params, false, one, &cache);
+  CHECK(clp.calls == 1);
+  CHECK(a.exact_parts == 0);
+  REQUIRE(a.r.status == LpStatus::Optimal);
+  const detail::JoinedSolve b = detail::solve_in_parts(m.lp, params, *pdhg, &clp, n + 1, params, false, one, &cache);
+  CHECK(clp.calls == 1);
+  CHECK(cache.reused == 1);
+  CHECK(b.exact_parts == 0);
+  CHECK(b.r.status == LpStatus::Optimal);
+  CHECK(b.r.objective == a.r.objective);
+  // Without the cap it is another question: Clp solves it.
+  const detail::JoinedSolve c = detail::solve_in_parts(m.lp, params, *pdhg, &clp, n + 1, params, false, 0.0, &cache);
+  CHECK(clp.calls == 2);
+  CHECK(c.exact_parts == 1);
+  CHECK(c.r.objective == doctest::Approx(exact.objective).epsilon(1e-9));
+}
+
 TEST_CASE("rounding: a part the exact solver was slow on is handed out as solved, once") {
   // Two independent parts (x0 + x1 = 1 and x2 + x3 = 1); `slow_part_seconds` 0 makes every exact
   // solve slow. Each part goes to the callback as the exact solver saw it; a part that takes its

@@ -401,15 +401,19 @@ JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpS
     const bool failed = s.status == LpStatus::NumericalTrouble ||
                         (s.status != LpStatus::Infeasible && s.x.size() != size_t(plp.cols())) ||
                         (pivot_cap && s.status == LpStatus::IterationLimit);
+    // The exact solver's failures are kept too: the same part would fail the same way (measured,
+    // deformation-transfer cat 0002-0009 at full resolution with --exact-pivots-per-column 2:
+    // rounds 13 and 15 of level 6 each spent 10 minutes of Clp at its cap on the same 29 011-
+    // column part before PDHG took it).
+    if (use_exact && cache && !same) kept.push_back({plp, exact_own.max_iterations, s, -1});
     if (failed && (use_exact || (exact && plp.cols() <= 10 * std::max<int64_t>(exact_below, 1)))) {
-      spdlog::warn("rounding: {} failed on a part of {} variables ({}); trying {}", use_exact ? exact->name() : solver.name(),
-                   plp.cols(), to_string(s.status), use_exact ? solver.name() : exact->name());
+      spdlog::warn("rounding: {} {} on a part of {} variables ({}); trying {}",
+                   use_exact ? exact->name() : solver.name(), same ? "failed before" : "failed", plp.cols(),
+                   to_string(s.status), use_exact ? solver.name() : exact->name());
       const int64_t before = s.iterations;
       s = use_exact ? first_order_solve() : exact->solve(plp, exact_params);
       s.iterations = std::max(s.iterations, before);
       exactly += use_exact ? -1 : 1;
-    } else if (use_exact && cache && !same) {
-      kept.push_back({plp, exact_own.max_iterations, s, -1});
     }
     r.iterations = std::max(r.iterations, s.iterations);
     if (s.status == LpStatus::NumericalTrouble) {

@@ -48,7 +48,8 @@ struct JoinedSolve {
 // still change with it: the stuck rule (stuck_after) counts failing rounds' seconds, and a reused
 // result costs none. Measured on that pair (docs/results-log.md, thirty-eighth session): the five
 // repeats took 32 s instead of 1 554, the rounding went on past the round where it had given up,
-// and the run ended at a lower energy by another path.
+// and the run ended at a lower energy by another path. A failure (numerical trouble, or the
+// pivot cap reached) is kept as well, and such a part goes to the first-order solver at once.
 struct ExactCache {
   static constexpr int kKeepCalls = 4;
   struct Entry {
