@@ -16,6 +16,13 @@ using namespace shapematch;
 
 namespace {
 
+// The dolphins at 30 faces: for tests that solve the whole LP exactly several times.
+const MatchingLp& dolphins_30() {
+  static const Mesh x = decimate(shapes::dolphin(0, 5), 30), y = decimate(shapes::dolphin(-40, 45), 30);
+  static const MatchingLp m = build_matching_lp(x, compute_geometry(x), y, compute_geometry(y));
+  return m;
+}
+
 // The dolphins at 60 faces, one bent: a pair small enough for many rounds, built once (the space
 // refers to its meshes, which live as long as the test binary).
 const MatchingLp& dolphins_60() {
@@ -1215,8 +1222,7 @@ public:
 TEST_CASE("rounding: a part solved exactly in one of the last rounds takes that result again") {
   // The dolphins at 30 faces: five exact solves of the 60-face LP took 124-166 s of this test's
   // time on an idle 2-core machine, over its 600 s timeout under load; the cache's logic is the same.
-  static const Mesh x = decimate(shapes::dolphin(0, 5), 30), y = decimate(shapes::dolphin(-40, 45), 30);
-  static const MatchingLp m = build_matching_lp(x, compute_geometry(x), y, compute_geometry(y));
+  const MatchingLp& m = dolphins_30();
   SolverParams params;
   params.tolerance = 1e-6;
   const auto pdhg = make_solver("pdhg-cpu");
@@ -1263,8 +1269,7 @@ TEST_CASE("rounding: a part the exact solver failed on in one of the last rounds
   // The dolphins at 30 faces with a cap of one pivot: Clp stops at its cap and PDHG solves the
   // part. The same part again: PDHG at once, without Clp's attempt (before: Clp's cap reached
   // once more, which on a hard part of a full-resolution run cost 10 minutes a round).
-  static const Mesh x = decimate(shapes::dolphin(0, 5), 30), y = decimate(shapes::dolphin(-40, 45), 30);
-  static const MatchingLp m = build_matching_lp(x, compute_geometry(x), y, compute_geometry(y));
+  const MatchingLp& m = dolphins_30();
   const LpResult exact = solve_lp(m.lp, "clp-dual");
   REQUIRE(exact.status == LpStatus::Optimal);
   REQUIRE(exact.iterations > 2);  // else a cap of one pivot would not bite

@@ -1436,7 +1436,8 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
       // What is left of the last fixing (nothing where one from a capped LP was undone whole).
       // A batch from a capped LP is blamed by the whole parts that failed: its iterate was far
       // from the optimum everywhere near them, not only on the certificate's rows.
-      std::vector<int64_t> blame = certificate_rows(joined.proof, red.rows);
+      const std::vector<int64_t> proof_rows = certificate_rows(joined.proof, red.rows);
+      std::vector<int64_t> blame = proof_rows;
       if (history.back().capped && !failed.empty()) blame = failed;
       // Parts are independent, so a failed part that no fixing of the last round touches failed
       // because of earlier fixings (its LP had stopped at its cap before, or the last fixing was
@@ -1474,7 +1475,6 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
         // released 234, its next LP 2.8 M variables). Where that is not enough, the part fails
         // again and the next release reaches further. (The proof's own rows also where a capped
         // batch was blamed by the whole failed parts.)
-        const std::vector<int64_t> proof_rows = certificate_rows(joined.proof, red.rows);
         const std::vector<int64_t>& around =
             !proof_rows.empty() && proof_rows.size() < failed.size() ? proof_rows : failed;
         spdlog::debug("round {}: a part failed {} ({} rows, the proof {}): releasing the fixings around it", round,
