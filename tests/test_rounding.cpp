@@ -1355,6 +1355,93 @@ TEST_CASE("rounding: trims in a row count only while the same part fails after e
 }
 
 namespace {
+
+// Two causes of infeasibility in one part, each set off by a carried fixing to 1, and a third
+// carried fixing that is innocent. A: a1 + a2 = a3 + a4 = 1 and a1 + … + a4 + cA = 2 (with
+// cA = 1 the sums disagree; no row alone says so). B: the same over k pairs, b's sum + cB = k:
+// its Farkas ray spreads over k + 1 rows, each under a tenth of A's, so the first proof names A's
+// rows alone. A chain a4 + m1 = m1 + m2 = m2 + m3 = m3 + b_2k = 1 joins them into one part; c3
+// sits on the chain's A end (c3 + m1 − m6 = 1), more than two steps from B. cA', cB', c3' are
+// their alternatives, and q1 + q2 = 1 (q1 costs 1) is a second part. Nothing else costs: PDHG's
+// proof is a dual point, and with the alternatives at cost 10 its ordinary duals on A's rows
+// (about 10) outweighed B's ray in round 2, so that proof named A's rows again (measured).
+struct TwoCauses {
+  LpProblem lp;
+  std::vector<double> cost;
+  int64_t ca, cb, c3;
+};
+
+TwoCauses two_causes(int k) {
+  const int n = 16 + 2 * k;
+  const int a = 0, cA = 4, b = 6, cB = 6 + 2 * k, m = 8 + 2 * k, c3 = 11 + 2 * k, m6 = 13 + 2 * k, q = 14 + 2 * k;
+  std::vector<std::vector<int>> rows;
+  std::vector<double> rhs;
+  auto row = [&](std::initializer_list<std::pair<int, int>> entries, double value) {
+    rows.emplace_back(n, 0);
+    for (const auto& [j, v] : entries) rows.back()[j] = v;
+    rhs.push_back(value);
+  };
+  row({{a, 1}, {a + 1, 1}}, 1);
+  row({{a + 2, 1}, {a + 3, 1}}, 1);
+  row({{a, 1}, {a + 1, 1}, {a + 2, 1}, {a + 3, 1}, {cA, 1}}, 2);
+  row({{cA, 1}, {cA + 1, 1}}, 1);
+  for (int i = 0; i < k; ++i) row({{b + 2 * i, 1}, {b + 2 * i + 1, 1}}, 1);
+  rows.emplace_back(n, 0);
+  for (int j = b; j < b + 2 * k; ++j) rows.back()[j] = 1;
+  rows.back()[cB] = 1;
+  rhs.push_back(k);
+  row({{cB, 1}, {cB + 1, 1}}, 1);
+  row({{a + 3, 1}, {m, 1}}, 1);
+  row({{m, 1}, {m + 1, 1}}, 1);
+  row({{m + 1, 1}, {m + 2, 1}}, 1);
+  row({{m + 2, 1}, {b + 2 * k - 1, 1}}, 1);
+  row({{c3, 1}, {m, 1}, {m6, -1}}, 1);
+  row({{c3, 1}, {c3 + 1, 1}}, 1);
+  row({{q, 1}, {q + 1, 1}}, 1);
+  TwoCauses t;
+  t.cost.assign(n, 0.0);
+  t.cost[q] = 1.0;
+  t.lp = test::dense_lp(rows, rhs, t.cost);
+  t.ca = cA;
+  t.cb = cB;
+  t.c3 = c3;
+  return t;
+}
+
+}  // namespace
+
+TEST_CASE("rounding: a part failing again after a trim releases the fixings around its proof, not around the whole part") {
+  // two_causes with cA, cB and c3 carried, on PDHG (its proof a dual point that names rows):
+  // round 1's proof names A's three rows and trims cA; the part fails again, its proof on B's
+  // rows (41 of the part's 50), and the release around those frees cB alone. Around the whole
+  // part it would free c3 too (its row is one of the part's), which nothing blames.
+  const TwoCauses t = two_causes(40);
+  const Mesh sphere = shapes::icosphere(2);
+  const auto id = identity_matching(sphere);
+  const ProductSpace space = ProductSpace::from_list(sphere, sphere, {id.begin(), id.begin() + t.lp.cols()});
+  RoundingOptions options;
+  options.solver = "pdhg-cpu";
+  options.exact_below = 0;
+  options.lp.threads = 1;  // the same iterates on any machine
+  options.release_after_trims = 1;
+  options.start_ones = {t.ca, t.cb, t.c3};
+  const RoundingResult r = round_to_graph_surface(space, t.lp, t.cost, options);
+  CHECK(satisfies_exactly(t.lp, r.gamma));
+  CHECK(r.energy == 0.0);  // q2
+  REQUIRE(r.rounds.size() >= 3);
+  CHECK(r.rounds[0].status == LpStatus::Infeasible);
+  CHECK(r.rounds[0].undone);
+  CHECK(r.rounds[0].released == 0);  // a trim
+  CHECK(r.rounds[1].status == LpStatus::Infeasible);
+  CHECK(r.rounds[1].released == 1);  // cB; around the whole part: cB and c3
+  CHECK(r.rounds[1].fixed_to_one == -1);
+  auto in_gamma = [&](int64_t j) { return std::find(r.gamma.begin(), r.gamma.end(), j) != r.gamma.end(); };
+  CHECK(!in_gamma(t.ca));
+  CHECK(!in_gamma(t.cb));
+  CHECK(in_gamma(t.c3));  // never released
+}
+
+namespace {
 // The first-order solver, noting the primal weight each solve was asked to start from.
 class WeightNoting final : public LpSolver {
 public:
