@@ -514,6 +514,38 @@ TEST_CASE("pdhg-cpu: a diverging infeasible LP stops early when asked, with the 
   }
 }
 
+TEST_CASE("pdhg-cpu: an infeasible LP's ray names the rows of the infeasibility, its dual costly rows too") {
+  // x0 + x1 = 1 and x0 + x1 − x2 = 1.5 clash (their ray is (−1, +1, 0)); x3 + x4 = 1 beside them
+  // costs 10 either way, its ordinary dual 10. The proof's dual point holds that 10 next to a ray
+  // only about twice as long, so its large entries name all three rows; the dual's growth after
+  // the proof, the first two alone.
+  const LpProblem p =
+      from_rows(5, {{{0, 1}, {1, 1}}, {{0, 1}, {1, 1}, {2, -1}}, {{3, 1}, {4, 1}}}, {1, 1.5, 1}, {0, 0, 0, 10, 10});
+  auto largest = [](const std::vector<double>& v) {
+    double top = 0.0;
+    for (double e : v) top = std::max(top, std::abs(e));
+    return top;
+  };
+  for (const char* solver : kNative) {
+    CAPTURE(solver);
+    const LpResult r = solve_lp(p, solver, tight());
+    REQUIRE(r.status == LpStatus::Infeasible);
+    REQUIRE(r.y.size() == 3);
+    CHECK(std::abs(r.y[2]) >= 0.1 * largest(r.y));
+    REQUIRE(r.ray.size() == 3);
+    CHECK(farkas_rate(p, r.ray) > 0.0);
+    CHECK(r.ray[0] < 0.0);
+    CHECK(r.ray[1] > 0.0);
+    CHECK(std::abs(r.ray[2]) < 0.01 * largest(r.ray));
+  }
+  // Without the iterations after the proof: no ray.
+  PdhgOptions none;
+  none.ray_iterations = 0;
+  const LpResult r = PdhgSolver(PdhgBackendKind::Cpu, none).solve(p, tight());
+  CHECK(r.status == LpStatus::Infeasible);
+  CHECK(r.ray.empty());
+}
+
 TEST_CASE("pdhg-cpu: feasible LPs never stop as diverging") {
   std::mt19937 rng(5);
   SolverParams params = tight(1e-8);

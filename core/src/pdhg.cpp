@@ -205,6 +205,15 @@ LpResult PdhgSolver::solve(const LpProblem& problem, const SolverParams& params)
       for (int64_t i = 0; i < m; ++i) y[i] = r[i] * yh[i];
       if (certified_lower_bound(problem, y) > problem.objective_scale * largest_objective) {
         result.status = LpStatus::Infeasible;
+        if (options_.ray_iterations > 0) {  // LpResult::ray
+          backend->iterate(options_.ray_iterations, k, step);
+          k += options_.ray_iterations;
+          total += options_.ray_iterations;
+          backend->read(xh, yh);
+          std::vector<double> ray(m);
+          for (int64_t i = 0; i < m; ++i) ray[i] = r[i] * yh[i] - y[i];
+          if (farkas_rate(problem, ray) > 0.0) result.ray = std::move(ray);
+        }
         result.y = std::move(y);
         break;
       }
