@@ -518,7 +518,7 @@ TEST_CASE("pdhg-cpu: an infeasible LP's ray names the rows of the infeasibility,
   // x0 + x1 = 1 and x0 + x1 − x2 = 1.5 clash (their ray is (−1, +1, 0)); x3 + x4 = 1 beside them
   // costs 10 either way, its ordinary dual 10. The proof's dual point holds that 10 next to a ray
   // only about twice as long, so its large entries name all three rows; the dual's growth after
-  // the proof, the first two alone.
+  // the proof (PdhgOptions::ray_iterations), the first two alone.
   const LpProblem p =
       from_rows(5, {{{0, 1}, {1, 1}}, {{0, 1}, {1, 1}, {2, -1}}, {{3, 1}, {4, 1}}}, {1, 1.5, 1}, {0, 0, 0, 10, 10});
   auto largest = [](const std::vector<double>& v) {
@@ -526,9 +526,10 @@ TEST_CASE("pdhg-cpu: an infeasible LP's ray names the rows of the infeasibility,
     for (double e : v) top = std::max(top, std::abs(e));
     return top;
   };
-  for (const char* solver : kNative) {
-    CAPTURE(solver);
-    const LpResult r = solve_lp(p, solver, tight());
+  PdhgOptions ray;
+  ray.ray_iterations = 256;
+  for (const PdhgBackendKind backend : {PdhgBackendKind::Cpu, PdhgBackendKind::CpuF32}) {
+    const LpResult r = PdhgSolver(backend, ray).solve(p, tight());
     REQUIRE(r.status == LpStatus::Infeasible);
     REQUIRE(r.y.size() == 3);
     CHECK(std::abs(r.y[2]) >= 0.1 * largest(r.y));
@@ -538,10 +539,8 @@ TEST_CASE("pdhg-cpu: an infeasible LP's ray names the rows of the infeasibility,
     CHECK(r.ray[1] > 0.0);
     CHECK(std::abs(r.ray[2]) < 0.01 * largest(r.ray));
   }
-  // Without the iterations after the proof: no ray.
-  PdhgOptions none;
-  none.ray_iterations = 0;
-  const LpResult r = PdhgSolver(PdhgBackendKind::Cpu, none).solve(p, tight());
+  // Without the iterations after the proof (the default): no ray.
+  const LpResult r = solve_lp(p, "pdhg-cpu", tight());
   CHECK(r.status == LpStatus::Infeasible);
   CHECK(r.ray.empty());
 }

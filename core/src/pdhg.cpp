@@ -212,7 +212,10 @@ LpResult PdhgSolver::solve(const LpProblem& problem, const SolverParams& params)
           backend->read(xh, yh);
           std::vector<double> ray(m);
           for (int64_t i = 0; i < m; ++i) ray[i] = r[i] * yh[i] - y[i];
-          if (farkas_rate(problem, ray) > 0.0) result.ray = std::move(ray);
+          const double rate = farkas_rate(problem, ray);
+          spdlog::debug("{}: infeasible; the dual's growth over {} iterations more {} a Farkas ray (rate {:.4g})", name(),
+                        options_.ray_iterations, rate > 0.0 ? "is" : "is not", rate);
+          if (rate > 0.0) result.ray = std::move(ray);
         }
         result.y = std::move(y);
         break;

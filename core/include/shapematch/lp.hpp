@@ -83,9 +83,10 @@ struct LpResult {
   std::vector<double> y;
   // Diverging only (y holds the dual's growth there): the dual iterate where it stopped.
   std::vector<double> last_y;
-  // Infeasible (PDHG): the dual's growth over PdhgOptions::ray_iterations more after the proof,
-  // where that is a Farkas ray (empty otherwise). Its large entries name the rows of the
-  // infeasibility; y's also hold the ordinary duals, which can outweigh a ray still short.
+  // Infeasible (PDHG, with PdhgOptions::ray_iterations): the dual's growth over those iterations
+  // after the proof, where that is a Farkas ray (empty otherwise). Its large entries name the
+  // rows of the infeasibility; y's also hold the ordinary duals, which can outweigh a ray still
+  // short. Rounding names a proof's rows by it where it is given.
   std::vector<double> ray;
   int64_t iterations = 0;
   // PDHG's primal weight ω where it stopped (scaled space); NaN for other solvers.

@@ -21,11 +21,14 @@ struct PdhgOptions {
   // on the π rows, which puts PDLP's ω₀ ~1e5 above where ω settles (~0.01) and made the bundled
   // pair at 100 faces diverge; 1 converges there and halved the iterations at 40 faces.
   double initial_primal_weight = 1.0;
-  // After an infeasibility proof, this many iterations more give LpResult::ray (0: none). On a
-  // hand-made LP (tests: two causes in one part, costs of 10 beside the second) the dual's growth
-  // over 64 named 48 of 51 rows, over 256 the 41 of the cause alone; y itself named the other
-  // cause's 4 rows, its ordinary duals.
-  int ray_iterations = 256;
+  // After an infeasibility proof, this many iterations more give LpResult::ray (0: none, the
+  // default). On a hand-made LP (two causes of infeasibility in one part, costs of 10 beside the
+  // first) the dual's growth over 64 named 48 of 51 rows, over 256 the 41 of the second cause
+  // alone, where y itself named the first cause's 4 rows, its ordinary duals. But at full
+  // resolution (TOSCA_r cat2-cat9's level-6 rounding, five parts of 30 831-43 111 variables
+  // proved infeasible) the growth over 256 was no ray once (Farkas rates -886 to -53): the
+  // ordinary duals still move that much, and the iterations bought nothing.
+  int ray_iterations = 0;
 };
 
 // CpuF32: the native kernels with fp32 vectors and the dual kept relative to its anchor
