@@ -424,8 +424,7 @@ JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpS
       if (!infeasible) out.failed_rows.clear();  // drop the suspect parts' rows
       infeasible = true;
       out.failed_rows.insert(out.failed_rows.end(), part.rows.begin(), part.rows.end());
-      const std::vector<double>& proof = s.ray.empty() ? s.y : s.ray;
-      for (size_t i = 0; i < part.rows.size() && i < proof.size(); ++i) out.proof[part.rows[i]] = proof[i];
+      for (size_t i = 0; i < part.rows.size() && i < s.y.size(); ++i) out.proof[part.rows[i]] = s.y[i];
       if (s.y.empty())  // no ray (Clp): the whole part is the proof
         for (int64_t i : part.rows) out.proof[i] = 1.0;
       continue;
@@ -1351,7 +1350,7 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
       } else {
         joined.r = solver->solve(red.lp, params);
       }
-      if (joined.r.status == LpStatus::Infeasible) joined.proof = joined.r.ray.empty() ? joined.r.y : joined.r.ray;
+      if (joined.r.status == LpStatus::Infeasible) joined.proof = joined.r.y;
     } else {
       std::vector<double> warm_weight;
       if (!w_full.empty()) {

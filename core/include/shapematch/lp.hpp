@@ -86,7 +86,7 @@ struct LpResult {
   // Infeasible (PDHG, with PdhgOptions::ray_iterations): the dual's growth over those iterations
   // after the proof, where that is a Farkas ray (empty otherwise). Its large entries name the
   // rows of the infeasibility; y's also hold the ordinary duals, which can outweigh a ray still
-  // short. Rounding names a proof's rows by it where it is given.
+  // short. (Rounding names a proof's rows by y: at full resolution this was never a ray.)
   std::vector<double> ray;
   int64_t iterations = 0;
   // PDHG's primal weight ω where it stopped (scaled space); NaN for other solvers.
