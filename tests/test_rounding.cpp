@@ -1365,8 +1365,8 @@ namespace {
 // their alternatives, and q1 + q2 = 1 (q1 costs 1) is a second part. Nothing else costs: PDHG's
 // proof is a dual point, and with the alternatives at cost 10 its ordinary duals on A's rows
 // (about 10) outweighed B's short ray in round 2, so that proof named A's 4 rows, released c3 and
-// left round 3 infeasible (measured; PdhgOptions::ray_iterations names B's rows there, off by
-// default because at full resolution the growth it measures was no ray).
+// left round 3 infeasible (measured; the dual's growth after the proof, PdhgOptions::
+// ray_iterations, named B's rows there, but at full resolution that growth was no ray).
 struct TwoCauses {
   LpProblem lp;
   std::vector<double> cost;
