@@ -1504,7 +1504,7 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
       record(info, clock);
       ++failing_rounds;
       failing_seconds += info.seconds;
-      std::vector<int64_t> where = failed.empty() ? certificate_rows(joined.proof, red.rows) : failed;
+      std::vector<int64_t> where = failed.empty() ? proof_rows : failed;
       if (options.stuck_after > 0.0 && failing_rounds >= options.stuck_rounds && !where.empty() &&
           failing_seconds > options.stuck_after * first_seconds)
         throw stuck("rounding: stuck, the LPs after its fixings failed " + std::to_string(failing_rounds) +
