@@ -1362,18 +1362,14 @@ namespace {
 // its Farkas ray spreads over k + 1 rows, each under a tenth of A's, so the first proof names A's
 // rows alone. A chain a4 + m1 = m1 + m2 = m2 + m3 = m3 + b_2k = 1 joins them into one part; c3
 // sits on the chain's A end (c3 + m1 − m6 = 1), more than two steps from B. cA', cB', c3' are
-// their alternatives, and q1 + q2 = 1 (q1 costs 1) is a second part. Nothing else costs: PDHG's
-// proof is a dual point, and with the alternatives at cost 10 its ordinary duals on A's rows
-// (about 10) outweighed B's short ray in round 2, so that proof named A's 4 rows, released c3 and
-// left round 3 infeasible (measured; the dual's growth after the proof, PdhgOptions::
-// ray_iterations, named B's rows there, but at full resolution that growth was no ray).
+// their alternatives (at `alternative_cost` each), and q1 + q2 = 1 (q1 costs 1) is a second part.
 struct TwoCauses {
   LpProblem lp;
   std::vector<double> cost;
   int64_t ca, cb, c3;
 };
 
-TwoCauses two_causes(int k) {
+TwoCauses two_causes(int k, double alternative_cost = 0.0) {
   const int n = 16 + 2 * k;
   const int a = 0, cA = 4, b = 6, cB = 6 + 2 * k, m = 8 + 2 * k, c3 = 11 + 2 * k, m6 = 13 + 2 * k, q = 14 + 2 * k;
   std::vector<std::vector<int>> rows;
@@ -1403,6 +1399,7 @@ TwoCauses two_causes(int k) {
   TwoCauses t;
   t.cost.assign(n, 0.0);
   t.cost[q] = 1.0;
+  t.cost[cA + 1] = t.cost[cB + 1] = t.cost[c3 + 1] = alternative_cost;
   t.lp = test::dense_lp(rows, rhs, t.cost);
   t.ca = cA;
   t.cb = cB;
@@ -1437,6 +1434,37 @@ TEST_CASE("rounding: a part failing again after a trim releases the fixings arou
   CHECK(r.rounds[1].status == LpStatus::Infeasible);
   CHECK(r.rounds[1].released == 1);  // cB; around the whole part: cB and c3
   CHECK(r.rounds[1].fixed_to_one == -1);
+  CHECK(r.rounds[2].status != LpStatus::Infeasible);
+  auto in_gamma = [&](int64_t j) { return std::find(r.gamma.begin(), r.gamma.end(), j) != r.gamma.end(); };
+  CHECK(!in_gamma(t.ca));
+  CHECK(!in_gamma(t.cb));
+  CHECK(in_gamma(t.c3));  // never released
+}
+
+TEST_CASE("rounding: a part proved infeasible by PDHG names its clash by a proof at zero cost, not by its ordinary duals") {
+  // two_causes as above with the alternatives at cost 10. PDHG's proof of round 2 is a dual point:
+  // its ordinary duals on A's rows (about 10) outweighed B's short ray, so it named A's 4 rows,
+  // released c3 and left round 3 infeasible (measured before the proof at zero cost; the dual's
+  // growth after the proof, PdhgOptions::ray_iterations, named B's rows here, but at full
+  // resolution that growth was no ray). The same part at zero cost has no ordinary duals: its
+  // proof names B's 41 rows, and the release frees cB alone.
+  const TwoCauses t = two_causes(40, 10.0);
+  const Mesh sphere = shapes::icosphere(2);
+  const auto id = identity_matching(sphere);
+  const ProductSpace space = ProductSpace::from_list(sphere, sphere, {id.begin(), id.begin() + t.lp.cols()});
+  RoundingOptions options;
+  options.solver = "pdhg-cpu";
+  options.exact_below = 0;
+  options.lp.threads = 1;
+  options.release_after_trims = 1;
+  options.start_ones = {t.ca, t.cb, t.c3};
+  const RoundingResult r = round_to_graph_surface(space, t.lp, t.cost, options);
+  CHECK(satisfies_exactly(t.lp, r.gamma));
+  CHECK(r.energy == doctest::Approx(20.0));  // cA' and cB'
+  REQUIRE(r.rounds.size() >= 3);
+  CHECK(r.rounds[0].status == LpStatus::Infeasible);
+  CHECK(r.rounds[1].status == LpStatus::Infeasible);
+  CHECK(r.rounds[1].released == 1);
   CHECK(r.rounds[2].status != LpStatus::Infeasible);
   auto in_gamma = [&](int64_t j) { return std::find(r.gamma.begin(), r.gamma.end(), j) != r.gamma.end(); };
   CHECK(!in_gamma(t.ca));

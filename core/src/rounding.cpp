@@ -294,6 +294,13 @@ bool same_lp(const LpProblem& p, const LpProblem& q) {
          p.c == q.c && p.a.row_ptr == q.a.row_ptr && p.a.entry == q.a.entry;
 }
 
+// How many of y's entries carry it: a tenth of its largest or more (as certificate_rows counts).
+int64_t carrying_rows(const std::vector<double>& y) {
+  double largest = 0.0;
+  for (double v : y) largest = std::max(largest, std::abs(v));
+  return largest > 0.0 ? std::count_if(y.begin(), y.end(), [&](double v) { return std::abs(v) >= 0.1 * largest; }) : 0;
+}
+
 bool looks_infeasible(const LpResult& r) {
   // Far above: those LPs' bounds were 3-60x their objectives; at 5 % above, feasible LPs that had
   // not converged by the cap (bound 5.34, objective 5.01) were undone round after round.
@@ -419,6 +426,27 @@ JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpS
     if (s.status == LpStatus::NumericalTrouble) {
       r.status = s.status;
       return out;
+    }
+    if (s.status == LpStatus::Infeasible && s.solver == solver.name() && s.solver.rfind("pdhg", 0) == 0 && !s.y.empty() &&
+        std::any_of(plp.c.begin(), plp.c.end(), [](double c) { return c != 0.0; })) {
+      // A first-order proof is a dual point whose bound passed the largest objective. Next to a
+      // ray still short, its ordinary duals (about the costs) can be its large entries and name
+      // rows that take no part in the clash (measured on the rounding test's two_causes with its
+      // alternatives at cost 10: the proof named the other cause, and the round after it failed
+      // again). The same part at zero cost has no ordinary duals: its proof is the clash alone.
+      LpProblem zero = plp;
+      std::fill(zero.c.begin(), zero.c.end(), 0.0);
+      SolverParams cold = first_order();
+      cold.initial_x.clear();
+      cold.initial_y.clear();
+      const LpResult z = solver.solve(zero, cold);
+      spdlog::debug("rounding: a part of {} variables proved infeasible ({} rows carry the proof); at zero cost {} in {} "
+                    "iterations ({:.2f} s){}",
+                    plp.cols(), carrying_rows(s.y), to_string(z.status), z.iterations, z.seconds,
+                    z.status == LpStatus::Infeasible ? fmt::format(", {} rows carry it", carrying_rows(z.y)) : "");
+      if (z.status == LpStatus::Infeasible && z.y.size() == s.y.size()) s.y = z.y;
+      s.iterations += z.iterations;
+      r.iterations = std::max(r.iterations, s.iterations);
     }
     if (s.status == LpStatus::Infeasible) {
       if (!infeasible) out.failed_rows.clear();  // drop the suspect parts' rows
