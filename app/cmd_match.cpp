@@ -49,6 +49,7 @@ struct MatchArgs {
   int64_t search_below = RoundingOptions{}.search_below;
   bool converged_first = RoundingOptions{}.converged_first;
   double exact_pivots_per_column = RoundingOptions{}.exact_pivots_per_column;
+  int64_t exact_below = RoundingOptions{}.exact_below;
   int release_after_trims = RoundingOptions{}.release_after_trims;
   double tolerance = 1e-4;
   double coarse_tolerance = CoarseToFineOptions{}.coarse_tolerance;
@@ -202,6 +203,7 @@ int run_match(const MatchArgs& args) {
   ro.stuck_stalled = args.stuck_stalled;
   ro.converged_first = args.converged_first;
   ro.exact_pivots_per_column = args.exact_pivots_per_column;
+  ro.exact_below = args.exact_below;
   ro.release_after_trims = args.release_after_trims;
   ro.lp.tolerance = args.tolerance;
   ro.lp.time_limit = args.time_limit;
@@ -445,6 +447,7 @@ int run_match(const MatchArgs& args) {
                               .set("search_below", args.search_below)
                               .set("converged_first", args.converged_first)
                               .set("exact_pivots_per_column", args.exact_pivots_per_column)
+                              .set("exact_below", args.exact_below)
                               .set("release_after_trims", args.release_after_trims)
                               .set("split_parts", !args.whole_lp)
                               .set("tolerance", args.tolerance)
@@ -615,6 +618,11 @@ Action add_match_command(CLI::App& app) {
   app.add_option("--exact-pivots-per-column", a->exact_pivots_per_column,
                  "stop Clp after this many pivots per column of a later round's part (at least 1 000 columns' worth) "
                  "and give the part to PDHG (0: no cap)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  app.add_option("--exact-below", a->exact_below,
+                 "solve a later round's parts under this many columns by Clp's dual simplex, the others by the "
+                 "first-order solver (0: all by it)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   app.add_option("--release-after-trims", a->release_after_trims,
