@@ -1407,14 +1407,8 @@ TwoCauses two_causes(int k, double alternative_cost = 0.0) {
   return t;
 }
 
-}  // namespace
-
-TEST_CASE("rounding: a part failing again after a trim releases the fixings around its proof, not around the whole part") {
-  // two_causes with cA, cB and c3 carried, on PDHG (its proof names rows): round 1's proof names
-  // A's three rows and trims cA; the part fails again, its proof on B's rows (41 of the part's
-  // 50), and the release around those frees cB alone. Around the whole part it would free c3 too
-  // (its row is one of the part's), which nothing blames.
-  const TwoCauses t = two_causes(40);
+// two_causes rounded on PDHG (its proofs name rows) with cA, cB and c3 carried.
+RoundingResult round_two_causes(const TwoCauses& t) {
   const Mesh sphere = shapes::icosphere(2);
   const auto id = identity_matching(sphere);
   const ProductSpace space = ProductSpace::from_list(sphere, sphere, {id.begin(), id.begin() + t.lp.cols()});
@@ -1424,7 +1418,18 @@ TEST_CASE("rounding: a part failing again after a trim releases the fixings arou
   options.lp.threads = 1;  // the same iterates on any machine
   options.release_after_trims = 1;
   options.start_ones = {t.ca, t.cb, t.c3};
-  const RoundingResult r = round_to_graph_surface(space, t.lp, t.cost, options);
+  return round_to_graph_surface(space, t.lp, t.cost, options);
+}
+
+}  // namespace
+
+TEST_CASE("rounding: a part failing again after a trim releases the fixings around its proof, not around the whole part") {
+  // two_causes with cA, cB and c3 carried, on PDHG (its proof names rows): round 1's proof names
+  // A's three rows and trims cA; the part fails again, its proof on B's rows (41 of the part's
+  // 50), and the release around those frees cB alone. Around the whole part it would free c3 too
+  // (its row is one of the part's), which nothing blames.
+  const TwoCauses t = two_causes(40);
+  const RoundingResult r = round_two_causes(t);
   CHECK(satisfies_exactly(t.lp, r.gamma));
   CHECK(r.energy == 0.0);  // q2
   REQUIRE(r.rounds.size() >= 3);
@@ -1449,16 +1454,7 @@ TEST_CASE("rounding: a part proved infeasible by PDHG names its clash by a proof
   // resolution that growth was no ray). The same part at zero cost has no ordinary duals: its
   // proof names B's 41 rows, and the release frees cB alone.
   const TwoCauses t = two_causes(40, 10.0);
-  const Mesh sphere = shapes::icosphere(2);
-  const auto id = identity_matching(sphere);
-  const ProductSpace space = ProductSpace::from_list(sphere, sphere, {id.begin(), id.begin() + t.lp.cols()});
-  RoundingOptions options;
-  options.solver = "pdhg-cpu";
-  options.exact_below = 0;
-  options.lp.threads = 1;
-  options.release_after_trims = 1;
-  options.start_ones = {t.ca, t.cb, t.c3};
-  const RoundingResult r = round_to_graph_surface(space, t.lp, t.cost, options);
+  const RoundingResult r = round_two_causes(t);
   CHECK(satisfies_exactly(t.lp, r.gamma));
   CHECK(r.energy == doctest::Approx(20.0));  // cA' and cB'
   REQUIRE(r.rounds.size() >= 3);

@@ -294,11 +294,15 @@ bool same_lp(const LpProblem& p, const LpProblem& q) {
          p.c == q.c && p.a.row_ptr == q.a.row_ptr && p.a.entry == q.a.entry;
 }
 
-// How many of y's entries carry it: a tenth of its largest or more (as certificate_rows counts).
-int64_t carrying_rows(const std::vector<double>& y) {
+// The entries that carry a certificate y: those where |y_i| is a tenth of the largest or more.
+std::vector<int64_t> carrying_rows(const std::vector<double>& y) {
   double largest = 0.0;
   for (double v : y) largest = std::max(largest, std::abs(v));
-  return largest > 0.0 ? std::count_if(y.begin(), y.end(), [&](double v) { return std::abs(v) >= 0.1 * largest; }) : 0;
+  std::vector<int64_t> out;
+  if (!(largest > 0.0)) return out;
+  for (size_t i = 0; i < y.size(); ++i)
+    if (std::abs(y[i]) >= 0.1 * largest) out.push_back(static_cast<int64_t>(i));
+  return out;
 }
 
 bool looks_infeasible(const LpResult& r) {
@@ -442,8 +446,8 @@ JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpS
       const LpResult z = solver.solve(zero, cold);
       spdlog::debug("rounding: a part of {} variables proved infeasible ({} rows carry the proof); at zero cost {} in {} "
                     "iterations ({:.2f} s){}",
-                    plp.cols(), carrying_rows(s.y), to_string(z.status), z.iterations, z.seconds,
-                    z.status == LpStatus::Infeasible ? fmt::format(", {} rows carry it", carrying_rows(z.y)) : "");
+                    plp.cols(), carrying_rows(s.y).size(), to_string(z.status), z.iterations, z.seconds,
+                    z.status == LpStatus::Infeasible ? fmt::format(", {} rows carry it", carrying_rows(z.y).size()) : "");
       if (z.status == LpStatus::Infeasible && z.y.size() == s.y.size()) s.y = z.y;
       s.iterations += z.iterations;
       r.iterations = std::max(r.iterations, s.iterations);
@@ -555,15 +559,12 @@ std::vector<std::pair<int64_t, int>> shrink_and_fix(Fixer& fixer, std::vector<st
   return batch;
 }
 
-// The rows that carry a Farkas certificate y (in the reduced LP's numbering): those where |y_i|
-// is a sizeable fraction of the largest, mapped back to the full LP.
+// The rows that carry a Farkas certificate y (in the reduced LP's numbering; carrying_rows),
+// mapped back to the full LP.
 std::vector<int64_t> certificate_rows(const std::vector<double>& y, const std::vector<int64_t>& rows) {
-  double largest = 0.0;
-  for (double v : y) largest = std::max(largest, std::abs(v));
   std::vector<int64_t> out;
-  if (!(largest > 0.0)) return out;
-  for (size_t i = 0; i < y.size() && i < rows.size(); ++i)
-    if (std::abs(y[i]) >= 0.1 * largest) out.push_back(rows[i]);
+  for (int64_t i : carrying_rows(y))
+    if (i < static_cast<int64_t>(rows.size())) out.push_back(rows[i]);
   spdlog::debug("infeasibility certificate: {} of {} rows", out.size(), y.size());
   return out;
 }
