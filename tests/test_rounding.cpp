@@ -4,6 +4,7 @@
 #include "shapematch/rounding.hpp"
 #include "shapematch/shapes.hpp"
 #include "failing_again.hpp"
+#include "release_reach.hpp"
 #include "solve_in_parts.hpp"
 #include "test_helpers.hpp"
 
@@ -1329,6 +1330,23 @@ TEST_CASE("rounding: a part the exact solver was slow on is handed out as solved
   detail::solve_in_parts(lp, params, *pdhg, &clp, 10, params, true, 0.0, &fresh, nullptr, keep, 3600.0);
   CHECK(clp.calls == 4);
   CHECK(seen.size() == 2);
+}
+
+TEST_CASE("rounding: a release reaches further only where the same part fails again") {
+  detail::ReleaseReach r;
+  CHECK(r.first_depth({4, 5}) == 2);  // the first release
+  r.released({5, 4, 5}, 2);
+  CHECK(r.first_depth({6, 5}) == 4);  // shares column 5 with the last release's rows
+  r.released({6, 5}, 8);              // (reached 8: nothing within 4 steps)
+  CHECK(r.first_depth({6}) == 16);
+  r.released({6}, 16);
+  CHECK(r.first_depth({7, 9}) == 2);  // elsewhere: 2 again, however far the last one reached
+  r.released({9, 7}, 2);
+  CHECK(r.first_depth({6}) == 2);     // only the last release counts
+  CHECK(r.first_depth({9}) == 4);
+  r.released({9}, 64);
+  CHECK(r.first_depth({9}) == 64);    // no further than 64 to start with
+  CHECK(r.first_depth({}) == 2);
 }
 
 TEST_CASE("rounding: trims in a row count only while the same part fails after each") {

@@ -1,6 +1,7 @@
 #include "shapematch/rounding.hpp"
 #include "parallel.hpp"
 #include "failing_again.hpp"
+#include "release_reach.hpp"
 #include "solve_in_parts.hpp"
 
 #include "shapematch/errors.hpp"
@@ -1136,12 +1137,14 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
   SolverParams base_params = options.lp;
   base_params.initial_x.clear();
   base_params.initial_y.clear();
-  // Releases every fixing within reach of `rows` (columns_near, 2, 4, 8 … steps, further until
-  // one is in reach) and propagates the rest again from the state before the first round: where
-  // a part has no binary solution, the fault lies in the fixings around it, not in the last ones
-  // made (parts are independent; the last fixing is as likely in another). Returns how many went.
+  // Releases every fixing within reach of `rows` (columns_near, 2 steps, 4, 8 … where the same
+  // part fails again (ReleaseReach), further until one is in reach) and propagates the rest again
+  // from the state before the first round: where a part has no binary solution, the fault lies in
+  // the fixings around it, not in the last ones made (parts are independent; the last fixing is
+  // as likely in another). Returns how many went.
   std::unique_ptr<LpSolver> search_solver;
   int releases = 0;
+  detail::ReleaseReach reach;
   detail::FailingAgain failing_again;  // release_after_trims
   // With `refute`, the released fixings to 1 join those not tried again while anything else
   // remains (the LP after the release would often pick them again: they came from its optimum;
@@ -1154,7 +1157,11 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
     constexpr int kMaxDepth = 1 << 12;
     int64_t all = 0;  // fixings made so far
     for (const Step& st : history) all += static_cast<int64_t>(st.batch.size());
-    for (int depth = 2 << std::min(releases - 1, 5); depth <= kMaxDepth; depth *= 2) {
+    std::vector<int64_t> cols;  // the columns of the part's rows: does it fail again?
+    for (int64_t i : rows)
+      for (uint32_t k = lp.a.row_ptr[i]; k < lp.a.row_ptr[i + 1]; ++k)
+        cols.push_back(col_of(lp.a.entry[k]));
+    for (int depth = reach.first_depth(cols); depth <= kMaxDepth; depth *= 2) {
       const std::vector<char> near = columns_near(lp, rows, depth);
       std::vector<std::pair<int64_t, int>> kept;
       for (const Step& st : history)
@@ -1176,6 +1183,7 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
       }
       spdlog::debug("rounding: released {} fixings within {} steps of the part",
                     all - static_cast<int64_t>(kept.size()), depth);
+      reach.released(std::move(cols), depth);
       return all - static_cast<int64_t>(kept.size());
     }
     throw InfeasibleError("rounding: no binary solution around a part, and no fixing near it",

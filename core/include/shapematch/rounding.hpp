@@ -102,12 +102,12 @@ struct RoundingOptions {
   // Where rounding stalls on a small remainder (its free variables no fewer than their fewest
   // for search_stall rounds in a row, and at most search_below of them), each part of it is
   // finished by a depth-first search over exact LPs (at most search_nodes each), and where a part
-  // has no binary solution the fixings around it are released (within 2, 4, 8 … LP steps, at most
-  // max_releases times) rather than undone in the order they were made. Measured, TOSCA_r
-  // horse0-5 at full resolution: 150 rounds fixed and undid the same few variables of a
-  // 1 082-variable remainder in 2 parts, each solved exactly with a fractional vertex, until
-  // max_rounds; with the search, a 2 272-variable remainder (10 parts) was finished in 16 nodes
-  // and one release of 447 fixings, and the pair verified (docs/results-log.md). 0: never.
+  // has no binary solution the fixings around it are released (within 2 LP steps, 4, 8 … where
+  // the same part fails again; at most max_releases times) rather than undone in the order they
+  // were made. Measured, TOSCA_r horse0-5 at full resolution: 150 rounds fixed and undid the
+  // same few variables of a 1 082-variable remainder in 2 parts, each solved exactly with a
+  // fractional vertex, until max_rounds; with the search, a 2 272-variable remainder (10 parts)
+  // was finished in 16 nodes and one release of 447 fixings, and the pair verified (docs/results-log.md). 0: never.
   int64_t search_below = 20000;
   int search_stall = 3;
   int64_t search_nodes = 2000;
