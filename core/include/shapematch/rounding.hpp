@@ -107,7 +107,8 @@ struct RoundingOptions {
   // were made. Measured, TOSCA_r horse0-5 at full resolution: 150 rounds fixed and undid the
   // same few variables of a 1 082-variable remainder in 2 parts, each solved exactly with a
   // fractional vertex, until max_rounds; with the search, a 2 272-variable remainder (10 parts)
-  // was finished in 16 nodes and one release of 447 fixings, and the pair verified (docs/results-log.md). 0: never.
+  // was finished in 16 nodes and one release of 447 fixings, and the pair verified
+  // (docs/results-log.md). 0: never.
   int64_t search_below = 20000;
   int search_stall = 3;
   int64_t search_nodes = 2000;
