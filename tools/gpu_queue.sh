@@ -75,6 +75,19 @@ if [ "$BACKEND" = vulkan ] && ! grep -q "0: NVIDIA" log/devices.txt; then
 fi
 (while true; do { date +%T; nvidia-smi --query-gpu=utilization.gpu,memory.used --format=csv,noheader 2>&1; uptime; } >> log/smi.txt; sleep 30; done) &
 SMI=$!
+# Packs logs, tables, results and checkpoints (no meshes) into $OUT/q.txz, with one line per
+# unfinished run's checkpoint (levels done, the attempt and its rounding) in log/checkpoints.txt.
+pack() {
+  cat out/*/bench_pairs.md > log/tables.md 2>/dev/null
+  for c in out/*/runs/*.ckpt; do [ -f "$c" ] && echo "$c $(./shapematch checkpoint "$c" | tr -d ' \n')"; done > log/checkpoints.txt 2>&1
+  tar cJf "${OUT:-/tmp}/q.part.txz" --exclude='*.ply' --exclude='*.png' --exclude=levels log out 2>/dev/null &&
+    mv -f "${OUT:-/tmp}/q.part.txz" "${OUT:-/tmp}/q.txz"
+}
+# Every PACK seconds too: a call killed at its own limit (a LIMIT too long for it) still brings
+# back the latest checkpoints (sixty-sixth session: one killed before its only pack brought none).
+rm -f .stop
+(n=0; while [ ! -e .stop ]; do sleep 5; n=$((n + 5)); [ "$n" -ge "${PACK:-60}" ] && { pack; n=0; }; done) &
+PACKER=$!
 # A job line: NAME on|off [TAG MATCH-ARGS...]: a TAG names a variant with options of its own
 # (added by hand, e.g. `03-024-043 on ring2 --ring 2`), so that one call compares them.
 run1() {
@@ -86,7 +99,8 @@ run1() {
   # still ends as "timed out" with its record and checkpoint, not killed with the queue.
   local left=$((DEADLINE - $(date +%s)))
   if [ "$left" -lt 30 ]; then echo "$id not started (${left} s left)" >> log/done.txt; return; fi
-  # (The jobs that start at once all get LIMIT: --resume goes on only under a limit no shorter.)
+  # (The jobs that start at once all get LIMIT: under a shorter limit than its last call's,
+  # --resume runs a timed-out pair again only where that call got its checkpoint further.)
   [ "$left" -ge $((LIMIT - 5)) ] && left=$LIMIT
   mapfile -t margs < match_args.txt
   ./shapematch bench match --pairs "pairs/$n.txt" --faces "$FACES" --time-limit "$left" --out "out/$id" --resume -- \
@@ -98,10 +112,8 @@ DEADLINE=$(($(date +%s) + LIMIT))
 export LIMIT DEADLINE BACKEND FACES THREADS
 timeout $((LIMIT + 45)) xargs -P "$P" -L 1 bash -c 'run1 "$@"' _ < "${JOBS:-jobs.txt}"
 kill $SMI
-cat out/*/bench_pairs.md > log/tables.md 2>/dev/null
-# Where each unfinished run stands (levels done, the attempt and its rounding), one line each.
-for c in out/*/runs/*.ckpt; do [ -f "$c" ] && echo "$c $(./shapematch checkpoint "$c" | tr -d ' \n')"; done > log/checkpoints.txt 2>&1
-tar cJf "${OUT:-/tmp}/q.txz" --exclude='*.ply' --exclude='*.png' --exclude=levels log out
+touch .stop; wait $PACKER  # (not killed: it may be halfway through a pack)
+pack
 ls -la "${OUT:-/tmp}/q.txz"
 EOF
 chmod +x "$dir/q.sh"
