@@ -92,7 +92,31 @@ struct MatchArgs {
   bool lookahead_bound_drop = CoarseToFineOptions{}.lookahead_bound_drop;
   double price_threshold = CoarseToFineOptions{}.price_threshold;
   double price_tolerance = CoarseToFineOptions{}.price_tolerance;
+  // The diagnostic of CoarseToFineOptions::truth: ground truth as eval takes it.
+  std::string truth, truth_x, truth_y, truth_map;
+  int truth_rings = CoarseToFineOptions{}.truth_rings;
 };
+
+// The true map of CoarseToFineOptions::truth from the ground truth named (none: empty), read
+// against the files as loaded for matching.
+std::vector<int> true_map(const MatchArgs& args, const MeshPair& p, std::string& name) {
+  if (args.truth.empty() && args.truth_x.empty() && args.truth_map.empty()) return {};
+  LoadOptions load;
+  load.close_holes = args.pair.close_holes;
+  const Mesh x = load_mesh(p.x_file, load), y = load_mesh(p.y_file, load);
+  GroundTruth truth;
+  if (!args.truth_map.empty()) {
+    truth = read_map_ground_truth(args.truth_map, x.num_vertices(), y.num_vertices());
+    name = args.truth_map;
+  } else if (!args.truth_x.empty()) {
+    truth = read_vts_ground_truth(args.truth_x, args.truth_y, x.num_vertices(), y.num_vertices());
+    name = args.truth_x + " <-> " + args.truth_y;
+  } else {
+    truth = identity_ground_truth(x.num_vertices(), y.num_vertices());
+    name = "identity";
+  }
+  return truth_at(x, y, p.x_ids, p.y_ids, truth);
+}
 
 // auto: a GPU if there is one, else the native solver (lavapipe is for testing, not speed).
 std::string solver_for(const MatchArgs& a) {
@@ -137,6 +161,8 @@ void publish(const fs::path& tmp, const fs::path& out) {
 int run_match(const MatchArgs& args) {
   Stopwatch total, stage;
   Json seconds = Json::object();
+  if ((!args.truth.empty() || !args.truth_x.empty() || !args.truth_map.empty()) && !args.checkpoint.empty())
+    throw InvalidInputError("--truth* and --checkpoint exclude each other (a diagnostic run is not gone on from)");
   const MeshPair p = load_pair(args.pair);
 
   CoarseToFineOptions co;
@@ -185,6 +211,9 @@ int run_match(const MatchArgs& args) {
   co.price_threshold = args.price_threshold;
   co.price_tolerance = args.price_tolerance;
   co.matching = matching_options(args.pair, p);
+  std::string truth_name;
+  co.truth = true_map(args, p, truth_name);
+  co.truth_rings = args.truth_rings;
   RoundingOptions& ro = co.rounding;
   ro.solver = solver_for(args);
   ro.threshold = args.threshold;
@@ -494,7 +523,9 @@ int run_match(const MatchArgs& args) {
                               .set("stuck_stalled", args.stuck_stalled)
                               .set("price_widenings", args.price_widenings)
                               .set("price_threshold", args.price_threshold)
-                              .set("price_tolerance", args.price_tolerance));
+                              .set("price_tolerance", args.price_tolerance)
+                              .set("truth", truth_name)
+                              .set("truth_rings", args.truth_rings));
     // Levels taken from a checkpoint keep the seconds and memory of the run that solved them.
     report.set("resumed_after_level", resume ? static_cast<int64_t>(resume->levels.size()) : int64_t(0));
     report.set("seconds", seconds);
@@ -741,6 +772,21 @@ Action add_match_command(CLI::App& app) {
                  "with --checkpoint: save where a level's rounding has got after its rounds, at most this often "
                  "(seconds)")
       ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  auto* tr = app.add_option("--truth", a->truth,
+                            "a diagnostic: the coarsest level keeps only product triangles near the true map (vertex "
+                            "i of X <-> vertex i of Y), and has no second start")
+                 ->check(CLI::IsMember({"identity"}));
+  auto* tx = app.add_option("--truth-x", a->truth_x, "as --truth, from 1-based .vts files: line k <-> line k of --truth-y");
+  auto* ty = app.add_option("--truth-y", a->truth_y, "1-based .vts file of Y");
+  auto* tm = app.add_option("--truth-map", a->truth_map, "as --truth, from two 1-based columns: X vertex, Y vertex");
+  tx->needs(ty);
+  ty->needs(tx);
+  tr->excludes(tx)->excludes(ty)->excludes(tm);
+  tm->excludes(tx)->excludes(ty);
+  app.add_option("--truth-rings", a->truth_rings,
+                 "with --truth*: each corner's Y vertex within this many edges of its true image on the coarsest Y")
+      ->check(CLI::Range(0, 16))
       ->capture_default_str();
   app.add_option("--dump-first-lps", a->dump_first_lps,
                  "write every first LP of a rounding to this directory (level<L>-<NNN>.smlp), to solve it again "

@@ -90,6 +90,45 @@ TEST_CASE("cli: lp on the bundled pair is positive, on an identity pair zero") {
   fs::remove(file);
 }
 
+TEST_CASE("cli: match --truth restricts the coarsest level to the true map's neighbourhood, a diagnostic") {
+  shapematch::test::TempDir tmp;
+  const std::string straight = std::string(SHAPEMATCH_ASSETS_DIR) + "/dolphin_straight.off";
+  const std::string swimming = std::string(SHAPEMATCH_ASSETS_DIR) + "/dolphin_swimming.off";
+  const fs::path out = tmp.path / "truth";
+  const std::string pair = "match " + straight + " " + swimming + " --faces 300 --levels 2 --backend cpu ";
+  Run r = run(pair + "--truth identity --truth-rings 1 -o " + out.string());
+  REQUIRE_MESSAGE(r.code == 0, r.err);
+  CHECK(r.err.find("within 1 rings of the true map") != std::string::npos);
+  std::ifstream report(out / "report.json");
+  const std::string text{std::istreambuf_iterator<char>(report), {}};
+  CHECK(text.find("\"truth\": \"identity\"") != std::string::npos);
+  r = run("eval " + out.string() + " --gt identity");
+  REQUIRE_MESSAGE(r.code == 0, r.err);
+  // Every coarsest vertex within one ring of its true image: so is its error, at 100 faces.
+  const std::string levels = r.out.substr(r.out.find("\"levels\""));
+  CHECK(json_number(levels, "mean_geodesic_error") < 0.15);
+
+  // The true map from two columns: the same pairs as the identity.
+  const fs::path map = tmp.path / "map.txt";
+  {
+    std::ofstream f(map);
+    for (int v = 1; v <= 20; ++v) f << v << " " << v << "\n";
+  }
+  r = run(pair + "--truth-map " + map.string() + " --truth-rings 16 -o " + (tmp.path / "map").string());
+  CHECK_MESSAGE(r.code == 0, r.err);
+  r = run(pair + "--truth identity --checkpoint " + (tmp.path / "c.ckpt").string() + " -o " + (tmp.path / "c").string());
+  CHECK(r.code != 0);
+  CHECK(std::count(r.err.begin(), r.err.end(), '\n') == 1);
+  CHECK(r.err.find("--checkpoint") != std::string::npos);
+  CHECK_FALSE(fs::exists(tmp.path / "c"));
+  CHECK(run(pair + "--truth-x " + map.string() + " -o " + (tmp.path / "x").string()).code != 0);
+  std::ofstream(map, std::ios::app) << "3 x\n";
+  r = run(pair + "--truth-map " + map.string() + " -o " + (tmp.path / "bad").string());
+  CHECK(r.code != 0);
+  CHECK(r.err.find(map.string()) != std::string::npos);
+  CHECK_FALSE(fs::exists(tmp.path / "bad"));
+}
+
 TEST_CASE("cli: malformed inputs give one clear line and a non-zero exit") {
   const fs::path good = write_temp("good.off", kTetra);
   struct Case {

@@ -17,6 +17,7 @@
 #include <map>
 #include <random>
 #include <memory>
+#include <numeric>
 #include <optional>
 #include <set>
 
@@ -1758,4 +1759,78 @@ TEST_CASE("coarse to fine: with lookahead_drop_stuck a chain stuck inside lookah
   REQUIRE(again);
   CHECK(again->levels[3].gamma == a.gamma);
   CHECK(again->levels[3].energy == doctest::Approx(a.energy).epsilon(1e-12));
+}
+
+TEST_CASE("coarse to fine: the truth space is the identity at 0 rings and grows with them to the full space") {
+  const Mesh m = lumpy_sphere(1, 3);
+  std::vector<int> identity(m.num_vertices());
+  std::iota(identity.begin(), identity.end(), 0);
+  const ProductSpace full = ProductSpace::full(m, m);
+  auto indices = [&](const std::vector<ProductTriangle>& list) {
+    std::set<int64_t> s;
+    for (const ProductTriangle& t : list) s.insert(full.index_in_full(t));
+    CHECK(s.size() == list.size());  // no duplicates
+    return s;
+  };
+  std::set<int64_t> expected;
+  for (const ProductTriangle& t : identity_matching(m)) expected.insert(full.index_in_full(t));
+  std::set<int64_t> last = indices(truth_space(m, m, identity, 0));
+  CHECK(last == expected);
+  for (int rings = 1; rings <= 4; ++rings) {
+    CAPTURE(rings);
+    const std::set<int64_t> now = indices(truth_space(m, m, identity, rings));
+    CHECK(now.size() > last.size());
+    CHECK(std::includes(now.begin(), now.end(), last.begin(), last.end()));
+    last = now;
+  }
+  // Every corner within reach of its image (the mesh's diameter in edges is under 16), or no image.
+  CHECK(int64_t(truth_space(m, m, identity, 16).size()) == full.size());
+  CHECK(int64_t(truth_space(m, m, std::vector<int>(m.num_vertices(), -1), 0).size()) == full.size());
+  // One vertex constrained: the full space less the product triangles that put it elsewhere.
+  std::vector<int> one(m.num_vertices(), -1);
+  one[0] = 0;
+  int64_t off = 0;
+  for (int64_t j = 0; j < full.size(); ++j) {
+    const ProductTriangle t = full[j];
+    for (int i = 0; i < 3; ++i)
+      if (t.a[i] == 0 && t.b[i] != 0) {
+        ++off;
+        break;
+      }
+  }
+  CHECK(int64_t(truth_space(m, m, one, 0).size()) == full.size() - off);
+  CHECK_THROWS_AS(truth_space(m, m, {0, 1}, 1), InvalidInputError);
+}
+
+TEST_CASE("coarse to fine: a true map restricts the coarsest level, and there is no second start beside it") {
+  const Mesh m = lumpy_sphere(2, 5);
+  CoarseToFineOptions o;
+  o.hierarchy.levels = 3;
+  o.hierarchy.coarsest_faces = 20;
+  o.hierarchy.second_faces = 40;
+  o.ring = 0;
+  o.rounding.solver = "clp-dual";
+  o.truth.resize(m.num_vertices());
+  std::iota(o.truth.begin(), o.truth.end(), 0);
+  o.truth_rings = 0;
+  const CoarseToFineMatcher matcher(m, m, o);
+  REQUIRE(matcher.x_levels().size() == 3);
+  REQUIRE(matcher.x_levels().levels[1].mesh.num_faces() == 40);
+  const CoarseToFineResult r = matcher.run();
+  // At 0 rings around the identity the coarsest space is the identity itself.
+  CHECK(r.levels[0].variables == matcher.x_levels().levels[0].mesh.num_faces());
+  for (const auto& l : r.levels) {
+    CAPTURE(l.level);
+    CHECK(l.energy == doctest::Approx(0.0).epsilon(1e-9));
+    CHECK(std::isnan(l.second_start_energy));
+  }
+  const VertexMaps maps = vertex_maps(r.finest.space, r.rounding.gamma);
+  for (int v = 0; v < m.num_vertices(); ++v) CHECK(maps.x_to_y[v] == v);
+
+  // A true map that sends every vertex to one vertex of Y leaves no closed matching at 0 rings.
+  std::fill(o.truth.begin(), o.truth.end(), 0);
+  const CoarseToFineMatcher collapsed(m, m, o);
+  CHECK_THROWS_WITH_AS(collapsed.run(), doctest::Contains("within 0 rings of the true map"), InfeasibleError);
+  o.truth.pop_back();
+  CHECK_THROWS_AS(CoarseToFineMatcher(m, m, o), InvalidInputError);
 }

@@ -483,3 +483,38 @@ TEST_CASE("evaluation: shapematch eval on a real match output of a shared-connec
   CHECK(json_number(r.out, "degenerate_faces") == 0);
   fs::remove_all(dir);
 }
+
+TEST_CASE("evaluation: a true map at the matched resolution takes the nearest ground truth on either side") {
+  const Mesh m = shapes::icosphere(3);
+  std::vector<int> ids;
+  const Mesh coarse = decimate(m, 200, &ids);
+  REQUIRE(coarse.num_vertices() < m.num_vertices());
+  // The identity, dense: every kept vertex is its own nearest pair and image.
+  const std::vector<int> same = truth_at(m, m, ids, ids, identity_ground_truth(m.num_vertices(), m.num_vertices()));
+  REQUIRE(same.size() == ids.size());
+  for (size_t v = 0; v < ids.size(); ++v) CHECK(same[v] == int(v));
+  // Two pairs only, swapping two antipodes: each vertex takes the nearer pair's image, on the
+  // matched Y the kept vertex nearest to it.
+  int north = 0, south = 0;
+  for (int v = 0; v < m.num_vertices(); ++v) {
+    if (m.vertices[v].z() > m.vertices[north].z()) north = v;
+    if (m.vertices[v].z() < m.vertices[south].z()) south = v;
+  }
+  const std::vector<int> swapped = truth_at(m, m, ids, ids, {{north, south}, {south, north}});
+  auto nearest_distance = [&](int target) {  // over the kept vertices
+    double best = 1e300;
+    for (int id : ids) best = std::min(best, (m.vertices[id] - m.vertices[target]).squaredNorm());
+    return best;
+  };
+  for (size_t v = 0; v < ids.size(); ++v) {
+    const double z = m.vertices[ids[v]].z();
+    if (std::abs(z) < 0.1) continue;  // near the equator either pair is about as near
+    CAPTURE(z);
+    const int target = z > 0 ? south : north;
+    CHECK((m.vertices[ids[swapped[v]]] - m.vertices[target]).squaredNorm() ==
+          doctest::Approx(nearest_distance(target)).epsilon(1e-12));
+    CHECK(m.vertices[ids[swapped[v]]].z() * z < 0);
+  }
+  CHECK_THROWS_AS(truth_at(m, m, ids, ids, {}), InvalidInputError);
+  CHECK_THROWS_AS(truth_at(m, m, ids, ids, {{m.num_vertices(), 0}}), InvalidInputError);
+}

@@ -242,6 +242,46 @@ int conflict_places(const MatchingLp& m, int max_places, int margin, ProofPlace&
 
 }  // namespace
 
+std::vector<ProductTriangle> truth_space(const Mesh& x, const Mesh& y, const std::vector<int>& image, int rings) {
+  if (image.size() != size_t(x.num_vertices()))
+    throw InvalidInputError("truth space: need one true image per vertex of X");
+  if (rings < 0) throw InvalidInputError("truth space: the rings must be 0 or more");
+  std::vector<std::vector<int>> neighbours(y.num_vertices());
+  for (const auto& e : y.edges) {
+    neighbours[e[0]].push_back(e[1]);
+    neighbours[e[1]].push_back(e[0]);
+  }
+  // near[w][b]: b within `rings` edges of w, for the images in use (breadth first from each).
+  std::vector<std::vector<char>> near(y.num_vertices());
+  for (int w : image) {
+    if (w < 0) continue;
+    if (w >= y.num_vertices()) throw InvalidInputError("truth space: an image is not a vertex of Y");
+    if (!near[w].empty()) continue;
+    std::vector<char>& in = near[w];
+    in.assign(y.num_vertices(), 0);
+    in[w] = 1;
+    std::vector<int> front{w}, next;
+    for (int r = 0; r < rings && !front.empty(); ++r, front.swap(next)) {
+      next.clear();
+      for (int u : front)
+        for (int n : neighbours[u])
+          if (!in[n]) {
+            in[n] = 1;
+            next.push_back(n);
+          }
+    }
+  }
+  const ProductSpace full = ProductSpace::full(x, y);
+  std::vector<ProductTriangle> kept;
+  for (int64_t j = 0; j < full.size(); ++j) {
+    const ProductTriangle t = full[j];
+    bool ok = true;
+    for (int i = 0; i < 3 && ok; ++i) ok = image[t.a[i]] < 0 || near[image[t.a[i]]][t.b[i]];
+    if (ok) kept.push_back(t);
+  }
+  return kept;
+}
+
 std::vector<ProductTriangle> reduced_product_space(const MeshLevel& fine_x, const MeshLevel& fine_y,
                                                    const Mesh& coarse_x, const Mesh& coarse_y,
                                                    const std::vector<ProductTriangle>& coarse_gamma, int ring,
@@ -447,10 +487,32 @@ CoarseToFineMatcher::CoarseToFineMatcher(const Mesh& x, const Mesh& y, CoarseToF
   // A second start only where both shapes have the second level of that size (not where a small
   // input made the levels plain geometric).
   second_level_ = options_.second_start && ho.second_faces > 0 && cx.size() > 1 && cx[1] == ho.second_faces &&
-                  cy[1] == ho.second_faces;
+                  cy[1] == ho.second_faces && options_.truth.empty();
+  if (!options_.truth.empty() && options_.truth.size() != size_t(x.num_vertices()))
+    throw InvalidInputError("coarse to fine: the true map needs one entry per input vertex of X");
   if (hx_.size() != hy_.size()) throw Error("coarse to fine: the hierarchies differ in length (a bug)");
   if (options_.matching.features_x.size() > 0 || options_.matching.features_y.size() > 0)
     set_features(std::move(options_.matching.features_x), std::move(options_.matching.features_y));
+}
+
+// Each coarsest X vertex's true image there: the coarsest Y vertex nearest in space to the true
+// input vertex of its own input vertex (CoarseToFineOptions::truth); -1 where that is unknown.
+std::vector<int> CoarseToFineMatcher::coarsest_truth() const {
+  const MeshLevel &cx = hx_.levels.front(), &cy = hy_.levels.front();
+  const Mesh& input_y = hy_.levels.back().mesh;
+  std::vector<int> image(cx.mesh.num_vertices(), -1);
+  for (int u = 0; u < cx.mesh.num_vertices(); ++u) {
+    const int t = options_.truth[cx.input_vertex[u]];
+    if (t < 0) continue;
+    if (t >= input_y.num_vertices()) throw InvalidInputError("coarse to fine: the true map names a vertex Y lacks");
+    double best = std::numeric_limits<double>::infinity();
+    for (int w = 0; w < cy.mesh.num_vertices(); ++w)
+      if (const double d = (cy.mesh.vertices[w] - input_y.vertices[t]).squaredNorm(); d < best) {
+        best = d;
+        image[u] = w;
+      }
+  }
+  return image;
 }
 
 void CoarseToFineMatcher::set_features(Eigen::MatrixXd fx, Eigen::MatrixXd fy) {
@@ -1106,7 +1168,12 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
         restarted ? &*restarted
                   : (first_attempt && resume && !resume->rounding.empty() ? &resume->rounding : nullptr);
     MatchingLp m;
-    if (l == 0) {
+    if (l == 0 && !options_.truth.empty()) {
+      m = build_matching_lp(
+          ProductSpace::from_list(lx.mesh, ly.mesh, truth_space(lx.mesh, ly.mesh, coarsest_truth(), options_.truth_rings)),
+          model, options_.matching.scale_costs);
+      spdlog::info("level 1: the space within {} rings of the true map", options_.truth_rings);
+    } else if (l == 0) {
       m = build_matching_lp(ProductSpace::full(lx.mesh, ly.mesh), model, options_.matching.scale_costs);
     } else {
       rep.ring = ring;
@@ -1136,7 +1203,8 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
     }
     const double kept = 100.0 * double(rep.variables) / double(rep.full_variables);
     spdlog::info("level {}/{}: {} × {} faces, {} variables ({}){}", l + 1, hx_.size(), rep.faces_x, rep.faces_y,
-                 rep.variables, l > 0 ? fmt::format("{:.3g} % of the full space", kept) : "the full space",
+                 rep.variables,
+                 l > 0 || !options_.truth.empty() ? fmt::format("{:.3g} % of the full space", kept) : "the full space",
                  l > 0 ? fmt::format(", ring {}", ring) : std::string());
     // Propagation alone proves most reduced LPs infeasible, and says where: widen there first.
     // (Not where a rounding of this LP goes on: it got past that.)
@@ -1375,6 +1443,10 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
       first_y = {};
       continue;
     } catch (const InfeasibleError& e) {
+      if (l == 0 && !options_.truth.empty() && !dynamic_cast<const StuckError*>(&e))
+        throw InfeasibleError(fmt::format("the coarsest level's space within {} rings of the true map holds no "
+                                          "matching ({}); try more rings",
+                                          options_.truth_rings, e.what()));
       if (l == 0) throw;
       ProofPlace proof(m);
       for (int64_t i : e.rows()) proof.add(m, i);

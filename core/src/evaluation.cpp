@@ -10,6 +10,7 @@
 #include <charconv>
 #include <cmath>
 #include <exception>
+#include <limits>
 #include <fstream>
 #include <mutex>
 #include <sstream>
@@ -75,6 +76,35 @@ std::vector<std::vector<int>> read_rows(const std::string& path, int columns, in
 }
 
 }  // namespace
+
+std::vector<int> truth_at(const Mesh& x_file, const Mesh& y_file, const std::vector<int>& x_ids,
+                          const std::vector<int>& y_ids, const GroundTruth& truth) {
+  if (truth.empty()) throw InvalidInputError("true map: the ground truth has no pairs");
+  // The nearest of `candidates` (vertices of `mesh`) to p: a plain scan, run once per vertex.
+  auto nearest = [](const Mesh& mesh, const auto& candidates, auto vertex_of, const Eigen::Vector3d& p) {
+    double best = std::numeric_limits<double>::infinity();
+    size_t arg = 0;
+    for (size_t k = 0; k < candidates.size(); ++k)
+      if (const double d = (mesh.vertices[vertex_of(candidates[k])] - p).squaredNorm(); d < best) {
+        best = d;
+        arg = k;
+      }
+    return arg;
+  };
+  for (const GroundTruthPair& g : truth)
+    if (g.x < 0 || g.x >= x_file.num_vertices() || g.y < 0 || g.y >= y_file.num_vertices())
+      throw InvalidInputError("true map: a ground-truth pair names a vertex the meshes lack");
+  for (int id : y_ids)
+    if (id < 0 || id >= y_file.num_vertices()) throw InvalidInputError("true map: a vertex id Y lacks");
+  std::vector<int> image(x_ids.size(), -1);
+  for (size_t v = 0; v < x_ids.size(); ++v) {
+    if (x_ids[v] < 0 || x_ids[v] >= x_file.num_vertices()) throw InvalidInputError("true map: a vertex id X lacks");
+    const GroundTruthPair& g =
+        truth[nearest(x_file, truth, [](const GroundTruthPair& t) { return t.x; }, x_file.vertices[x_ids[v]])];
+    image[v] = static_cast<int>(nearest(y_file, y_ids, [](int id) { return id; }, y_file.vertices[g.y]));
+  }
+  return image;
+}
 
 std::vector<int> read_vertex_list(const std::string& path, bool one_based, int num_vertices) {
   std::vector<int> list;

@@ -279,6 +279,15 @@ struct CoarseToFineOptions {
   // A directory: every later round's part that Clp took RoundingOptions::slow_part_seconds or
   // more on is written there as level<L>-slow-<NNN>.smlp (write_lp). Empty: none.
   std::string dump_slow_parts;
+  // A diagnostic, not an input of matching: a true map of the matched meshes, for every input
+  // vertex of X its true input vertex of Y (-1: unknown; truth_at in evaluation.hpp makes one
+  // from ground truth). Non-empty: the coarsest level's space is truth_space around it (each X
+  // vertex's image there: the coarsest Y vertex nearest in space to its true vertex), and there
+  // is no second start. A run with it against one without says whether the energy or the search
+  // prefers a wrong matching: TOSCA_r victoria0–victoria4 without WKS (sixty-fifth session) ended
+  // wrong at every level with a gap of 1.4 %, which cannot tell the two apart.
+  std::vector<int> truth;
+  int truth_rings = 2;
   // With a checkpoint (run's `checkpoint`), where a level's rounding has got is saved after its
   // rounds at most this often (LevelAttempt::rounding): each save writes every level's Γ, a few
   // hundred kB at full resolution, and the last rounds take hundredths of a second each.
@@ -304,6 +313,12 @@ std::vector<ProductTriangle> reduced_product_space(const MeshLevel& fine_x, cons
                                                    const std::vector<ProductTriangle>& coarse_gamma, int ring,
                                                    Neighbourhood neighbourhood,
                                                    const std::vector<int>& extra_rings = {}, int y_margin = 0);
+
+// The product triangles of x × y each of whose corners (a, b) has b within `rings` edges of
+// image[a] (one entry per vertex of x; -1: any b). At rings 0 with the identity as image, the
+// identity matching (and degenerate triangles never qualify there: their corners repeat on one
+// side only). Enumerated from the full space: for the coarsest level.
+std::vector<ProductTriangle> truth_space(const Mesh& x, const Mesh& y, const std::vector<int>& image, int rings);
 
 // (A new field goes into checkpoint.cpp's each_field too, so that checkpoints keep it.)
 struct LevelReport {
@@ -498,6 +513,8 @@ private:
   // and rounding; false where it found no Γ.
   bool solve_second_start(int l, const EnergyModel& model, LevelReport& rep, std::vector<ProductTriangle>& gamma,
                           CoarseToFineResult& finest, const Progress& progress, bool optional) const;
+
+  std::vector<int> coarsest_truth() const;  // CoarseToFineOptions::truth on the coarsest meshes
 
   CoarseToFineOptions options_;
   MeshHierarchy hx_, hy_;

@@ -30,6 +30,15 @@ GroundTruth read_map_ground_truth(const std::string& path, int x_vertices, int y
 // The same two columns with either base (match's levels/level_K.txt are 0-based).
 GroundTruth read_vertex_pairs(const std::string& path, bool one_based, int x_vertices, int y_vertices);
 
+// A true map of the matched meshes from ground truth between the files they came from
+// (CoarseToFineOptions::truth): for every vertex v of the matched X (x_ids[v]: its vertex of
+// x_file), the vertex of the matched Y (y_ids likewise) nearest in space to the Y side of the
+// ground-truth pair whose X side is nearest in space to x_ids[v]. In space, not on the surface:
+// where two parts nearly touch it can take the other part. Throws InvalidInputError where the
+// ground truth is empty.
+std::vector<int> truth_at(const Mesh& x_file, const Mesh& y_file, const std::vector<int>& x_ids,
+                          const std::vector<int>& y_ids, const GroundTruth& truth);
+
 // One vertex index per line (map_x_to_y.txt, x_vertex_ids.txt; `.vts` with one_based), each in
 // [0, num_vertices) after subtracting the base; returned 0-based. Throws IoError or
 // InvalidInputError "<path>: line N: <problem>".
