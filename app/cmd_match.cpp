@@ -97,10 +97,14 @@ struct MatchArgs {
   int truth_rings = CoarseToFineOptions{}.truth_rings;
 };
 
+bool truth_given(const MatchArgs& args) {
+  return !args.truth.empty() || !args.truth_x.empty() || !args.truth_map.empty();
+}
+
 // The true map of CoarseToFineOptions::truth from the ground truth named (none: empty), read
 // against the files as loaded for matching.
 std::vector<int> true_map(const MatchArgs& args, const MeshPair& p, std::string& name) {
-  if (args.truth.empty() && args.truth_x.empty() && args.truth_map.empty()) return {};
+  if (!truth_given(args)) return {};
   LoadOptions load;
   load.close_holes = args.pair.close_holes;
   const Mesh x = load_mesh(p.x_file, load), y = load_mesh(p.y_file, load);
@@ -115,7 +119,11 @@ std::vector<int> true_map(const MatchArgs& args, const MeshPair& p, std::string&
     truth = identity_ground_truth(x.num_vertices(), y.num_vertices());
     name = "identity";
   }
-  return truth_at(x, y, p.x_ids, p.y_ids, truth);
+  try {
+    return truth_at(x, y, p.x_ids, p.y_ids, truth);
+  } catch (const InvalidInputError& e) {
+    throw InvalidInputError(name + ": " + e.what());
+  }
 }
 
 // auto: a GPU if there is one, else the native solver (lavapipe is for testing, not speed).
@@ -161,7 +169,7 @@ void publish(const fs::path& tmp, const fs::path& out) {
 int run_match(const MatchArgs& args) {
   Stopwatch total, stage;
   Json seconds = Json::object();
-  if ((!args.truth.empty() || !args.truth_x.empty() || !args.truth_map.empty()) && !args.checkpoint.empty())
+  if (truth_given(args) && !args.checkpoint.empty())
     throw InvalidInputError("--truth* and --checkpoint exclude each other (a diagnostic run is not gone on from)");
   const MeshPair p = load_pair(args.pair);
 
@@ -214,6 +222,8 @@ int run_match(const MatchArgs& args) {
   std::string truth_name;
   co.truth = true_map(args, p, truth_name);
   co.truth_rings = args.truth_rings;
+  if (!truth_given(args) && args.truth_rings != CoarseToFineOptions{}.truth_rings)
+    spdlog::warn("--truth-rings without --truth, --truth-x or --truth-map: no effect");
   RoundingOptions& ro = co.rounding;
   ro.solver = solver_for(args);
   ro.threshold = args.threshold;

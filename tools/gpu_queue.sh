@@ -58,7 +58,8 @@ cat > "$dir/q.sh" <<'EOF'
 # Runs the jobs of jobs.txt (or $JOBS), P at once, each `bench match` of one pair with the options
 # of match_args.txt and --backend $BACKEND (vulkan; cpu where no NVIDIA device shows) at FACES faces
 # (full), THREADS threads each (default nproc / P), stopped LIMIT seconds after the queue starts;
-# then packs logs, tables, results and checkpoints (no meshes) into $OUT/q.txz. Run it from a
+# then packs logs, tables, results and checkpoints (no meshes) into $OUT/q.txz (also every PACK
+# seconds, 60, on the way: a call killed at its limit brings back the latest). Run it from a
 # folder outside the checkout (a later call would replace an ignored folder it does not carry).
 # Runs go on where an earlier call stopped (bench match --resume): unpack its q.txz here first.
 LIMIT=${LIMIT:-515}; P=${P:-8}; BACKEND=${BACKEND:-vulkan}; FACES=${FACES:-full}
@@ -80,13 +81,15 @@ SMI=$!
 pack() {
   cat out/*/bench_pairs.md > log/tables.md 2>/dev/null
   for c in out/*/runs/*.ckpt; do [ -f "$c" ] && echo "$c $(./shapematch checkpoint "$c" | tr -d ' \n')"; done > log/checkpoints.txt 2>&1
-  tar cJf "${OUT:-/tmp}/q.part.txz" --exclude='*.ply' --exclude='*.png' --exclude=levels log out 2>/dev/null &&
-    mv -f "${OUT:-/tmp}/q.part.txz" "${OUT:-/tmp}/q.txz"
+  # (tar's status 1: a file changed or went while it read, as the runs' logs and checkpoints do.)
+  tar cJf "${OUT:-/tmp}/q.part.txz" --warning=no-file-changed --warning=no-file-removed --exclude='*.ply' \
+    --exclude='*.png' --exclude=levels log out 2>/dev/null
+  [ $? -le 1 ] && mv -f "${OUT:-/tmp}/q.part.txz" "${OUT:-/tmp}/q.txz"
 }
 # Every PACK seconds too: a call killed at its own limit (a LIMIT too long for it) still brings
 # back the latest checkpoints (sixty-sixth session: one killed before its only pack brought none).
 rm -f .stop
-(n=0; while [ ! -e .stop ]; do sleep 5; n=$((n + 5)); [ "$n" -ge "${PACK:-60}" ] && { pack; n=0; }; done) &
+(n=0; while [ ! -e .stop ]; do sleep 5; n=$((n + 5)); [ "$n" -ge "${PACK:-60}" ] && { XZ_OPT=-1 nice -n 19 bash -c "$(declare -f pack); pack"; n=0; }; done) &
 PACKER=$!
 # A job line: NAME on|off [TAG MATCH-ARGS...]: a TAG names a variant with options of its own
 # (added by hand, e.g. `03-024-043 on ring2 --ring 2`), so that one call compares them.

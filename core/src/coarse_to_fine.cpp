@@ -490,6 +490,8 @@ CoarseToFineMatcher::CoarseToFineMatcher(const Mesh& x, const Mesh& y, CoarseToF
                   cy[1] == ho.second_faces && options_.truth.empty();
   if (!options_.truth.empty() && options_.truth.size() != size_t(x.num_vertices()))
     throw InvalidInputError("coarse to fine: the true map needs one entry per input vertex of X");
+  for (int t : options_.truth)
+    if (t < -1 || t >= y.num_vertices()) throw InvalidInputError("coarse to fine: the true map names a vertex Y lacks");
   if (hx_.size() != hy_.size()) throw Error("coarse to fine: the hierarchies differ in length (a bug)");
   if (options_.matching.features_x.size() > 0 || options_.matching.features_y.size() > 0)
     set_features(std::move(options_.matching.features_x), std::move(options_.matching.features_y));
@@ -497,6 +499,7 @@ CoarseToFineMatcher::CoarseToFineMatcher(const Mesh& x, const Mesh& y, CoarseToF
 
 // Each coarsest X vertex's true image there: the coarsest Y vertex nearest in space to the true
 // input vertex of its own input vertex (CoarseToFineOptions::truth); -1 where that is unknown.
+// Measured in the input's frame: decimation rescales what it keeps.
 std::vector<int> CoarseToFineMatcher::coarsest_truth() const {
   const MeshLevel &cx = hx_.levels.front(), &cy = hy_.levels.front();
   const Mesh& input_y = hy_.levels.back().mesh;
@@ -504,10 +507,9 @@ std::vector<int> CoarseToFineMatcher::coarsest_truth() const {
   for (int u = 0; u < cx.mesh.num_vertices(); ++u) {
     const int t = options_.truth[cx.input_vertex[u]];
     if (t < 0) continue;
-    if (t >= input_y.num_vertices()) throw InvalidInputError("coarse to fine: the true map names a vertex Y lacks");
     double best = std::numeric_limits<double>::infinity();
     for (int w = 0; w < cy.mesh.num_vertices(); ++w)
-      if (const double d = (cy.mesh.vertices[w] - input_y.vertices[t]).squaredNorm(); d < best) {
+      if (const double d = (input_y.vertices[cy.input_vertex[w]] - input_y.vertices[t]).squaredNorm(); d < best) {
         best = d;
         image[u] = w;
       }
@@ -1169,10 +1171,13 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
                   : (first_attempt && resume && !resume->rounding.empty() ? &resume->rounding : nullptr);
     MatchingLp m;
     if (l == 0 && !options_.truth.empty()) {
-      m = build_matching_lp(
-          ProductSpace::from_list(lx.mesh, ly.mesh, truth_space(lx.mesh, ly.mesh, coarsest_truth(), options_.truth_rings)),
-          model, options_.matching.scale_costs);
-      spdlog::info("level 1: the space within {} rings of the true map", options_.truth_rings);
+      std::vector<ProductTriangle> near = truth_space(lx.mesh, ly.mesh, coarsest_truth(), options_.truth_rings);
+      if (near.empty())
+        throw InfeasibleError(fmt::format("no product triangle of the coarsest level lies within {} rings of the true map",
+                                          options_.truth_rings));
+      m = build_matching_lp(ProductSpace::from_list(lx.mesh, ly.mesh, std::move(near)), model,
+                            options_.matching.scale_costs);
+      spdlog::info("level {}: the space within {} rings of the true map", l + 1, options_.truth_rings);
     } else if (l == 0) {
       m = build_matching_lp(ProductSpace::full(lx.mesh, ly.mesh), model, options_.matching.scale_costs);
     } else {
@@ -1443,10 +1448,11 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
       first_y = {};
       continue;
     } catch (const InfeasibleError& e) {
-      if (l == 0 && !options_.truth.empty() && !dynamic_cast<const StuckError*>(&e))
-        throw InfeasibleError(fmt::format("the coarsest level's space within {} rings of the true map holds no "
-                                          "matching ({}); try more rings",
-                                          options_.truth_rings, e.what()));
+      if (l == 0 && !options_.truth.empty())  // (the rounding's own message says whether the LP was)
+        throw InfeasibleError(fmt::format("found no matching in the coarsest level's space within {} rings of the true "
+                                          "map: {}",
+                                          options_.truth_rings, e.what()),
+                              e.rows(), e.certified());
       if (l == 0) throw;
       ProofPlace proof(m);
       for (int64_t i : e.rows()) proof.add(m, i);

@@ -10,8 +10,8 @@
 #include <charconv>
 #include <cmath>
 #include <exception>
-#include <limits>
 #include <fstream>
+#include <limits>
 #include <mutex>
 #include <sstream>
 #include <thread>
@@ -96,12 +96,21 @@ std::vector<int> truth_at(const Mesh& x_file, const Mesh& y_file, const std::vec
       throw InvalidInputError("true map: a ground-truth pair names a vertex the meshes lack");
   for (int id : y_ids)
     if (id < 0 || id >= y_file.num_vertices()) throw InvalidInputError("true map: a vertex id Y lacks");
+  // Exact where they can be: a vertex with a pair of its own, an image that was kept.
+  std::vector<int> pair_of(x_file.num_vertices(), -1), kept_as(y_file.num_vertices(), -1);
+  for (size_t k = 0; k < truth.size(); ++k)
+    if (pair_of[truth[k].x] < 0) pair_of[truth[k].x] = static_cast<int>(k);
+  for (size_t w = 0; w < y_ids.size(); ++w) kept_as[y_ids[w]] = static_cast<int>(w);
   std::vector<int> image(x_ids.size(), -1);
   for (size_t v = 0; v < x_ids.size(); ++v) {
     if (x_ids[v] < 0 || x_ids[v] >= x_file.num_vertices()) throw InvalidInputError("true map: a vertex id X lacks");
+    const int k = pair_of[x_ids[v]];
     const GroundTruthPair& g =
-        truth[nearest(x_file, truth, [](const GroundTruthPair& t) { return t.x; }, x_file.vertices[x_ids[v]])];
-    image[v] = static_cast<int>(nearest(y_file, y_ids, [](int id) { return id; }, y_file.vertices[g.y]));
+        k >= 0 ? truth[k]
+               : truth[nearest(x_file, truth, [](const GroundTruthPair& t) { return t.x; }, x_file.vertices[x_ids[v]])];
+    image[v] = kept_as[g.y] >= 0
+                   ? kept_as[g.y]
+                   : static_cast<int>(nearest(y_file, y_ids, [](int id) { return id; }, y_file.vertices[g.y]));
   }
   return image;
 }
