@@ -285,7 +285,8 @@ struct CoarseToFineOptions {
   // vertex's image there: the coarsest Y vertex nearest in space to its true vertex), and there
   // is no second start. A run with it against one without says whether the energy or the search
   // prefers a wrong matching: TOSCA_r victoria0–victoria4 without WKS (sixty-fifth session) ended
-  // wrong at every level with a gap of 1.4 %, which cannot tell the two apart.
+  // wrong at every level with a gap of 1.4 %, which cannot tell the two apart; at 100 faces the
+  // search had missed a lower matching near the truth (docs/results-log.md, sixty-sixth session).
   std::vector<int> truth;
   int truth_rings = 2;
   // With a checkpoint (run's `checkpoint`), where a level's rounding has got is saved after its
