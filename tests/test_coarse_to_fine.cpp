@@ -1826,6 +1826,7 @@ TEST_CASE("coarse to fine: a true map restricts the coarsest level, and there is
   }
   const VertexMaps maps = vertex_maps(r.finest.space, r.rounding.gamma);
   for (int v = 0; v < m.num_vertices(); ++v) CHECK(maps.x_to_y[v] == v);
+  CHECK_THROWS_AS(matcher.run({}, nullptr, [](const LevelCheckpoint&) {}), InvalidInputError);
 
   // A true map that sends every vertex to one vertex of Y leaves no closed matching at 0 rings.
   std::fill(o.truth.begin(), o.truth.end(), 0);

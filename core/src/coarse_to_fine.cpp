@@ -527,6 +527,9 @@ void CoarseToFineMatcher::set_features(Eigen::MatrixXd fx, Eigen::MatrixXd fy) {
 
 CoarseToFineResult CoarseToFineMatcher::run(const Progress& progress, const LevelCheckpoint* resume,
                                             const Checkpointing& checkpoint) const {
+  // A checkpoint does not record the true map: a run near it neither goes on from one nor makes one.
+  if (!options_.truth.empty() && (resume || checkpoint))
+    throw InvalidInputError("coarse to fine: a run near a true map takes no checkpoint");
   CoarseToFineResult result;
   // The Γ that goes on, or with lookahead from the second level two: the refined one and the
   // second start's, the lower energy first ("leading"), refined side by side up to `decide_at`,
