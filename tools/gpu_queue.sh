@@ -89,7 +89,8 @@ pack() {
 # Every PACK seconds too: a call killed at its own limit (a LIMIT too long for it) still brings
 # back the latest checkpoints (sixty-sixth session: one killed before its only pack brought none).
 rm -f .stop
-(n=0; while [ ! -e .stop ]; do sleep 5; n=$((n + 5)); [ "$n" -ge "${PACK:-60}" ] && { XZ_OPT=-1 nice -n 19 bash -c "$(declare -f pack); pack"; n=0; }; done) &
+(renice -n 19 $BASHPID > /dev/null; export XZ_OPT=-1  # beside the timed runs: the spare cycles only
+ n=0; while [ ! -e .stop ]; do sleep 5; n=$((n + 5)); [ "$n" -ge "${PACK:-60}" ] && { pack; n=0; }; done) &
 PACKER=$!
 # A job line: NAME on|off [TAG MATCH-ARGS...]: a TAG names a variant with options of its own
 # (added by hand, e.g. `03-024-043 on ring2 --ring 2`), so that one call compares them.
