@@ -963,8 +963,15 @@ bool resume_row(const BenchMatchArgs& args, const PairSpec& pair, const std::vec
     const std::vector<std::string> recorded_match = strings_of(record.get("match"));
     if (what_asked(recorded_match) != what_asked(match) ||
         what_asked(strings_of(record.get("truth"))) != what_asked(pair.truth)) {
-      spdlog::info("{}: the recorded run had other options; running it again", row.name);
-      fs::remove(checkpoint);
+      // Its checkpoint is of those options: set aside, not deleted (a flag spelt otherwise, say
+      // `--wks on` for the default, would otherwise cost the hours its levels took).
+      std::string aside;
+      if (fs::exists(checkpoint)) {
+        aside = checkpoint.string() + ".other-options";
+        fs::rename(checkpoint, aside);
+      }
+      spdlog::info("{}: the recorded run had other options; running it again{}", row.name,
+                   aside.empty() ? "" : " (its checkpoint kept as " + aside + ")");
       return false;
     }
     // (A record from before total_seconds: its own seconds, checkpoints it went on from unknown.)

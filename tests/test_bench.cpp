@@ -544,6 +544,17 @@ TEST_CASE("cli: bench match --pairs --resume goes on from where a run that timed
   CHECK(read_text(log).find("the checkpointed rounding was of an LP of 1 × 1") != std::string::npos);
   CHECK(row().at("status") == "ok");
   CHECK_FALSE(fs::exists(checkpoint));
+  // Asked with other options: it runs afresh, the checkpoint of the old ones set aside (whole).
+  fs::copy_file(dir / "saved.ckpt", checkpoint);
+  edit_record("status", "\"timed out\"");
+  REQUIRE(run_cli(bench + " --ring 1", err) == 0);
+  const fs::path aside = checkpoint.string() + ".other-options";
+  CHECK(read_text(err).find("had other options; running it again (its checkpoint kept as " + aside.string() + ")") !=
+        std::string::npos);
+  CHECK(row().at("resumed_after_level") == "0");
+  CHECK(read_text(aside) == read_text(dir / "saved.ckpt"));
+  fs::remove(aside);
+  REQUIRE(run_cli(bench, err) == 0);  // (the record back at this test's options)
   // Stopped on another backend, in another folder (a GPU machine's queue): its checkpoint goes on
   // here, whatever the limit.
   fs::copy_file(dir / "saved.ckpt", checkpoint);
