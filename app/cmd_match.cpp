@@ -95,6 +95,10 @@ struct MatchArgs {
   // The diagnostic of CoarseToFineOptions::truth: ground truth as eval takes it.
   std::string truth, truth_x, truth_y, truth_map;
   int truth_rings = CoarseToFineOptions{}.truth_rings;
+  int branch_depth = CoarseToFineOptions{}.branch_depth;
+  int branch_rings = CoarseToFineOptions{}.branch_rings;
+  double branch_min_split = CoarseToFineOptions{}.branch_min_split;
+  double branch_gap = CoarseToFineOptions{}.branch_gap;
 };
 
 bool truth_given(const MatchArgs& args) {
@@ -222,6 +226,10 @@ int run_match(const MatchArgs& args) {
   std::string truth_name;
   co.truth = true_map(args, p, truth_name);
   co.truth_rings = args.truth_rings;
+  co.branch_depth = args.branch_depth;
+  co.branch_rings = args.branch_rings;
+  co.branch_min_split = args.branch_min_split;
+  co.branch_gap = args.branch_gap;
   if (!truth_given(args) && args.truth_rings != CoarseToFineOptions{}.truth_rings)
     spdlog::warn("--truth-rings without --truth, --truth-x or --truth-map: no effect");
   RoundingOptions& ro = co.rounding;
@@ -535,7 +543,11 @@ int run_match(const MatchArgs& args) {
                               .set("price_threshold", args.price_threshold)
                               .set("price_tolerance", args.price_tolerance)
                               .set("truth", truth_name)
-                              .set("truth_rings", args.truth_rings));
+                              .set("truth_rings", args.truth_rings)
+                              .set("branch_depth", args.branch_depth)
+                              .set("branch_rings", args.branch_rings)
+                              .set("branch_min_split", args.branch_min_split)
+                              .set("branch_gap", args.branch_gap));
     // Levels taken from a checkpoint keep the seconds and memory of the run that solved them.
     report.set("resumed_after_level", resume ? static_cast<int64_t>(resume->levels.size()) : int64_t(0));
     report.set("seconds", seconds);
@@ -576,6 +588,9 @@ int run_match(const MatchArgs& args) {
                       .set("lookahead_other_bound", l.lookahead_other_bound)
                       .set("lookahead_other_stuck", l.lookahead_other_stuck)
                       .set("lookahead_switched", l.lookahead_switched)
+                      .set("branch_roundings", l.branch_roundings)
+                      .set("branch_energy", l.branch_energy)
+                      .set("branch_kept", l.branch_kept)
                       .set("seconds", l.seconds)
                       .set("peak_rss_mb", l.peak_rss_mb));
     report.set("levels", levels);
@@ -797,6 +812,23 @@ Action add_match_command(CLI::App& app) {
   app.add_option("--truth-rings", a->truth_rings,
                  "with --truth*: each corner's Y vertex within this many edges of its true image on the coarsest Y")
       ->check(CLI::Range(0, 16))
+      ->capture_default_str();
+  app.add_option("--branch-depth", a->branch_depth,
+                 "where the coarsest level's Γ is over --branch-gap above its LP's bound, dive this many steps: split "
+                 "on the X vertex whose image the LP spreads most between two places of Y, round each side, keep the "
+                 "lowest Γ, go on from the lower side (0: off)")
+      ->check(CLI::Range(0, 16))
+      ->capture_default_str();
+  app.add_option("--branch-rings", a->branch_rings, "with --branch-depth: each place is a ball of this many edges of Y")
+      ->check(CLI::Range(0, 16))
+      ->capture_default_str();
+  app.add_option("--branch-min-split", a->branch_min_split,
+                 "with --branch-depth: split only where the second place holds at least this share of the image")
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str();
+  app.add_option("--branch-gap", a->branch_gap,
+                 "with --branch-depth: dive only where the coarsest gap (energy over bound, relative) is above this")
+      ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   app.add_option("--dump-first-lps", a->dump_first_lps,
                  "write every first LP of a rounding to this directory (level<L>-<NNN>.smlp), to solve it again "

@@ -1560,8 +1560,8 @@ TEST_CASE("coarse to fine: a run gone on from an attempt of a level in progress 
     bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
   }
   const size_t at = std::string("shapematch level checkpoint\n").size();
-  REQUIRE(bytes[at] == 7);
-  bytes[at] = 8;  // a later version than this build's
+  REQUIRE(bytes[at] == 8);
+  bytes[at] = 9;  // a later version than this build's
   std::ofstream(file, std::ios::binary) << bytes;
   CHECK_THROWS_AS(load_checkpoint(file), IoError);
   detail::save_checkpoint_as(file, marked, 1);
@@ -1581,7 +1581,7 @@ TEST_CASE("coarse to fine: a run gone on from an attempt of a level in progress 
   CHECK(v3.attempt.report.widened_faces == a.report.widened_faces);
   CHECK(v3.attempt.report.stuck_restarts == 0);
   CHECK(v3.levels.back().gamma == last.levels.back().gamma);
-  CHECK_THROWS_AS(detail::save_checkpoint_as(file, marked, 8), InvalidInputError);
+  CHECK_THROWS_AS(detail::save_checkpoint_as(file, marked, 9), InvalidInputError);
 }
 
 TEST_CASE("coarse to fine: a run gone on from a checkpoint inside a rounding fixes its decisions and keeps its bound") {
@@ -1834,4 +1834,123 @@ TEST_CASE("coarse to fine: a true map restricts the coarsest level, and there is
   CHECK_THROWS_WITH_AS(collapsed.run(), doctest::Contains("within 0 rings of the true map"), InfeasibleError);
   o.truth.pop_back();
   CHECK_THROWS_AS(CoarseToFineMatcher(m, m, o), InvalidInputError);
+}
+
+TEST_CASE("image split: an LP half the identity and half a rotation splits the images the rotation moves") {
+  const Mesh m = shapes::octahedron();
+  // Rotation by 180° about z: ±x and ±y swap signs, ±z stay.
+  std::vector<int> turn(m.num_vertices(), -1), identity(m.num_vertices());
+  std::iota(identity.begin(), identity.end(), 0);
+  for (int v = 0; v < m.num_vertices(); ++v) {
+    const Eigen::Vector3d p = m.vertices[v], q(-p.x(), -p.y(), p.z());
+    for (int w = 0; w < m.num_vertices(); ++w)
+      if ((m.vertices[w] - q).norm() < 1e-9) turn[v] = w;
+  }
+  REQUIRE(std::count(turn.begin(), turn.end(), -1) == 0);
+  std::vector<ProductTriangle> list = truth_space(m, m, identity, 0), rotated = truth_space(m, m, turn, 0);
+  REQUIRE(list.size() == size_t(m.num_faces()));
+  REQUIRE(rotated.size() == size_t(m.num_faces()));
+  list.insert(list.end(), rotated.begin(), rotated.end());
+  const ProductSpace space = ProductSpace::from_list(m, m, list);
+  const std::vector<double> half(list.size(), 0.5);
+  std::vector<char> moved(m.num_vertices(), 0);
+  for (int v = 0; v < m.num_vertices(); ++v) moved[v] = turn[v] != v;
+  const int first_moved = int(std::find(moved.begin(), moved.end(), 1) - moved.begin());
+
+  // At 0 rings each place is one vertex: a moved vertex's image is half at itself, half at its turn.
+  const ImageSplit s = most_split_image(space, half, 0);
+  CHECK(s.vertex == first_moved);  // (four tie; the lowest index)
+  CHECK(s.split == doctest::Approx(0.5));
+  REQUIRE(s.first.size() == size_t(m.num_vertices()));
+  REQUIRE(s.second.size() == size_t(m.num_vertices()));
+  CHECK(std::count(s.first.begin(), s.first.end(), 1) == 1);
+  CHECK(s.first[s.vertex] + s.second[s.vertex] == 1);  // one place is itself, the other its turn
+  CHECK(s.first[turn[s.vertex]] + s.second[turn[s.vertex]] == 1);
+  // At 1 ring a vertex's ball holds all but its antipode, which is its turn: the same split.
+  CHECK(most_split_image(space, half, 1).split == doctest::Approx(0.5));
+  // At 2 rings one ball is the whole octahedron: no second place.
+  const ImageSplit whole = most_split_image(space, half, 2);
+  CHECK(whole.split == 0.0);
+  CHECK(whole.second.empty());
+  // The moved vertices skipped, the rest are not split.
+  const ImageSplit rest = most_split_image(space, half, 0, moved);
+  CHECK(rest.vertex >= 0);
+  CHECK_FALSE(moved[rest.vertex]);
+  CHECK(rest.split == 0.0);
+  // Only the identity's values: nothing split.
+  std::vector<double> one(list.size(), 0.0);
+  std::fill(one.begin(), one.begin() + m.num_faces(), 1.0);
+  CHECK(most_split_image(space, one, 0).split == 0.0);
+  CHECK(most_split_image(space, std::vector<double>(list.size(), 0.0), 0).vertex == -1);
+  CHECK_THROWS_AS(most_split_image(space, {0.5}, 0), InvalidInputError);
+
+  // Kept at its own place, the vertex keeps the identity's triangles and loses the rotation's
+  // through it; at its turn's, the other way round.
+  const int v = s.vertex;
+  std::vector<char> at_self(m.num_vertices(), 0), at_turn(m.num_vertices(), 0);
+  at_self[v] = 1;
+  at_turn[turn[v]] = 1;
+  int through = 0;
+  for (const std::array<int, 3>& f : m.faces) through += std::count(f.begin(), f.end(), v);
+  for (const std::vector<char>* place : {&at_self, &at_turn}) {
+    const std::vector<ProductTriangle> kept = keep_images(list, v, *place);
+    CHECK(kept.size() == list.size() - through);
+    for (const ProductTriangle& t : kept)
+      for (int i = 0; i < 3; ++i)
+        if (t.a[i] == v) CHECK((*place)[t.b[i]]);
+  }
+  CHECK(keep_images(list, v, std::vector<char>(m.num_vertices(), 1)).size() == list.size());
+}
+
+TEST_CASE("coarse to fine: the coarsest dive keeps its bound and ends below a fractional LP's plain rounding") {
+  // A single level (the coarsest is the finest: its LP and rounding are the result's), on a pair
+  // whose LP is fractional there: the plain rounding ends 9 % above the bound.
+  CoarseToFineOptions o;
+  o.hierarchy.levels = 1;
+  o.rounding.solver = "pdhg-cpu";
+  o.branch_gap = 0.0;
+  o.branch_min_split = 1e-6;
+  const Mesh x = decimate(shapes::dolphin(20, 0), 40), y = decimate(shapes::dolphin(-20, 40), 44);
+  const CoarseToFineResult plain = CoarseToFineMatcher(x, y, o).run();
+  o.branch_depth = 2;
+  const CoarseToFineMatcher diving(x, y, o);  // (r.finest points into its levels)
+  const CoarseToFineResult r = diving.run();
+  const LevelReport& p = plain.levels[0];
+  const LevelReport& b = r.levels[0];
+  MESSAGE("plain ", p.energy, " (bound ", p.lower_bound, "), dive ", b.energy, ", ", b.branch_roundings,
+          " sides rounded, least ", b.branch_energy);
+  CHECK(p.branch_roundings == 0);
+  CHECK(std::isnan(p.branch_energy));
+  CHECK_FALSE(p.branch_kept);
+  REQUIRE(p.gap > 0.05);
+  CHECK(b.lower_bound == p.lower_bound);  // the full space's
+  CHECK(b.variables == p.variables);
+  CHECK(b.branch_roundings >= 2);
+  CHECK(b.branch_kept);
+  CHECK(b.energy < p.energy);
+  CHECK(b.energy == b.branch_energy);
+  CHECK(b.gap == doctest::Approx(relative_gap(b.energy, b.lower_bound)));
+  CHECK(check_graph_surface(r.finest.space, r.rounding.gamma).ok());
+  CHECK(r.rounding.energy == doctest::Approx(b.energy).epsilon(1e-12));
+  CHECK(r.rounding.lower_bound == p.lower_bound);
+  double sum = 0.0;
+  for (int64_t j : r.rounding.gamma) sum += r.finest.energy[j];
+  CHECK(sum == doctest::Approx(b.energy).epsilon(1e-9));
+  // The branch numbers go through a checkpoint (version 8), not through a version-7 one.
+  test::TempDir tmp;
+  const std::string file = (tmp.path / "branch.ckpt").string();
+  LevelCheckpoint c;
+  c.levels = r.levels;
+  save_checkpoint(file, c);
+  const LevelReport loaded = load_checkpoint(file).levels[0];
+  CHECK(loaded.branch_roundings == b.branch_roundings);
+  CHECK(loaded.branch_energy == b.branch_energy);
+  CHECK(loaded.branch_kept);
+  detail::save_checkpoint_as(file, c, 7);
+  CHECK(std::isnan(load_checkpoint(file).levels[0].branch_energy));
+  // Where the plain Γ is within branch_gap of its bound there is no dive.
+  o.branch_gap = 1.0;
+  const CoarseToFineResult none = CoarseToFineMatcher(x, y, o).run();
+  CHECK(none.levels[0].branch_roundings == 0);
+  CHECK(none.levels[0].gamma == p.gamma);
 }

@@ -16,8 +16,9 @@ constexpr char kMagic[] = "shapematch level checkpoint\n";
 // 2: the attempt of the level in progress (LevelAttempt) follows the extra rings. 3: its
 // rounding (LevelAttempt::Rounding) follows the attempt. 4: LevelReport::stuck_restarts. 5: the
 // lookahead's chains (LevelCheckpoint::chains) follow. 6: each chain's attempt follows it. 7:
-// LevelReport::lookahead_other_bound and lookahead_other_stuck. 1 to 6 are read too.
-constexpr uint32_t kVersion = 7;
+// LevelReport::lookahead_other_bound and lookahead_other_stuck. 8: branch_roundings,
+// branch_energy and branch_kept. 1 to 7 are read too.
+constexpr uint32_t kVersion = 8;
 
 // Every number of a report, in the file's order (the Γ follows on its own). A field added to
 // LevelReport goes here too, with kVersion one higher; the size check below is the reminder.
@@ -31,9 +32,10 @@ void each_field(R& r, F&& f, uint32_t version) {
   f(r.gap), f(r.threshold), f(r.roundings), f(r.seconds), f(r.peak_rss_mb), f(r.second_start_energy);
   f(r.second_start_kept), f(r.lookahead_other_energy), f(r.lookahead_switched);
   if (version >= 7) f(r.lookahead_other_bound), f(r.lookahead_other_stuck);
+  if (version >= 8) f(r.branch_roundings), f(r.branch_energy), f(r.branch_kept);
 }
 // (It misses a new int or bool that fits in padding: LevelReport's comment asks for this list too.)
-static_assert(sizeof(LevelReport) == 232 + sizeof(std::vector<ProductTriangle>),
+static_assert(sizeof(LevelReport) == 248 + sizeof(std::vector<ProductTriangle>),
               "LevelReport changed: add the new field to each_field and raise kVersion");
 
 class Writer {

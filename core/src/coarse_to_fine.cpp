@@ -17,6 +17,7 @@
 #include <cmath>
 #include <exception>
 #include <limits>
+#include <numeric>
 #include <optional>
 
 namespace shapematch {
@@ -242,34 +243,47 @@ int conflict_places(const MatchingLp& m, int max_places, int margin, ProofPlace&
 
 }  // namespace
 
+namespace {
+
+std::vector<std::vector<int>> vertex_neighbours(const Mesh& m) {
+  std::vector<std::vector<int>> neighbours(m.num_vertices());
+  for (const auto& e : m.edges) {
+    neighbours[e[0]].push_back(e[1]);
+    neighbours[e[1]].push_back(e[0]);
+  }
+  return neighbours;
+}
+
+// The vertices within `rings` edges of w (breadth first), as a mask.
+std::vector<char> ball(const std::vector<std::vector<int>>& neighbours, int w, int rings) {
+  std::vector<char> in(neighbours.size(), 0);
+  in[w] = 1;
+  std::vector<int> front{w}, next;
+  for (int r = 0; r < rings && !front.empty(); ++r, front.swap(next)) {
+    next.clear();
+    for (int u : front)
+      for (int n : neighbours[u])
+        if (!in[n]) {
+          in[n] = 1;
+          next.push_back(n);
+        }
+  }
+  return in;
+}
+
+}  // namespace
+
 std::vector<ProductTriangle> truth_space(const Mesh& x, const Mesh& y, const std::vector<int>& image, int rings) {
   if (image.size() != size_t(x.num_vertices()))
     throw InvalidInputError("truth space: need one true image per vertex of X");
   if (rings < 0) throw InvalidInputError("truth space: the rings must be 0 or more");
-  std::vector<std::vector<int>> neighbours(y.num_vertices());
-  for (const auto& e : y.edges) {
-    neighbours[e[0]].push_back(e[1]);
-    neighbours[e[1]].push_back(e[0]);
-  }
-  // near[w][b]: b within `rings` edges of w, for the images in use (breadth first from each).
+  const std::vector<std::vector<int>> neighbours = vertex_neighbours(y);
+  // near[w][b]: b within `rings` edges of w, for the images in use.
   std::vector<std::vector<char>> near(y.num_vertices());
   for (int w : image) {
     if (w < 0) continue;
     if (w >= y.num_vertices()) throw InvalidInputError("truth space: an image is not a vertex of Y");
-    if (!near[w].empty()) continue;
-    std::vector<char>& in = near[w];
-    in.assign(y.num_vertices(), 0);
-    in[w] = 1;
-    std::vector<int> front{w}, next;
-    for (int r = 0; r < rings && !front.empty(); ++r, front.swap(next)) {
-      next.clear();
-      for (int u : front)
-        for (int n : neighbours[u])
-          if (!in[n]) {
-            in[n] = 1;
-            next.push_back(n);
-          }
-    }
+    if (near[w].empty()) near[w] = ball(neighbours, w, rings);
   }
   const ProductSpace full = ProductSpace::full(x, y);
   std::vector<ProductTriangle> kept;
@@ -277,6 +291,55 @@ std::vector<ProductTriangle> truth_space(const Mesh& x, const Mesh& y, const std
     const ProductTriangle t = full[j];
     bool ok = true;
     for (int i = 0; i < 3 && ok; ++i) ok = image[t.a[i]] < 0 || near[image[t.a[i]]][t.b[i]];
+    if (ok) kept.push_back(t);
+  }
+  return kept;
+}
+
+ImageSplit most_split_image(const ProductSpace& space, const std::vector<double>& x, int rings,
+                            const std::vector<char>& skip) {
+  if (x.size() != size_t(space.size())) throw InvalidInputError("image split: need one value per product triangle");
+  if (rings < 0) throw InvalidInputError("image split: the rings must be 0 or more");
+  const int nx = space.x().num_vertices(), ny = space.y().num_vertices();
+  if (!skip.empty() && skip.size() != size_t(nx)) throw InvalidInputError("image split: need one mark per vertex of X");
+  // Dense: for the coarsest level (a few hundred vertices a side).
+  std::vector<double> mass(size_t(nx) * size_t(ny), 0.0);
+  for (int64_t j = 0; j < space.size(); ++j) {
+    if (!(x[j] > 0.0)) continue;
+    const ProductTriangle t = space[j];
+    for (int i = 0; i < 3; ++i) mass[size_t(t.a[i]) * ny + t.b[i]] += x[j];
+  }
+  const std::vector<std::vector<int>> neighbours = vertex_neighbours(space.y());
+  ImageSplit best;
+  for (int a = 0; a < nx; ++a) {
+    if (!skip.empty() && skip[a]) continue;
+    const double* row = mass.data() + size_t(a) * ny;
+    const int top = int(std::max_element(row, row + ny) - row);
+    const double total = std::accumulate(row, row + ny, 0.0);
+    if (!(total > 0.0)) continue;
+    std::vector<char> first = ball(neighbours, top, rings);
+    int other = -1;
+    for (int b = 0; b < ny; ++b)
+      if (!first[b] && row[b] > 0.0 && (other < 0 || row[b] > row[other])) other = b;
+    std::vector<char> second;
+    double split = 0.0;
+    if (other >= 0) {
+      second = ball(neighbours, other, rings);
+      for (int b = 0; b < ny; ++b)
+        if (second[b] && !first[b]) split += row[b];
+      split /= total;
+    }
+    if (best.vertex < 0 || split > best.split) best = {a, split, std::move(first), std::move(second)};
+  }
+  return best;
+}
+
+std::vector<ProductTriangle> keep_images(const std::vector<ProductTriangle>& list, int vertex,
+                                         const std::vector<char>& allowed) {
+  std::vector<ProductTriangle> kept;
+  for (const ProductTriangle& t : list) {
+    bool ok = true;
+    for (int i = 0; i < 3 && ok; ++i) ok = t.a[i] != vertex || (size_t(t.b[i]) < allowed.size() && allowed[t.b[i]]);
     if (ok) kept.push_back(t);
   }
   return kept;
@@ -1321,6 +1384,11 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
           if (options_.warm_widening) warm.keep(m, x, y, omega);
           if (may_carry) first.keep(m, x, y, omega);
         };
+      // The coarsest level's dive starts from round 1's iterate over the whole LP.
+      const bool branching = l == 0 && options_.branch_depth > 0 && options_.truth.empty();
+      std::vector<double> coarsest_x;
+      if (branching)
+        ro.first_iterate = [&](const std::vector<double>& x, const std::vector<double>&, double) { coarsest_x = x; };
       if (carrying) {
         std::sort(carried_ones.begin(), carried_ones.end());
         for (int64_t j = 0; j < m.lp.cols(); ++j) {
@@ -1433,6 +1501,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
         rr.gap = relative_gap(rr.energy, rr.lower_bound);
       }
       accept(m, rr, rep, gamma);
+      if (branching && coarsest_x.size() == size_t(m.lp.cols())) branch_coarsest(m, rr, coarsest_x, model, rep, gamma);
       if (going_on) {
         rep.rounds += going_on->rounds;
         rep.iterations += going_on->iterations;
@@ -1540,6 +1609,100 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
   }
   widened = std::move(extra);  // what the next level inherits
   widened.resize(lx.mesh.num_faces(), 0);
+}
+
+void CoarseToFineMatcher::branch_coarsest(MatchingLp& m, RoundingResult& rr, const std::vector<double>& x,
+                                          const EnergyModel& model, LevelReport& rep,
+                                          std::vector<ProductTriangle>& gamma) const {
+  if (!(rr.gap > options_.branch_gap)) return;
+  const Mesh& X = m.space.x();
+  const Mesh& Y = m.space.y();
+  const double bound = rr.lower_bound;  // the full space's: every side's space is a part of it
+  struct Pruned {
+    double bound;
+  };
+  struct Side {
+    std::vector<ProductTriangle> list;
+    MatchingLp m;
+    RoundingResult rr;
+    std::vector<double> x;
+  };
+  std::optional<Side> best;  // the lowest side so far, where one is below the level's own Γ
+  double best_energy = rr.energy;
+  std::vector<ProductTriangle> list;
+  list.reserve(m.space.size());
+  for (int64_t j = 0; j < m.space.size(); ++j) list.push_back(m.space[j]);
+  std::vector<double> here = x;
+  std::vector<char> split(X.num_vertices(), 0);
+  for (int depth = 0; depth < options_.branch_depth; ++depth) {
+    const ImageSplit s =
+        most_split_image(ProductSpace::from_list(X, Y, list), here, options_.branch_rings, split);
+    if (s.vertex < 0 || s.split < options_.branch_min_split) {
+      spdlog::info("level 1: branching stops at depth {}: no image split {:.3g} or more (largest {:.3g})", depth + 1,
+                   options_.branch_min_split, s.split);
+      break;
+    }
+    split[s.vertex] = 1;
+    std::optional<Side> lower;
+    for (const std::vector<char>* place : {&s.first, &s.second}) {
+      Side side;
+      side.list = keep_images(list, s.vertex, *place);
+      if (side.list.empty()) continue;
+      side.m = build_matching_lp(ProductSpace::from_list(X, Y, side.list), model, options_.matching.scale_costs);
+      RoundingOptions ro = rounding_for(0);
+      ro.first_iterate = [&](const std::vector<double>& v, const std::vector<double>&, double) { side.x = v; };
+      // No Γ of a side whose LP's bound reaches the best energy can win: not rounded.
+      ro.decided = [&](const RoundingRound& r, const std::vector<int64_t>&, double b) {
+        if (r.round == 1 && b >= best_energy) throw Pruned{b};
+      };
+      const char* which = place == &s.first ? "first" : "second";
+      try {
+        side.rr = round_to_graph_surface(side.m.space, side.m.lp, side.m.energy, ro);
+      } catch (const Pruned& p) {
+        spdlog::info("level 1: branch {}, vertex {} at its {} place ({:.0f} % of its mass elsewhere): LP bound {:.6g} "
+                     "at or above {:.6g}, not rounded",
+                     depth + 1, s.vertex, which, 100.0 * s.split, p.bound, best_energy);
+        continue;
+      } catch (const InfeasibleError& e) {
+        spdlog::info("level 1: branch {}, vertex {} at its {} place: no Γ ({})", depth + 1, s.vertex, which, e.what());
+        continue;
+      } catch (const SolverError& e) {
+        spdlog::info("level 1: branch {}, vertex {} at its {} place: no Γ ({})", depth + 1, s.vertex, which, e.what());
+        continue;
+      }
+      ++rep.branch_roundings;
+      if (!(side.rr.energy >= rep.branch_energy)) rep.branch_energy = side.rr.energy;
+      spdlog::info("level 1: branch {}, vertex {} at its {} place ({:.0f} % of its mass elsewhere): energy {:.6g} "
+                   "(its LP's bound {:.6g}) against {:.6g}",
+                   depth + 1, s.vertex, which, 100.0 * s.split, side.rr.energy, side.rr.lower_bound, best_energy);
+      if (!lower || side.rr.energy < lower->rr.energy) lower = std::move(side);
+    }
+    if (!lower) break;
+    // (Without round 1's iterate, where propagation decided the side, nothing to split further.)
+    const bool deeper = lower->x.size() == lower->list.size();
+    if (deeper) {
+      list = lower->list;
+      here = lower->x;
+    }
+    if (lower->rr.energy < best_energy) {
+      best_energy = lower->rr.energy;
+      best = std::move(lower);
+    }
+    if (!deeper) break;
+  }
+  if (!best) return;
+  spdlog::info("level 1: a branch's Γ goes on: energy {:.6g} against {:.6g} (bound {:.6g})", best->rr.energy,
+               rr.energy, bound);
+  m = std::move(best->m);
+  rr = std::move(best->rr);
+  rr.lower_bound = bound;
+  rr.gap = relative_gap(rr.energy, bound);
+  const int roundings = rep.branch_roundings;
+  const double branch_energy = rep.branch_energy;
+  accept(m, rr, rep, gamma);  // (variables and constraints stay the full space's, whose LP the bound is)
+  rep.branch_roundings = roundings;
+  rep.branch_energy = branch_energy;
+  rep.branch_kept = true;
 }
 
 bool CoarseToFineMatcher::solve_second_start(int l, const EnergyModel& model, LevelReport& rep,

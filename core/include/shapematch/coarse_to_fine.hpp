@@ -289,6 +289,21 @@ struct CoarseToFineOptions {
   // search had missed a lower matching near the truth (docs/results-log.md, sixty-sixth session).
   std::vector<int> truth;
   int truth_rings = 2;
+  // The coarsest level decides the global structure, and its LP is often fractional there: an
+  // image spread over two places (left and right, head and tail), which iterative fixing mixes.
+  // Where its rounding ends more than branch_gap above the LP's bound, a dive of up to
+  // branch_depth steps splits on the X vertex whose image the LP spreads most between two places
+  // of Y (most_split_image: balls of branch_rings edges, the second holding at least
+  // branch_min_split of its mass), rounds the space with that vertex kept to each place, keeps the
+  // Γ of least energy and goes on from the lower side. A side whose LP's bound is at or above the
+  // best energy so far is not rounded. The level's bound stays the full space's. Why: at 100
+  // faces `--truth` found matchings near the truth below the plain run's energy on david0–david6
+  // (gap 87 %), victoria0–victoria4 and two FAUST_r pairs without WKS and on dog0–dog8 with it
+  // (docs/results-log.md, sixty-sixth session). 0: off.
+  int branch_depth = 0;
+  int branch_rings = 2;
+  double branch_min_split = 0.2;
+  double branch_gap = 0.01;
   // With a checkpoint (run's `checkpoint`), where a level's rounding has got is saved after its
   // rounds at most this often (LevelAttempt::rounding): each save writes every level's Γ, a few
   // hundred kB at full resolution, and the last rounds take hundredths of a second each.
@@ -320,6 +335,25 @@ std::vector<ProductTriangle> reduced_product_space(const MeshLevel& fine_x, cons
 // identity matching (and degenerate triangles never qualify there: their corners repeat on one
 // side only). Enumerated from the full space: for the coarsest level.
 std::vector<ProductTriangle> truth_space(const Mesh& x, const Mesh& y, const std::vector<int>& image, int rings);
+
+// Where the LP values x over `space` spread an X vertex's image: per vertex a of x, the mass at
+// each b of y is the sum of x over the product triangles with a corner (a, b); its first place is
+// the ball of `rings` edges around its heaviest b, its second the ball around the heaviest b
+// outside the first, and its split the share of its mass in the second place outside the first.
+// The vertex of largest split (not one marked in `skip`; the lowest index on a tie; -1 where no
+// vertex has mass), with both places as masks over y's vertices.
+struct ImageSplit {
+  int vertex = -1;
+  double split = 0.0;
+  std::vector<char> first, second;
+};
+ImageSplit most_split_image(const ProductSpace& space, const std::vector<double>& x, int rings,
+                            const std::vector<char>& skip = {});
+
+// The product triangles of `list` whose corners pair X vertex `vertex` only with vertices of Y
+// marked in `allowed`.
+std::vector<ProductTriangle> keep_images(const std::vector<ProductTriangle>& list, int vertex,
+                                         const std::vector<char>& allowed);
 
 // (A new field goes into checkpoint.cpp's each_field too, so that checkpoints keep it.)
 struct LevelReport {
@@ -364,6 +398,12 @@ struct LevelReport {
   double lookahead_other_bound = std::numeric_limits<double>::quiet_NaN();
   // At the level where a lookahead chain dropped out stuck (lookahead_drop_stuck), the other's.
   bool lookahead_other_stuck = false;
+  // The coarsest level's dive (CoarseToFineOptions::branch_depth): the sides rounded, the least
+  // energy among them (NaN where none was rounded or none found a Γ), and whether a side's Γ
+  // went on (the level's rounds, iterations and threshold are then that side's rounding's).
+  int branch_roundings = 0;
+  double branch_energy = std::numeric_limits<double>::quiet_NaN();
+  bool branch_kept = false;
   // The level's Γ, the one that went on (on the level's meshes, x_levels()/y_levels()): match
   // writes a vertex map per level from it, so that eval can say at which level an error arose.
   std::vector<ProductTriangle> gamma;
@@ -514,6 +554,12 @@ private:
   // and rounding; false where it found no Γ.
   bool solve_second_start(int l, const EnergyModel& model, LevelReport& rep, std::vector<ProductTriangle>& gamma,
                           CoarseToFineResult& finest, const Progress& progress, bool optional) const;
+
+  // The coarsest level's dive (CoarseToFineOptions::branch_depth) from its LP `m`, rounded as
+  // `rr` with round 1's iterate `x`: where a side's Γ is lower, `m`, `rr`, `rep` and `gamma`
+  // become that side's (`rr` keeping the full space's bound).
+  void branch_coarsest(MatchingLp& m, RoundingResult& rr, const std::vector<double>& x, const EnergyModel& model,
+                       LevelReport& rep, std::vector<ProductTriangle>& gamma) const;
 
   std::vector<int> coarsest_truth() const;  // CoarseToFineOptions::truth on the coarsest meshes
 
