@@ -230,6 +230,12 @@ int run_match(const MatchArgs& args) {
   co.branch_rings = args.branch_rings;
   co.branch_min_split = args.branch_min_split;
   co.branch_gap = args.branch_gap;
+  const CoarseToFineOptions defaults;
+  if (args.branch_depth == 0 && (args.branch_rings != defaults.branch_rings ||
+                                 args.branch_min_split != defaults.branch_min_split || args.branch_gap != defaults.branch_gap))
+    spdlog::warn("--branch-rings, --branch-min-split or --branch-gap without --branch-depth: no effect");
+  if (args.branch_depth > 0 && truth_given(args))
+    spdlog::warn("--branch-depth with --truth*: no effect (the coarsest level is the truth's space, not the full one)");
   if (!truth_given(args) && args.truth_rings != CoarseToFineOptions{}.truth_rings)
     spdlog::warn("--truth-rings without --truth, --truth-x or --truth-map: no effect");
   RoundingOptions& ro = co.rounding;

@@ -95,26 +95,32 @@ TEST_CASE("cli: match --branch-depth dives at the coarsest level and reports it"
   const std::string straight = std::string(SHAPEMATCH_ASSETS_DIR) + "/finger_straight.off";
   const std::string bent = std::string(SHAPEMATCH_ASSETS_DIR) + "/finger_bent.off";
   // At 60 faces without WKS this pair's LP is fractional, and its plain rounding ends 73 % above
-  // its bound (1.369 against 0.791); the dive's first side ends at 0.809.
+  // its bound (1.369 against 0.791); the dive's first side ends at 0.809, the second is pruned by
+  // its LP's bound (0.8097), and at the second step (any split counts) both sides are.
   const std::string pair = "match " + straight + " " + bent + " --faces 60 --levels 1 --backend cpu --wks off ";
   const fs::path dive = tmp.path / "dive";
-  Run r = run(pair + "--branch-depth 1 -o " + dive.string());
+  Run r = run(pair + "--branch-depth 2 --branch-min-split 0.01 -o " + dive.string());
   REQUIRE_MESSAGE(r.code == 0, r.err);
   CHECK(r.err.find("level 1: branch 1, vertex") != std::string::npos);
+  CHECK(r.err.find("level 1: branch 2, vertex") != std::string::npos);
+  CHECK(r.err.find("not rounded") != std::string::npos);
   const size_t at = r.err.find("a branch's Γ goes on: energy ");
   REQUIRE(at != std::string::npos);
   const std::string b = read_file(dive / "report.json");
-  CHECK(b.find("\"branch_depth\": 1") != std::string::npos);
+  CHECK(b.find("\"branch_depth\": 2") != std::string::npos);
   const std::string lb = b.substr(b.find("\"levels\": ["));
   const double plain = std::stod(r.err.substr(r.err.find(" against ", at) + 9));
   MESSAGE("plain ", plain, ", dive ", json_number(b, "energy"), " (bound ", json_number(b, "lower_bound"), "), ",
           json_number(lb, "branch_roundings"), " sides");
   CHECK(json_number(b, "energy") < 0.9 * plain);
-  CHECK(json_number(lb, "branch_roundings") >= 1);
+  CHECK(json_number(lb, "branch_roundings") == 1);
   CHECK(lb.find("\"branch_kept\": true") != std::string::npos);
   CHECK(json_number(lb, "branch_energy") == doctest::Approx(json_number(b, "energy")).epsilon(1e-9));
   CHECK(json_number(b, "lower_bound") < json_number(b, "energy"));
   CHECK(b.find("\"orientation_preserved\": true") != std::string::npos);
+  r = run("match " + straight + " " + bent + " --faces 20 --levels 1 --backend cpu --branch-rings 1 -o " +
+          (tmp.path / "alone").string());
+  CHECK(r.err.find("without --branch-depth: no effect") != std::string::npos);
   r = run(pair + "--branch-depth -1 -o " + (tmp.path / "bad").string());
   CHECK(r.code != 0);
   CHECK_FALSE(fs::exists(tmp.path / "bad"));

@@ -241,10 +241,6 @@ int conflict_places(const MatchingLp& m, int max_places, int margin, ProofPlace&
   return places;
 }
 
-}  // namespace
-
-namespace {
-
 std::vector<std::vector<int>> vertex_neighbours(const Mesh& m) {
   std::vector<std::vector<int>> neighbours(m.num_vertices());
   for (const auto& e : m.edges) {
@@ -539,6 +535,9 @@ CoarseToFineMatcher::CoarseToFineMatcher(const Mesh& x, const Mesh& y, CoarseToF
     throw InvalidInputError("coarse to fine: need 0 ≤ --ring ≤ max ring");
   if (options_.coarse_ring_faces > 0 && (options_.coarse_ring < 0 || options_.max_ring < options_.coarse_ring))
     throw InvalidInputError("coarse to fine: need 0 ≤ --coarse-ring ≤ max ring");
+  if (options_.branch_depth < 0 || options_.branch_rings < 0 || !(options_.branch_min_split >= 0.0) ||
+      !(options_.branch_gap >= 0.0))
+    throw InvalidInputError("coarse to fine: need a branch depth, rings, split and gap of 0 or more");
   // Both shapes get the same number of levels (the larger shape's count), each its own face counts.
   HierarchyOptions ho = options_.hierarchy;
   if (ho.levels == 0)
@@ -1384,7 +1383,8 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
           if (options_.warm_widening) warm.keep(m, x, y, omega);
           if (may_carry) first.keep(m, x, y, omega);
         };
-      // The coarsest level's dive starts from round 1's iterate over the whole LP.
+      // The coarsest level's dive starts from round 1's iterate over the whole LP. (Level 0 sets
+      // no other first_iterate; a truth run's space is not the full one, and has no dive.)
       const bool branching = l == 0 && options_.branch_depth > 0 && options_.truth.empty();
       std::vector<double> coarsest_x;
       if (branching)
@@ -1637,7 +1637,7 @@ void CoarseToFineMatcher::branch_coarsest(MatchingLp& m, RoundingResult& rr, con
   for (int depth = 0; depth < options_.branch_depth; ++depth) {
     const ImageSplit s =
         most_split_image(ProductSpace::from_list(X, Y, list), here, options_.branch_rings, split);
-    if (s.vertex < 0 || s.split < options_.branch_min_split) {
+    if (s.vertex < 0 || s.second.empty() || s.split < options_.branch_min_split) {
       spdlog::info("level 1: branching stops at depth {}: no image split {:.3g} or more (largest {:.3g})", depth + 1,
                    options_.branch_min_split, s.split);
       break;
@@ -1651,9 +1651,11 @@ void CoarseToFineMatcher::branch_coarsest(MatchingLp& m, RoundingResult& rr, con
       side.m = build_matching_lp(ProductSpace::from_list(X, Y, side.list), model, options_.matching.scale_costs);
       RoundingOptions ro = rounding_for(0);
       ro.first_iterate = [&](const std::vector<double>& v, const std::vector<double>&, double) { side.x = v; };
-      // No Γ of a side whose LP's bound reaches the best energy can win: not rounded.
+      // No Γ of a side whose LP's bound reaches the best energy, or the other side's (a tie
+      // keeps the first), can win or be the side to go on from: not rounded.
+      const double beat = lower ? std::min(best_energy, lower->rr.energy) : best_energy;
       ro.decided = [&](const RoundingRound& r, const std::vector<int64_t>&, double b) {
-        if (r.round == 1 && b >= best_energy) throw Pruned{b};
+        if (r.round == 1 && b >= beat) throw Pruned{b};
       };
       const char* which = place == &s.first ? "first" : "second";
       try {
@@ -1661,12 +1663,9 @@ void CoarseToFineMatcher::branch_coarsest(MatchingLp& m, RoundingResult& rr, con
       } catch (const Pruned& p) {
         spdlog::info("level 1: branch {}, vertex {} at its {} place ({:.0f} % of its mass elsewhere): LP bound {:.6g} "
                      "at or above {:.6g}, not rounded",
-                     depth + 1, s.vertex, which, 100.0 * s.split, p.bound, best_energy);
+                     depth + 1, s.vertex, which, 100.0 * s.split, p.bound, beat);
         continue;
-      } catch (const InfeasibleError& e) {
-        spdlog::info("level 1: branch {}, vertex {} at its {} place: no Γ ({})", depth + 1, s.vertex, which, e.what());
-        continue;
-      } catch (const SolverError& e) {
+      } catch (const SolverError& e) {  // (InfeasibleError too)
         spdlog::info("level 1: branch {}, vertex {} at its {} place: no Γ ({})", depth + 1, s.vertex, which, e.what());
         continue;
       }
@@ -1697,11 +1696,7 @@ void CoarseToFineMatcher::branch_coarsest(MatchingLp& m, RoundingResult& rr, con
   rr = std::move(best->rr);
   rr.lower_bound = bound;
   rr.gap = relative_gap(rr.energy, bound);
-  const int roundings = rep.branch_roundings;
-  const double branch_energy = rep.branch_energy;
   accept(m, rr, rep, gamma);  // (variables and constraints stay the full space's, whose LP the bound is)
-  rep.branch_roundings = roundings;
-  rep.branch_energy = branch_energy;
   rep.branch_kept = true;
 }
 
