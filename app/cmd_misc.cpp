@@ -84,6 +84,10 @@ Action add_checkpoint_command(CLI::App& app) {
                         .set("energy", r.energy)
                         .set("lower_bound", r.lower_bound)
                         .set("gap", r.gap)
+                        .set("second_start_energy", r.second_start_energy)
+                        .set("second_start_kept", r.second_start_kept)
+                        .set("branch_energy", r.branch_energy)
+                        .set("branch_kept", r.branch_kept)
                         .set("seconds", r.seconds));
       return levels;
     };

@@ -377,6 +377,16 @@ TEST_CASE("cli: match --checkpoint goes on after the levels a stopped run finish
   REQUIRE(first.find("\"level\": 1,") != std::string::npos);
   CHECK(json_number(r.out.substr(r.out.find("\"level\": 1,")), "energy") ==
         json_number(first.substr(first.find("\"level\": 1,")), "energy"));
+  // (and the second start's numbers there, null where it did not run, as written)
+  auto value = [](const std::string& json, const std::string& key) {
+    const size_t level = json.find("\"level\": 1,");
+    const size_t at = level == std::string::npos ? level : json.find("\"" + key + "\": ", level);
+    return at == std::string::npos ? std::string("missing") : json.substr(at, json.find_first_of(",\n", at) - at);
+  };
+  CHECK(value(r.out, "second_start_energy") == value(first, "second_start_energy"));
+  CHECK(value(r.out, "second_start_kept") == value(first, "second_start_kept"));
+  CHECK(value(r.out, "second_start_kept") != "missing");
+  CHECK(r.out.find("\"branch_kept\": false") != std::string::npos);
   // Going on from it solves only the finest level again, to the same Γ.
   r = run("match " + dolphin + " " + swimming + args + (tmp.path / "b").string());
   REQUIRE_MESSAGE(r.code == 0, r.err);
