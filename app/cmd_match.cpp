@@ -236,7 +236,7 @@ int run_match(const MatchArgs& args) {
     spdlog::warn("--branch-rings, --branch-min-split or --branch-gap without --branch-depth: no effect");
   if (args.branch_depth > 0 && truth_given(args))
     spdlog::warn("--branch-depth with --truth*: no effect (the coarsest level is the truth's space, not the full one)");
-  if (!truth_given(args) && args.truth_rings != CoarseToFineOptions{}.truth_rings)
+  if (!truth_given(args) && args.truth_rings != defaults.truth_rings)
     spdlog::warn("--truth-rings without --truth, --truth-x or --truth-map: no effect");
   RoundingOptions& ro = co.rounding;
   ro.solver = solver_for(args);

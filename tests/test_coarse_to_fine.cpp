@@ -1893,13 +1893,13 @@ TEST_CASE("image split: an LP half the identity and half a rotation splits the i
   int through = 0;
   for (const std::array<int, 3>& f : m.faces) through += std::count(f.begin(), f.end(), v);
   for (const std::vector<char>* place : {&at_self, &at_turn}) {
-    const std::vector<ProductTriangle> kept = keep_images(list, v, *place);
+    const std::vector<ProductTriangle> kept = keep_images(space, v, *place);
     CHECK(kept.size() == list.size() - through);
     for (const ProductTriangle& t : kept)
       for (int i = 0; i < 3; ++i)
         if (t.a[i] == v) CHECK((*place)[t.b[i]]);
   }
-  CHECK(keep_images(list, v, std::vector<char>(m.num_vertices(), 1)).size() == list.size());
+  CHECK(keep_images(space, v, std::vector<char>(m.num_vertices(), 1)).size() == list.size());
 }
 
 TEST_CASE("coarse to fine: the coarsest dive keeps its bound and ends below a fractional LP's plain rounding") {

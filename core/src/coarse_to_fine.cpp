@@ -330,10 +330,10 @@ ImageSplit most_split_image(const ProductSpace& space, const std::vector<double>
   return best;
 }
 
-std::vector<ProductTriangle> keep_images(const std::vector<ProductTriangle>& list, int vertex,
-                                         const std::vector<char>& allowed) {
+std::vector<ProductTriangle> keep_images(const ProductSpace& space, int vertex, const std::vector<char>& allowed) {
   std::vector<ProductTriangle> kept;
-  for (const ProductTriangle& t : list) {
+  for (int64_t j = 0; j < space.size(); ++j) {
+    const ProductTriangle t = space[j];
     bool ok = true;
     for (int i = 0; i < 3 && ok; ++i) ok = t.a[i] != vertex || (size_t(t.b[i]) < allowed.size() && allowed[t.b[i]]);
     if (ok) kept.push_back(t);
@@ -1622,35 +1622,32 @@ void CoarseToFineMatcher::branch_coarsest(MatchingLp& m, RoundingResult& rr, con
     double bound;
   };
   struct Side {
-    std::vector<ProductTriangle> list;
     MatchingLp m;
     RoundingResult rr;
-    std::vector<double> x;
+    std::vector<double> x;  // round 1's iterate (empty where propagation decided the side)
   };
-  std::optional<Side> best;  // the lowest side so far, where one is below the level's own Γ
+  // The side the dive goes on from (null: the level's own LP) and the lowest side so far, where
+  // one is below the level's own Γ (shared: often the same side).
+  std::shared_ptr<Side> current, best;
   double best_energy = rr.energy;
-  std::vector<ProductTriangle> list;
-  list.reserve(m.space.size());
-  for (int64_t j = 0; j < m.space.size(); ++j) list.push_back(m.space[j]);
-  std::vector<double> here = x;
   std::vector<char> split(X.num_vertices(), 0);
   for (int depth = 0; depth < options_.branch_depth; ++depth) {
-    const ImageSplit s =
-        most_split_image(ProductSpace::from_list(X, Y, list), here, options_.branch_rings, split);
+    const ProductSpace& space = current ? current->m.space : m.space;
+    const ImageSplit s = most_split_image(space, current ? current->x : x, options_.branch_rings, split);
     if (s.vertex < 0 || s.second.empty() || s.split < options_.branch_min_split) {
       spdlog::info("level 1: branching stops at depth {}: no image split {:.3g} or more (largest {:.3g})", depth + 1,
                    options_.branch_min_split, s.split);
       break;
     }
     split[s.vertex] = 1;
-    std::optional<Side> lower;
+    std::shared_ptr<Side> lower;
     for (const std::vector<char>* place : {&s.first, &s.second}) {
-      Side side;
-      side.list = keep_images(list, s.vertex, *place);
-      if (side.list.empty()) continue;
-      side.m = build_matching_lp(ProductSpace::from_list(X, Y, side.list), model, options_.matching.scale_costs);
+      std::vector<ProductTriangle> kept = keep_images(space, s.vertex, *place);
+      if (kept.empty()) continue;
+      auto side = std::make_shared<Side>();
+      side->m = build_matching_lp(ProductSpace::from_list(X, Y, std::move(kept)), model, options_.matching.scale_costs);
       RoundingOptions ro = rounding_for(0);
-      ro.first_iterate = [&](const std::vector<double>& v, const std::vector<double>&, double) { side.x = v; };
+      ro.first_iterate = [&](const std::vector<double>& v, const std::vector<double>&, double) { side->x = v; };
       // No Γ of a side whose LP's bound reaches the best energy, or the other side's (a tie
       // keeps the first), can win or be the side to go on from: not rounded.
       const double beat = lower ? std::min(best_energy, lower->rr.energy) : best_energy;
@@ -1659,7 +1656,7 @@ void CoarseToFineMatcher::branch_coarsest(MatchingLp& m, RoundingResult& rr, con
       };
       const char* which = place == &s.first ? "first" : "second";
       try {
-        side.rr = round_to_graph_surface(side.m.space, side.m.lp, side.m.energy, ro);
+        side->rr = round_to_graph_surface(side->m.space, side->m.lp, side->m.energy, ro);
       } catch (const Pruned& p) {
         spdlog::info("level 1: branch {}, vertex {} at its {} place ({:.0f} % of its mass elsewhere): LP bound {:.6g} "
                      "at or above {:.6g}, not rounded",
@@ -1670,24 +1667,20 @@ void CoarseToFineMatcher::branch_coarsest(MatchingLp& m, RoundingResult& rr, con
         continue;
       }
       ++rep.branch_roundings;
-      if (!(side.rr.energy >= rep.branch_energy)) rep.branch_energy = side.rr.energy;
+      if (!(side->rr.energy >= rep.branch_energy)) rep.branch_energy = side->rr.energy;
       spdlog::info("level 1: branch {}, vertex {} at its {} place ({:.0f} % of its mass elsewhere): energy {:.6g} "
                    "(its LP's bound {:.6g}) against {:.6g}",
-                   depth + 1, s.vertex, which, 100.0 * s.split, side.rr.energy, side.rr.lower_bound, best_energy);
-      if (!lower || side.rr.energy < lower->rr.energy) lower = std::move(side);
+                   depth + 1, s.vertex, which, 100.0 * s.split, side->rr.energy, side->rr.lower_bound, best_energy);
+      if (!lower || side->rr.energy < lower->rr.energy) lower = std::move(side);
     }
     if (!lower) break;
-    // (Without round 1's iterate, where propagation decided the side, nothing to split further.)
-    const bool deeper = lower->x.size() == lower->list.size();
-    if (deeper) {
-      list = lower->list;
-      here = lower->x;
-    }
     if (lower->rr.energy < best_energy) {
       best_energy = lower->rr.energy;
-      best = std::move(lower);
+      best = lower;
     }
-    if (!deeper) break;
+    // (Without round 1's iterate, where propagation decided the side, nothing to split further.)
+    if (lower->x.size() != size_t(lower->m.lp.cols())) break;
+    current = std::move(lower);
   }
   if (!best) return;
   spdlog::info("level 1: a branch's Γ goes on: energy {:.6g} against {:.6g} (bound {:.6g})", best->rr.energy,

@@ -353,10 +353,9 @@ struct ImageSplit {
 ImageSplit most_split_image(const ProductSpace& space, const std::vector<double>& x, int rings,
                             const std::vector<char>& skip = {});
 
-// The product triangles of `list` whose corners pair X vertex `vertex` only with vertices of Y
+// The product triangles of `space` whose corners pair X vertex `vertex` only with vertices of Y
 // marked in `allowed`.
-std::vector<ProductTriangle> keep_images(const std::vector<ProductTriangle>& list, int vertex,
-                                         const std::vector<char>& allowed);
+std::vector<ProductTriangle> keep_images(const ProductSpace& space, int vertex, const std::vector<char>& allowed);
 
 // (A new field goes into checkpoint.cpp's each_field too, so that checkpoints keep it.)
 struct LevelReport {
