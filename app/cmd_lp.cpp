@@ -9,6 +9,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <iostream>
 
 namespace shapematch::app {
@@ -20,6 +21,7 @@ struct LpArgs {
   std::string json_path, mps_path, lp_path, from;
   SolverParams params;
   PdhgOptions pdhg;
+  bool zero_cost = false;
 };
 
 int run_lp(const LpArgs& args) {
@@ -45,6 +47,9 @@ int run_lp(const LpArgs& args) {
                build_seconds);
   if (!args.mps_path.empty()) write_mps(lp, args.mps_path);
   if (!args.lp_path.empty()) write_lp(lp, args.lp_path);
+  // A feasibility problem: how soon a solver proves an LP infeasible without costs to chase.
+  if (args.zero_cost) std::fill(lp.c.begin(), lp.c.end(), 0.0);
+  out.set("zero_cost", args.zero_cost);
 
   const LpResult r = make_solver(args.solver, args.pdhg)->solve(lp, args.params);
   spdlog::info("{}: {} after {} iterations, objective {:.9g} ({:.2f} s)", r.solver, to_string(r.status),
@@ -96,6 +101,8 @@ Action add_lp_command(CLI::App& app) {
       ->capture_default_str();
   app.add_flag("--stop-on-divergence", args->params.stop_on_divergence,
                "stop PDHG where the divergence watch says the LP behaves like an infeasible one");
+  app.add_flag("--zero-cost", args->zero_cost,
+               "solve with every cost set to 0 (a feasibility problem; after --export-mps/--export-lp)");
   return [args] { return run_lp(*args); };
 }
 

@@ -50,6 +50,7 @@ struct MatchArgs {
   bool converged_first = RoundingOptions{}.converged_first;
   double exact_pivots_per_column = RoundingOptions{}.exact_pivots_per_column;
   int64_t exact_below = RoundingOptions{}.exact_below;
+  int64_t feasibility_first = RoundingOptions{}.feasibility_iterations;
   int release_after_trims = RoundingOptions{}.release_after_trims;
   double tolerance = 1e-4;
   double coarse_tolerance = CoarseToFineOptions{}.coarse_tolerance;
@@ -257,6 +258,7 @@ int run_match(const MatchArgs& args) {
   ro.converged_first = args.converged_first;
   ro.exact_pivots_per_column = args.exact_pivots_per_column;
   ro.exact_below = args.exact_below;
+  ro.feasibility_iterations = args.feasibility_first;
   ro.release_after_trims = args.release_after_trims;
   ro.lp.tolerance = args.tolerance;
   ro.lp.time_limit = args.time_limit;
@@ -501,6 +503,7 @@ int run_match(const MatchArgs& args) {
                               .set("converged_first", args.converged_first)
                               .set("exact_pivots_per_column", args.exact_pivots_per_column)
                               .set("exact_below", args.exact_below)
+                              .set("feasibility_first", args.feasibility_first)
                               .set("release_after_trims", args.release_after_trims)
                               .set("split_parts", !args.whole_lp)
                               .set("tolerance", args.tolerance)
@@ -685,6 +688,11 @@ Action add_match_command(CLI::App& app) {
   app.add_option("--exact-below", a->exact_below,
                  "solve a later round's parts under this many columns by Clp's dual simplex, the others by the "
                  "first-order solver (0: all by it)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  app.add_option("--feasibility-first", a->feasibility_first,
+                 "before a refined level's first LP, solve it without costs for at most N PDHG iterations: an "
+                 "infeasible one is proved there (0: off)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   app.add_option("--release-after-trims", a->release_after_trims,

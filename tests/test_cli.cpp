@@ -126,6 +126,41 @@ TEST_CASE("cli: match --branch-depth dives at the coarsest level and reports it"
   CHECK_FALSE(fs::exists(tmp.path / "bad"));
 }
 
+TEST_CASE("cli: match --feasibility-first tests a refined level's first LPs at zero cost until one is feasible") {
+  shapematch::test::TempDir tmp;
+  const std::string straight = std::string(SHAPEMATCH_ASSETS_DIR) + "/finger_straight.off";
+  const std::string bent = std::string(SHAPEMATCH_ASSETS_DIR) + "/finger_bent.off";
+  // At ring 0 level 2's first LPs are widened on propagation's contradictions, then three are
+  // solved: the first (tested at zero cost, feasible) and two re-solves after pricing widenings,
+  // whose spaces contain its space (not tested). Level 1 is the full space (not tested).
+  const std::string pair = "match " + straight + " " + bent +
+                           " --faces 240 --levels 2 --ring 0 --coarse-ring 0 --backend cpu --threads 1 ";
+  auto count = [](const std::string& text, const std::string& what) {
+    size_t n = 0;
+    for (size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
+    return n;
+  };
+  Run r = run("-v " + pair + "--feasibility-first 2000 -o " + (tmp.path / "tested").string());
+  REQUIRE_MESSAGE(r.code == 0, r.err);
+  CHECK(count(r.err, "round 1's LP at zero cost: optimal") == 1);
+  CHECK(count(r.err, "level 2 round  1:") >= 2);
+  const std::string tested = read_file(tmp.path / "tested" / "report.json");
+  CHECK(tested.find("\"feasibility_first\": 2000") != std::string::npos);
+  // On a feasible LP the pre-test changes nothing but the time.
+  r = run("-v " + pair + "--feasibility-first 0 -o " + (tmp.path / "plain").string());
+  REQUIRE_MESSAGE(r.code == 0, r.err);
+  CHECK(count(r.err, "at zero cost") == 0);
+  // The default: on, at 1 024 iterations.
+  CHECK(run(pair + "--help").out.find("--feasibility-first INT:NONNEGATIVE=1024") != std::string::npos);
+  REQUIRE_MESSAGE(r.code == 0, r.err);
+  const std::string plain = read_file(tmp.path / "plain" / "report.json");
+  CHECK(plain.find("\"feasibility_first\": 0") != std::string::npos);
+  CHECK(json_number(tested, "energy") == doctest::Approx(json_number(plain, "energy")).epsilon(1e-12));
+  r = run(pair + "--feasibility-first -1 -o " + (tmp.path / "bad").string());
+  CHECK(r.code != 0);
+  CHECK_FALSE(fs::exists(tmp.path / "bad"));
+}
+
 TEST_CASE("cli: match --truth restricts the coarsest level to the true map's neighbourhood, a diagnostic") {
   shapematch::test::TempDir tmp;
   const std::string straight = std::string(SHAPEMATCH_ASSETS_DIR) + "/dolphin_straight.off";

@@ -1487,6 +1487,67 @@ TEST_CASE("rounding: a part proved infeasible by PDHG names its clash by a proof
 }
 
 namespace {
+// An LP infeasible beyond what propagation sees: a1 + a2 = 1, a3 + a4 = 1, a1 + … + a4 = 3 (no
+// row alone says so), beside q1 + q2 = 1 at `q_cost` each, whose ordinary dual is that cost. With
+// `feasible`, the third row asks for 2 instead.
+LpProblem clash_beside_costs(double q_cost, bool feasible = false) {
+  const std::vector<std::vector<int>> rows = {
+      {1, 1, 0, 0, 0, 0}, {0, 0, 1, 1, 0, 0}, {1, 1, 1, 1, 0, 0}, {0, 0, 0, 0, 1, 1}};
+  return test::dense_lp(rows, {1, 1, feasible ? 2.0 : 3.0, 1}, {0.5, 1, 0.25, 1, q_cost, q_cost});
+}
+
+RoundingResult round_clash(const LpProblem& lp, int64_t feasibility_iterations) {
+  const Mesh sphere = shapes::icosphere(2);
+  const auto id = identity_matching(sphere);
+  const ProductSpace space = ProductSpace::from_list(sphere, sphere, {id.begin(), id.begin() + lp.cols()});
+  RoundingOptions options;
+  options.solver = "pdhg-cpu";
+  options.lp.threads = 1;  // the same iterates on any machine
+  options.lp.tolerance = 1e-6;
+  options.feasibility_iterations = feasibility_iterations;
+  return round_to_graph_surface(space, lp, lp.c, options);
+}
+}  // namespace
+
+TEST_CASE("rounding: round 1's LP solved first at zero cost is proved infeasible there, by the clash's rows alone") {
+  const LpProblem lp = clash_beside_costs(100.0);
+  std::string what;
+  std::vector<int64_t> rows;
+  bool certified = false;
+  auto failure = [&](int64_t iterations) {
+    what.clear();
+    rows.clear();
+    try {
+      round_clash(lp, iterations);
+    } catch (const InfeasibleError& e) {
+      what = e.what();
+      rows = e.rows();
+      certified = e.certified();
+    }
+  };
+  failure(1000);
+  CHECK(what.find("proved at zero cost") != std::string::npos);
+  CHECK(certified);
+  CHECK(rows == std::vector<int64_t>{0, 1, 2});
+  // With its costs the proof is a dual point whose ordinary duals (q's row at 100) can outweigh a
+  // ray still short: it names q's row too, where a widening would be wasted.
+  failure(0);
+  CHECK(!what.empty());
+  CHECK(what.find("zero cost") == std::string::npos);
+  CHECK(std::find(rows.begin(), rows.end(), 3) != rows.end());
+  // A cap too short for a proof: the costed solve proves it as before.
+  failure(1);
+  CHECK(what.find("zero cost") == std::string::npos);
+  CHECK(!rows.empty());
+  // A feasible LP: the pre-test changes nothing.
+  const LpProblem ok = clash_beside_costs(100.0, true);
+  const RoundingResult plain = round_clash(ok, 0), tested = round_clash(ok, 1000);
+  CHECK(tested.gamma == plain.gamma);
+  CHECK(tested.energy == doctest::Approx(plain.energy));
+  CHECK(tested.lower_bound == doctest::Approx(plain.lower_bound).epsilon(1e-5));
+}
+
+namespace {
 // The first-order solver, noting the primal weight each solve was asked to start from.
 class WeightNoting final : public LpSolver {
 public:

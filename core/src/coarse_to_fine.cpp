@@ -1016,6 +1016,7 @@ int CoarseToFineMatcher::ring_at(int l) const {
 RoundingOptions CoarseToFineMatcher::rounding_for(int l) const {
   RoundingOptions ro = options_.rounding;
   if (l + 1 < hx_.size() && options_.coarse_tolerance > 0.0) ro.lp.tolerance = options_.coarse_tolerance;
+  if (l == 0) ro.feasibility_iterations = 0;  // the full product space: never infeasible
   if (!options_.dump_first_lps.empty())
     ro.first_lp = [dir = options_.dump_first_lps, l, count = dumped_](const LpProblem& lp) {
       const std::string path = fmt::format("{}/level{}-{:03d}.smlp", dir, l + 1, (*count)++);
@@ -1107,6 +1108,11 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
   double first_omega = 0.0;
   CarriedIterate priced_from;
   bool price_warm = false;
+  // A first LP at this level was feasible: every later attempt's space contains its space (a
+  // widening only adds columns, and the rows it adds are those of new product edges, all of whose
+  // columns are new), so it is feasible too, and the zero-cost pre-test would only cost. (Not
+  // after the ring grows: the extra rings beyond max_ring are cut back there.)
+  bool feasible_seen = false;
   bool propagating = false;
   detail::RecurringConflicts recurring;  // π rows where propagation failed, by face
   // One more fine ring on these faces (up to `cap` rings); false if none could grow. `last`: the
@@ -1356,6 +1362,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
         ro.reference_iterations = cold_iterations;
       }
       price_warm = false;
+      if (feasible_seen || carrying || going_on) ro.feasibility_iterations = 0;
       const bool pricing = l > 0 && !carrying && !going_on && priced < options_.price_widenings &&
                            options_.local_widening && local < options_.max_local_widenings;
       // The iterate pricing reads (and a widening it calls for starts from).
@@ -1512,6 +1519,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
       }
       break;
     } catch (const PricedWider&) {
+      feasible_seen = true;
       ++rep.price_widenings;
       ++priced;
       priced_from.keep(m, first_x, first_y, first_omega);
@@ -1532,6 +1540,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
       // from its fixings but those over the faces just widened (what failed there). Where nothing
       // could widen there, on as below (without trying the same place again).
       const auto* s = dynamic_cast<const StuckError*>(&e);
+      if (s) feasible_seen = true;  // (its round 1 was solved)
       if (s && rules.drop_when_stuck) throw;
       // First (stuck_restarts) start its rounding again here from its fixings, its state afresh.
       if (s && restarts < options_.stuck_restarts && !s->ones().empty() && rounds_so_far > 0 &&
@@ -1604,6 +1613,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
       ++rep.widenings;
       spdlog::warn("level {}: the reduced LP at ring {} is infeasible; widening to ring {}", l + 1, ring, ring + 1);
       ++ring;
+      feasible_seen = false;
       for (int& x : extra) x = std::max(0, std::min(x, options_.max_ring - ring));
     }
   }
@@ -1701,6 +1711,7 @@ bool CoarseToFineMatcher::solve_second_start(int l, const EnergyModel& model, Le
   MatchingLp m = build_matching_lp(ProductSpace::full(lx.mesh, ly.mesh), model, options_.matching.scale_costs);
   spdlog::info("level {}: second start over the full product space, {} variables", l + 1, m.lp.cols());
   RoundingOptions ro = rounding_for(l);
+  ro.feasibility_iterations = 0;  // the full product space
   ro.fractional_batch = options_.second_start_fractional_batch;
   // Beside a refined Γ this one is optional: its rounding has a budget, and where it runs out the
   // alternative thresholds still try from round 1's optimum.

@@ -1283,7 +1283,7 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
       throw InfeasibleError(what, fixer.unsatisfied_rows());
     }
     Stopwatch clock;
-    const Reduced red = reduce(lp, fixer.state());
+    Reduced red = reduce(lp, fixer.state());  // (round 1's costs are set aside for its pre-test)
     if (red.lp.cols() < fewest_free) {
       fewest_free = red.lp.cols();
       stalled = 0;
@@ -1365,6 +1365,41 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
     if (!after_fixing) {
       round_one_weight = params.initial_primal_weight;
       if (options.first_lp) options.first_lp(red.lp);
+      if (options.feasibility_iterations > 0 && options.solver.rfind("pdhg", 0) == 0) {
+        // Without costs there are no ordinary duals to converge first: PDHG proves an infeasible
+        // LP in a fraction of the iterations (and names only the clash), and finds a feasible
+        // one's point as fast. Only its proof is used; the costs go back in place after it.
+        SolverParams zp = params;
+        zp.initial_x.clear();
+        zp.initial_y.clear();
+        zp.initial_primal_weight = 0.0;
+        zp.stop_on_divergence = false;
+        zp.patient_divergence_watch = false;
+        zp.max_iterations = std::min(params.max_iterations, options.feasibility_iterations);
+        std::vector<double> costs(red.lp.c.size(), 0.0);
+        std::swap(costs, red.lp.c);
+        LpResult z;
+        try {
+          z = solver->solve(red.lp, zp);
+        } catch (...) {
+          std::swap(costs, red.lp.c);
+          throw;
+        }
+        std::swap(costs, red.lp.c);
+        spdlog::debug("rounding: round 1's LP at zero cost: {} in {} iterations ({:.2f} s)", to_string(z.status),
+                      z.iterations, z.seconds);
+        if (z.status == LpStatus::Infeasible) {
+          spdlog::info("rounding: round 1's LP ({} variables) is infeasible, proved at zero cost in {} iterations "
+                       "({:.1f} s)",
+                       red.lp.cols(), z.iterations, z.seconds);
+          throw InfeasibleError("rounding: the matching LP is infeasible (proved at zero cost)",
+                                certificate_rows(z.y, red.rows));
+        }
+        // A point within the tolerance of feasible: where the costed solve then looks diverging it
+        // is more likely slow than infeasible, so it is watched patiently only.
+        if (z.status == LpStatus::Optimal && params.stop_on_divergence) params.patient_divergence_watch = true;
+        params.time_limit -= z.seconds;
+      }
       if (options.probe && options.probe_tolerance > params.tolerance) {
         SolverParams loose = params;
         loose.tolerance = options.probe_tolerance;
@@ -1680,6 +1715,7 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
     alt.probe = {};
     alt.probe_tolerance = 0.0;
     alt.first_max_iterations = 0;
+    alt.feasibility_iterations = 0;  // (round 1 was optimal)
     alt.lp.initial_x = first.x;  // round 1 starts at its optimum: it only confirms it
     alt.lp.initial_y = first.y;
     alt.lp.initial_primal_weight = first.primal_weight;
