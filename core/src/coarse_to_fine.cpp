@@ -1465,6 +1465,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
       RoundingResult rr = round_to_graph_surface(m.space, m.lp, m.energy, ro,
                                                  [&](const RoundingRound& r) {
                                                    if (r.round == 1 && !carrying && !going_on) {
+                                                     if (r.status == LpStatus::Optimal) feasible_seen = true;
                                                      first_iterations = r.iterations;
                                                      if (!warm_resolve) {
                                                        cold_iterations = r.iterations;
