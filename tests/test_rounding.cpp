@@ -1545,6 +1545,13 @@ TEST_CASE("rounding: round 1's LP solved first at zero cost is proved infeasible
   CHECK(tested.gamma == plain.gamma);
   CHECK(tested.energy == doctest::Approx(plain.energy));
   CHECK(tested.lower_bound == doctest::Approx(plain.lower_bound).epsilon(1e-5));
+  // Its iterations are round 1's own, apart from the costed solve's.
+  REQUIRE(!tested.rounds.empty());
+  REQUIRE(!plain.rounds.empty());
+  CHECK(plain.rounds[0].feasibility_iterations == 0);
+  CHECK(tested.rounds[0].feasibility_iterations > 0);
+  CHECK(tested.rounds[0].feasibility_iterations <= 1000);
+  CHECK(tested.rounds[0].iterations == plain.rounds[0].iterations);
 }
 
 namespace {

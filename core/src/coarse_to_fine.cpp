@@ -1016,7 +1016,8 @@ int CoarseToFineMatcher::ring_at(int l) const {
 RoundingOptions CoarseToFineMatcher::rounding_for(int l) const {
   RoundingOptions ro = options_.rounding;
   if (l + 1 < hx_.size() && options_.coarse_tolerance > 0.0) ro.lp.tolerance = options_.coarse_tolerance;
-  if (l == 0) ro.feasibility_iterations = 0;  // the full product space: never infeasible
+  // The full product space is never infeasible (a truth run's coarsest space can be).
+  if (l == 0 && options_.truth.empty()) ro.feasibility_iterations = 0;
   if (!options_.dump_first_lps.empty())
     ro.first_lp = [dir = options_.dump_first_lps, l, count = dumped_](const LpProblem& lp) {
       const std::string path = fmt::format("{}/level{}-{:03d}.smlp", dir, l + 1, (*count)++);
@@ -1541,7 +1542,6 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
       // from its fixings but those over the faces just widened (what failed there). Where nothing
       // could widen there, on as below (without trying the same place again).
       const auto* s = dynamic_cast<const StuckError*>(&e);
-      if (s) feasible_seen = true;  // (its round 1 was solved)
       if (s && rules.drop_when_stuck) throw;
       // First (stuck_restarts) start its rounding again here from its fixings, its state afresh.
       if (s && restarts < options_.stuck_restarts && !s->ones().empty() && rounds_so_far > 0 &&

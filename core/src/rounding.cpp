@@ -1250,7 +1250,7 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
     return ones;
   };
   const auto record = [&](RoundingRound& info, const Stopwatch& clock) {
-    info.seconds = clock.seconds();
+    info.seconds = clock.seconds() - info.feasibility_seconds;
     if (info.round > 1) later_work += double(info.iterations) * double(info.variables);
     result.rounds.push_back(info);
     if (progress) progress(info);
@@ -1362,6 +1362,8 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
     };
     JoinedSolve joined;
     double round_one_weight = 0.0;  // the ω round 1's (first) solve was asked to start from
+    int64_t pretest_iterations = 0;  // round 1's solve at zero cost (feasibility_iterations)
+    double pretest_seconds = 0.0;
     if (!after_fixing) {
       round_one_weight = params.initial_primal_weight;
       if (options.first_lp) options.first_lp(red.lp);
@@ -1386,6 +1388,8 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
           throw;
         }
         std::swap(costs, red.lp.c);
+        pretest_iterations = z.iterations;
+        pretest_seconds = z.seconds;
         spdlog::debug("rounding: round 1's LP at zero cost: {} in {} iterations ({:.2f} s)", to_string(z.status),
                       z.iterations, z.seconds);
         if (z.status == LpStatus::Infeasible) {
@@ -1395,10 +1399,13 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
           throw InfeasibleError("rounding: the matching LP is infeasible (proved at zero cost)",
                                 certificate_rows(z.y, red.rows));
         }
-        // A point within the tolerance of feasible: where the costed solve then looks diverging it
-        // is more likely slow than infeasible, so it is watched patiently only.
-        if (z.status == LpStatus::Optimal && params.stop_on_divergence) params.patient_divergence_watch = true;
-        params.time_limit -= z.seconds;
+        // A point within the tolerance of feasible: the costed solve converges at that tolerance
+        // too, so a stop on divergence could only be a false alarm (unwatched, it cannot run on
+        // forever the way an infeasible LP does).
+        if (z.status == LpStatus::Optimal) {
+          params.stop_on_divergence = false;
+          params.patient_divergence_watch = false;
+        }
       }
       if (options.probe && options.probe_tolerance > params.tolerance) {
         SolverParams loose = params;
@@ -1450,7 +1457,7 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
         keep->x = x;
         keep->y = y;
         keep->primal_weight = std::isfinite(r.primal_weight) ? r.primal_weight : 0.0;
-        keep->seconds = clock.seconds();
+        keep->seconds = clock.seconds() - pretest_seconds;
         keep->iterations = r.iterations;
         // As result.first_lp below (which a failing first_iterate never reaches), without vectors.
         keep->result = r;
@@ -1478,8 +1485,10 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
       info.primal_weight = r.primal_weight;
     }
     info.objective = r.objective + lp.objective_scale * red.fixed_cost;
+    info.feasibility_iterations = pretest_iterations;
+    info.feasibility_seconds = pretest_seconds;
     if (round == 1) {  // in the units of the full LP: add what propagation fixed to 1 before it
-      first_seconds = options.reference_seconds > 0.0 ? options.reference_seconds : clock.seconds();
+      first_seconds = options.reference_seconds > 0.0 ? options.reference_seconds : clock.seconds() - pretest_seconds;
       first_iterations = options.reference_iterations > 0 ? options.reference_iterations : r.iterations;
       first_work = double(first_iterations) * double(red.lp.cols());
       result.first_lp = r;

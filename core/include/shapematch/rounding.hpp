@@ -144,8 +144,8 @@ struct RoundingOptions {
   int64_t first_max_iterations = 0;
   // Before round 1's LP (a first LP, not one from start_ones), solve it without its costs for at
   // most this many iterations, cold (PDHG only): an infeasible one is proved there, and the
-  // InfeasibleError names the clash alone; a feasible one goes on to its costed solve, its
-  // divergence watch patient where the pre-test converged. Measured (sixty-eighth session): a
+  // InfeasibleError names the clash alone; a feasible one goes on to its costed solve, unwatched
+  // for divergence where the pre-test converged (RoundingRound::feasibility_iterations). Measured (sixty-eighth session): a
   // full-resolution 13.9 M-column first LP of TOSCA_r horse0-horse10 proved infeasible at zero
   // cost in 704 iterations (3 minutes on one core), where the costed solve of the attempt before
   // it took 1.5 hours; at 3 000 faces 192-320 against a costed divergence stop at 1 024-1 536 and
@@ -242,6 +242,10 @@ struct RoundingRound {
   double primal_weight = std::numeric_limits<double>::quiet_NaN();
   double objective = 0.0;      // of this round's LP, including the fixed part
   double seconds = 0.0;
+  // Round 1's solve at zero cost before it (RoundingOptions::feasibility_iterations), not counted
+  // in iterations and seconds.
+  int64_t feasibility_iterations = 0;
+  double feasibility_seconds = 0.0;
   bool undone = false;         // the fixing made the LP infeasible and was replaced by a smaller one
   int64_t searched_parts = 0;  // parts finished by search (search_below); iterations: its nodes
   bool search = false;         // finished by search (search_below), not by an LP
