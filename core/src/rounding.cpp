@@ -1369,8 +1369,9 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
       if (options.first_lp) options.first_lp(red.lp);
       if (options.feasibility_iterations > 0 && options.solver.rfind("pdhg", 0) == 0) {
         // Without costs there are no ordinary duals to converge first: PDHG proves an infeasible
-        // LP in a fraction of the iterations (and names only the clash), and finds a feasible
-        // one's point as fast. Only its proof is used; the costs go back in place after it.
+        // LP in a fraction of the iterations (and names only the clash); a feasible one's point
+        // it finds not always sooner (hence the cap). Its iterate is not kept, only its verdict;
+        // the costs go back in place after it.
         SolverParams zp = params;
         zp.initial_x.clear();
         zp.initial_y.clear();
