@@ -145,15 +145,16 @@ struct RoundingOptions {
   // Before round 1's LP (a first LP, not one from start_ones), solve it without its costs for at
   // most this many iterations, cold (PDHG only): an infeasible one is proved there, and the
   // InfeasibleError names the clash alone; a feasible one goes on to its costed solve, unwatched
-  // for divergence where the pre-test converged (RoundingRound::feasibility_iterations). Measured (sixty-eighth session): a
-  // full-resolution 13.9 M-column first LP of TOSCA_r horse0-horse10 proved infeasible at zero
-  // cost in 704 iterations (3 minutes on one core), where the costed solve of the attempt before
-  // it took 1.5 hours; at 3 000 faces 192-320 against a costed divergence stop at 1 024-1 536 and
-  // proof at 2 560-5 632. Feasible LPs converge without costs not always sooner than with them (192-3 072
-  // against 1 216-3 136 cold): the cap bounds what the pre-test costs them. Off by default: a proof
-  // widens less than the divergence watch's suspicion with its margin, and at 3 000 faces two of
-  // three pairs ended 2-4 % higher in energy and 4-9 % in mean error for it (match
-  // --feasibility-first 1024 is the measured setting). 0: off.
+  // for divergence where the pre-test converged (RoundingRound::feasibility_iterations).
+  // Measured (sixty-eighth session): full-resolution first LPs of TOSCA_r horse0-horse10 (13.9 M
+  // columns) proved infeasible at zero cost in 704 iterations (3 minutes on one core), where the
+  // costed solve of the attempt before them took 1.5 hours; at 3 000 faces 192-320 against a
+  // costed divergence stop at 1 024-1 536 and proof at 2 560-5 632. Feasible LPs converge without
+  // costs not always sooner than with them (192-3 072 against 1 216-3 136 cold): the cap bounds
+  // what the pre-test costs them. Off by default: a proof widens less than the divergence watch's
+  // suspicion with its margin, and at 3 000 faces two of three pairs ended 2-4 % higher in energy
+  // and 4-9 % in mean error for it (match --feasibility-first 1024 is the measured setting).
+  // 0: off.
   int64_t feasibility_iterations = 0;
   // Where the LPs after fixings have failed (infeasible, or looking it at their cap) round after
   // round, at least stuck_rounds of them taking over this many times round 1's seconds in all,
