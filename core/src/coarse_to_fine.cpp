@@ -1363,7 +1363,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
         ro.reference_iterations = cold_iterations;
       }
       price_warm = false;
-      if (feasible_seen || carrying || going_on) ro.feasibility_iterations = 0;
+      if (feasible_seen) ro.feasibility_iterations = 0;  // (a start from fixings has none: rounding)
       const bool pricing = l > 0 && !carrying && !going_on && priced < options_.price_widenings &&
                            options_.local_widening && local < options_.max_local_widenings;
       // The iterate pricing reads (and a widening it calls for starts from).

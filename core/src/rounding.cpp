@@ -306,6 +306,24 @@ std::vector<int64_t> carrying_rows(const std::vector<double>& y) {
   return out;
 }
 
+// `lp` solved cold with every cost 0 (set aside and put back after): a feasibility problem,
+// whose proof of infeasibility holds no ordinary duals, only the clash.
+LpResult solve_at_zero_cost(LpProblem& lp, SolverParams params, LpSolver& solver) {
+  params.initial_x.clear();
+  params.initial_y.clear();
+  std::vector<double> costs(lp.c.size(), 0.0);
+  std::swap(costs, lp.c);
+  LpResult z;
+  try {
+    z = solver.solve(lp, params);
+  } catch (...) {
+    std::swap(costs, lp.c);
+    throw;
+  }
+  std::swap(costs, lp.c);
+  return z;
+}
+
 bool looks_infeasible(const LpResult& r) {
   // Far above: those LPs' bounds were 3-60x their objectives; at 5 % above, feasible LPs that had
   // not converged by the cap (bound 5.34, objective 5.01) were undone round after round.
@@ -439,12 +457,8 @@ JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpS
       // rows that take no part in the clash (measured on the rounding test's two_causes with its
       // alternatives at cost 10: the proof named the other cause, and the round after it failed
       // again). The same part at zero cost has no ordinary duals: its proof is the clash alone.
-      LpProblem zero = plp;
-      std::fill(zero.c.begin(), zero.c.end(), 0.0);
-      SolverParams cold = first_order();
-      cold.initial_x.clear();
-      cold.initial_y.clear();
-      const LpResult z = solver.solve(zero, cold);
+      LpProblem zero = plp;  // (a part of a const LP)
+      const LpResult z = solve_at_zero_cost(zero, first_order(), solver);
       spdlog::debug("rounding: a part of {} variables proved infeasible ({} rows carry the proof); at zero cost {} in {} "
                     "iterations ({:.2f} s){}",
                     plp.cols(), carrying_rows(s.y).size(), to_string(z.status), z.iterations, z.seconds,
@@ -1370,25 +1384,13 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
       if (options.feasibility_iterations > 0 && options.solver.rfind("pdhg", 0) == 0) {
         // Without costs there are no ordinary duals to converge first: PDHG proves an infeasible
         // LP in a fraction of the iterations (and names only the clash); a feasible one's point
-        // it finds not always sooner (hence the cap). Its iterate is not kept, only its verdict;
-        // the costs go back in place after it.
+        // it finds not always sooner (hence the cap). Only its verdict is kept.
         SolverParams zp = params;
-        zp.initial_x.clear();
-        zp.initial_y.clear();
         zp.initial_primal_weight = 0.0;
         zp.stop_on_divergence = false;
         zp.patient_divergence_watch = false;
         zp.max_iterations = std::min(params.max_iterations, options.feasibility_iterations);
-        std::vector<double> costs(red.lp.c.size(), 0.0);
-        std::swap(costs, red.lp.c);
-        LpResult z;
-        try {
-          z = solver->solve(red.lp, zp);
-        } catch (...) {
-          std::swap(costs, red.lp.c);
-          throw;
-        }
-        std::swap(costs, red.lp.c);
+        const LpResult z = solve_at_zero_cost(red.lp, zp, *solver);
         pretest_iterations = z.iterations;
         pretest_seconds = z.seconds;
         spdlog::debug("rounding: round 1's LP at zero cost: {} in {} iterations ({:.2f} s)", to_string(z.status),
