@@ -74,6 +74,7 @@ struct MatchArgs {
   bool watch_resolve = CoarseToFineOptions{}.watch_resolve;
   int max_suspected_widenings = CoarseToFineOptions{}.max_suspected_widenings;
   int suspicion_rings = CoarseToFineOptions{}.suspicion_rings;
+  int zero_cost_proof_rings = CoarseToFineOptions{}.zero_cost_proof_rings;
   double second_start_budget = CoarseToFineOptions{}.second_start_budget;
   bool warm_widening = CoarseToFineOptions{}.warm_widening;
   bool carry_primal_weight = CoarseToFineOptions{}.carry_primal_weight;
@@ -200,6 +201,7 @@ int run_match(const MatchArgs& args) {
   co.watch_resolve = args.watch_resolve;
   co.max_suspected_widenings = args.max_suspected_widenings;
   co.suspicion_rings = args.suspicion_rings;
+  co.zero_cost_proof_rings = args.zero_cost_proof_rings;
   co.second_start_budget = args.second_start_budget;
   co.warm_widening = args.warm_widening;
   co.carry_primal_weight = args.carry_primal_weight;
@@ -538,6 +540,7 @@ int run_match(const MatchArgs& args) {
                               .set("watch_resolve", args.watch_resolve)
                               .set("max_suspected_widenings", args.max_suspected_widenings)
                               .set("suspicion_rings", args.suspicion_rings)
+                              .set("zero_cost_proof_rings", args.zero_cost_proof_rings)
                               .set("second_start_budget", args.second_start_budget)
                               .set("warm_widening", args.warm_widening)
                               .set("carry_primal_weight", args.carry_primal_weight)
@@ -871,6 +874,12 @@ Action add_match_command(CLI::App& app) {
   app.add_option("--suspicion-rings", a->suspicion_rings,
                  "where --max-suspected-widenings ends the watch, every X face within this many fine rings of "
                  "the faces widened so far at the level gets one more ring first (0: off)")
+      ->check(CLI::Range(0, 16))
+      ->capture_default_str();
+  app.add_option("--zero-cost-proof-rings", a->zero_cost_proof_rings,
+                 "where --feasibility-first proves a level's first LP infeasible for the first time at its ring, "
+                 "every X face within this many fine rings of the faces widened so far gets one more ring too "
+                 "(0: off)")
       ->check(CLI::Range(0, 16))
       ->capture_default_str();
   app.add_option("--max-propagation-widenings", a->max_propagation_widenings,

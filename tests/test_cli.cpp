@@ -160,6 +160,39 @@ TEST_CASE("cli: match --feasibility-first tests a refined level's first LPs at z
   CHECK_FALSE(fs::exists(tmp.path / "bad"));
 }
 
+TEST_CASE("cli: match --zero-cost-proof-rings widens around a level's widenings after its first proof at zero cost") {
+  shapematch::test::TempDir tmp;
+  const std::string bent = std::string(SHAPEMATCH_ASSETS_DIR) + "/finger_bent.off";
+  const std::string straight = std::string(SHAPEMATCH_ASSETS_DIR) + "/finger_straight.off";
+  // Measured: at ring 0 without a margin, level 2's first LP after propagation's widenings (9 517
+  // variables) is infeasible, and the pre-test proves it in 192 iterations; the LPs after it are
+  // feasible.
+  const std::string pair = "match " + bent + " " + straight +
+                           " --faces 200 --levels 3 --ring 0 --coarse-ring 0 --widen-margin 0 --backend cpu "
+                           "--threads 1 --feasibility-first 4000 ";
+  auto count = [](const std::string& text, const std::string& what) {
+    size_t n = 0;
+    for (size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
+    return n;
+  };
+  Run r = run("-v " + pair + "--zero-cost-proof-rings 0 -o " + (tmp.path / "none").string());
+  REQUIRE_MESSAGE(r.code == 0, r.err);
+  REQUIRE(count(r.err, "proved at zero cost") >= 1);
+  CHECK(count(r.err, "after a proof at zero cost") == 0);
+  const std::string none = read_file(tmp.path / "none" / "report.json");
+  CHECK(count(none, "\"margin_widenings\": 0") == 3);
+  CHECK(none.find("\"zero_cost_proof_rings\": 0") != std::string::npos);
+
+  r = run("-v " + pair + "--zero-cost-proof-rings 2 -o " + (tmp.path / "margin").string());
+  REQUIRE_MESSAGE(r.code == 0, r.err);
+  CHECK(count(r.err, "proved at zero cost") >= 1);
+  CHECK(count(r.err, "level 2: widened around all earlier local widenings (2 rings) after a proof at zero cost") == 1);
+  const std::string margin = read_file(tmp.path / "margin" / "report.json");
+  CHECK(count(margin, "\"margin_widenings\": 1") == 1);  // level 2's
+  CHECK(margin.find("\"zero_cost_proof_rings\": 2") != std::string::npos);
+  CHECK(run(pair + "--help").out.find("--zero-cost-proof-rings INT:INT in [0 - 16]=2") != std::string::npos);
+}
+
 TEST_CASE("cli: match --truth restricts the coarsest level to the true map's neighbourhood, a diagnostic") {
   shapematch::test::TempDir tmp;
   const std::string straight = std::string(SHAPEMATCH_ASSETS_DIR) + "/dolphin_straight.off";

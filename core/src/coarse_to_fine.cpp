@@ -1114,6 +1114,8 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
   // columns are new), so it is feasible too, and the zero-cost pre-test would only cost. (Not
   // after the ring grows: the extra rings beyond max_ring are cut back there.)
   bool feasible_seen = false;
+  // The margin after a zero-cost proof (zero_cost_proof_rings) was given at this ring.
+  bool zero_cost_margin_given = false;
   bool propagating = false;
   detail::RecurringConflicts recurring;  // π rows where propagation failed, by face
   // One more fine ring on these faces (up to `cap` rings); false if none could grow. `last`: the
@@ -1578,6 +1580,15 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
         // A proof restores the watch.
         if (e.certified()) {
           suspicions.proof();
+          // The pre-test's proof stands in for the suspicion the watch would have raised on this
+          // LP: the same margin, once per ring (zero_cost_proof_rings says why).
+          if (dynamic_cast<const ZeroCostInfeasible*>(&e) && !zero_cost_margin_given &&
+              options_.zero_cost_proof_rings > 0) {
+            zero_cost_margin_given = true;
+            if (widen_around(options_.zero_cost_proof_rings, "infeasible at zero cost, around its widenings"))
+              spdlog::info("level {}: widened around all earlier local widenings ({} rings) after a proof at zero cost",
+                           l + 1, options_.zero_cost_proof_rings);
+          }
         } else if (suspicions.suspicion()) {
           spdlog::info("level {}: {} on a diverging PDHG, none proved: the next first LPs are watched patiently", l + 1,
                        suspicions.count() == 1 ? std::string("a widening")
@@ -1615,6 +1626,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
       spdlog::warn("level {}: the reduced LP at ring {} is infeasible; widening to ring {}", l + 1, ring, ring + 1);
       ++ring;
       feasible_seen = false;
+      zero_cost_margin_given = false;
       for (int& x : extra) x = std::max(0, std::min(x, options_.max_ring - ring));
     }
   }

@@ -1399,8 +1399,8 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
           spdlog::info("rounding: round 1's LP ({} variables) is infeasible, proved at zero cost in {} iterations "
                        "({:.1f} s)",
                        red.lp.cols(), z.iterations, z.seconds);
-          throw InfeasibleError("rounding: the matching LP is infeasible (proved at zero cost)",
-                                certificate_rows(z.y, red.rows));
+          throw ZeroCostInfeasible("rounding: the matching LP is infeasible (proved at zero cost)",
+                                   certificate_rows(z.y, red.rows));
         }
         // A point within the tolerance of feasible: the costed solve converges at that tolerance
         // too, so a stop on divergence could only be a false alarm (unwatched, it cannot run on

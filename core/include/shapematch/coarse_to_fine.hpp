@@ -128,6 +128,13 @@ struct CoarseToFineOptions {
   // (11.2 M variables) was optimal in 4.4 minutes, and level 6 ended in 31 minutes, gap 1.12 %,
   // error 0.0221 (0.0317 at μ = 1). 0: off.
   int suspicion_rings = 2;
+  // Where the zero-cost pre-test (RoundingOptions::feasibility_iterations) proves a level's first
+  // LP infeasible for the first time at its ring, every X face within this many fine rings of the
+  // faces widened so far gets one more ring too, as after the suspicion that the divergence watch
+  // would have raised on that LP (suspicion_rings). A proof widens less than a suspicion with its
+  // margin, and the narrower space held worse matchings (FAUST_r 016-020 at 3 000 faces: energy
+  // 2.18881 against 2.10551, docs/results-log.md, sixty-eighth session). 0: off.
+  int zero_cost_proof_rings = 2;
   // Start the first LP of a widened space from the previous attempt's iterate (its dual reset
   // where it diverged), by variable and row identity. Off: measured at full resolution (FAUST_r
   // 020-024) after a diverging attempt, the widened LP took 3 008 iterations warm against 2 048

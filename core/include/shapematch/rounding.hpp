@@ -286,6 +286,14 @@ private:
   std::vector<double> x_, y_;
 };
 
+// Round 1's LP proved infeasible by the zero-cost pre-test (RoundingOptions::feasibility_iterations):
+// coarse to fine gives such a proof the margin the divergence watch's suspicion would have had
+// (CoarseToFineOptions::zero_cost_proof_rings).
+class ZeroCostInfeasible : public InfeasibleError {
+public:
+  using InfeasibleError::InfeasibleError;
+};
+
 // Calls `progress(round)` after each round (for a progress line); may be empty.
 RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem& lp, const std::vector<double>& energy,
                                       const RoundingOptions& options = {},
