@@ -51,6 +51,7 @@ struct MatchArgs {
   double exact_pivots_per_column = RoundingOptions{}.exact_pivots_per_column;
   int64_t exact_below = RoundingOptions{}.exact_below;
   int64_t feasibility_first = RoundingOptions{}.feasibility_iterations;
+  int64_t feasibility_later = RoundingOptions{}.later_feasibility_iterations;
   int release_after_trims = RoundingOptions{}.release_after_trims;
   double tolerance = 1e-4;
   double coarse_tolerance = CoarseToFineOptions{}.coarse_tolerance;
@@ -261,6 +262,7 @@ int run_match(const MatchArgs& args) {
   ro.exact_pivots_per_column = args.exact_pivots_per_column;
   ro.exact_below = args.exact_below;
   ro.feasibility_iterations = args.feasibility_first;
+  ro.later_feasibility_iterations = args.feasibility_later;
   ro.release_after_trims = args.release_after_trims;
   ro.lp.tolerance = args.tolerance;
   ro.lp.time_limit = args.time_limit;
@@ -506,6 +508,7 @@ int run_match(const MatchArgs& args) {
                               .set("exact_pivots_per_column", args.exact_pivots_per_column)
                               .set("exact_below", args.exact_below)
                               .set("feasibility_first", args.feasibility_first)
+                              .set("feasibility_later", args.feasibility_later)
                               .set("release_after_trims", args.release_after_trims)
                               .set("split_parts", !args.whole_lp)
                               .set("tolerance", args.tolerance)
@@ -696,6 +699,11 @@ Action add_match_command(CLI::App& app) {
   app.add_option("--feasibility-first", a->feasibility_first,
                  "before a refined level's first LP, solve it without costs for at most N PDHG iterations: an "
                  "infeasible one is proved there (0: off)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  app.add_option("--feasibility-later", a->feasibility_later,
+                 "in the later rounds, solve each part PDHG would solve without costs first for at most N "
+                 "iterations: an infeasible one is proved there (0: off)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   app.add_option("--release-after-trims", a->release_after_trims,

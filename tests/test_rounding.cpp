@@ -1555,6 +1555,58 @@ TEST_CASE("rounding: round 1's LP solved first at zero cost is proved infeasible
 }
 
 namespace {
+// The first-order solver, noting for each solve whether it was at zero cost.
+class ZeroCostNoting final : public LpSolver {
+public:
+  std::string name() const override { return "pdhg-cpu"; }
+  LpResult solve(const LpProblem& lp, const SolverParams& params) override {
+    zero.push_back(std::all_of(lp.c.begin(), lp.c.end(), [](double c) { return c == 0.0; }));
+    return inner->solve(lp, params);
+  }
+  std::unique_ptr<LpSolver> inner = make_solver("pdhg-cpu");
+  std::vector<bool> zero;
+};
+}  // namespace
+
+TEST_CASE("rounding: a later round's part solved first at zero cost is proved infeasible there alone") {
+  // Two parts: the clash (rows 0-2) and q's row, feasible.
+  const LpProblem lp = clash_beside_costs(100.0);
+  SolverParams params;
+  params.tolerance = 1e-6;
+  params.threads = 1;
+  auto joined = [&](ZeroCostNoting& solver, int64_t feasibility_iterations) {
+    return detail::solve_in_parts(lp, params, solver, nullptr, 0, params, true, 0.0, nullptr, nullptr, {}, 10.0,
+                                  feasibility_iterations);
+  };
+  ZeroCostNoting plain, tested;
+  const detail::JoinedSolve a = joined(plain, 0), b = joined(tested, 1000);
+  REQUIRE(a.parts == 2);
+  CHECK(a.r.status == LpStatus::Infeasible);
+  CHECK(b.r.status == LpStatus::Infeasible);
+  CHECK(a.failed_rows == std::vector<int64_t>{0, 1, 2});
+  CHECK(b.failed_rows == a.failed_rows);
+  // The proof is the clash's alone either way (without the pre-test, proved again at zero cost).
+  CHECK(b.proof[3] == 0.0);
+  CHECK(std::abs(b.proof[2]) > 0.0);
+  // Without it: the clash costed, then again at zero cost for its proof; q's part costed.
+  CHECK(plain.zero == std::vector<bool>{false, true, false});
+  // With it: the clash at zero cost only; q's part at zero cost (feasible) and then costed.
+  CHECK(tested.zero == std::vector<bool>{true, true, false});
+  // A feasible LP: the same solution, the pre-test's iterations added.
+  const LpProblem ok = clash_beside_costs(100.0, true);
+  ZeroCostNoting plain_ok, tested_ok;
+  const detail::JoinedSolve c = detail::solve_in_parts(ok, params, plain_ok, nullptr, 0, params, true),
+                            d = detail::solve_in_parts(ok, params, tested_ok, nullptr, 0, params, true, 0.0, nullptr,
+                                                       nullptr, {}, 10.0, 1000);
+  REQUIRE(c.r.status == LpStatus::Optimal);
+  REQUIRE(d.r.status == LpStatus::Optimal);
+  CHECK(d.r.objective == doctest::Approx(c.r.objective).epsilon(1e-9));
+  CHECK(d.r.x == c.r.x);
+  CHECK(d.r.iterations > c.r.iterations);
+  CHECK(tested_ok.zero == std::vector<bool>{true, false, true, false});
+}
+
+namespace {
 // The first-order solver, noting the primal weight each solve was asked to start from.
 class WeightNoting final : public LpSolver {
 public:

@@ -336,7 +336,8 @@ JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpS
                                    int64_t exact_below, const SolverParams& exact_params, bool split,
                                    double exact_pivots_per_column, ExactCache* cache,
                                    const std::vector<double>* warm_weight,
-                                   const std::function<void(const LpProblem&)>& slow_part, double slow_part_seconds) {
+                                   const std::function<void(const LpProblem&)>& slow_part, double slow_part_seconds,
+                                   int64_t feasibility_iterations) {
   JoinedSolve out;
   std::vector<Part> parts;
   if (split) parts = split_into_parts(lp);
@@ -387,10 +388,31 @@ JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpS
       return own;
     };
     double asked = 0.0;  // the ω this part's first-order solve was asked to start from
+    bool proved_at_zero = false;  // by the pre-test (feasibility_iterations)
     auto first_order_solve = [&]() {
       const SolverParams& p = first_order();
       asked = p.initial_primal_weight;
-      return solver.solve(plp, p);
+      int64_t pretest = 0;
+      if (feasibility_iterations > 0 && solver.name().rfind("pdhg", 0) == 0) {
+        // Without costs PDHG's dual grows along the Farkas ray alone (see solve_at_zero_cost's
+        // callers): an infeasible part is proved in a fraction of the costed iterations.
+        SolverParams zp = p;
+        zp.max_iterations = std::min(p.max_iterations, feasibility_iterations);
+        zp.stop_on_divergence = false;
+        zp.patient_divergence_watch = false;
+        LpProblem zero = plp;  // (a part of a const LP)
+        LpResult z = solve_at_zero_cost(zero, zp, solver);
+        spdlog::debug("rounding: a part of {} variables at zero cost: {} in {} iterations ({:.2f} s)", plp.cols(),
+                      to_string(z.status), z.iterations, z.seconds);
+        if (z.status == LpStatus::Infeasible) {
+          proved_at_zero = true;
+          return z;
+        }
+        pretest = z.iterations;
+      }
+      LpResult costed = solver.solve(plp, p);
+      costed.iterations += pretest;
+      return costed;
     };
     exactly += use_exact;
     // The exact solver's parameters: with a pivot cap where asked (its iterations are pivots).
@@ -450,7 +472,8 @@ JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpS
       r.status = s.status;
       return out;
     }
-    if (s.status == LpStatus::Infeasible && s.solver == solver.name() && s.solver.rfind("pdhg", 0) == 0 && !s.y.empty() &&
+    if (s.status == LpStatus::Infeasible && !proved_at_zero && s.solver == solver.name() &&
+        s.solver.rfind("pdhg", 0) == 0 && !s.y.empty() &&
         std::any_of(plp.c.begin(), plp.c.end(), [](double c) { return c != 0.0; })) {
       // A first-order proof is a dual point whose bound passed the largest objective. Next to a
       // ray still short, its ordinary duals (about the costs) can be its large entries and name
@@ -1442,7 +1465,7 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
       joined = detail::solve_in_parts(red.lp, std::move(params), *solver, exact ? exact_solver.get() : nullptr,
                               options.exact_below, exact_params, options.split_parts,
                               options.exact_pivots_per_column, &exact_cache, &warm_weight, options.slow_part,
-                              options.slow_part_seconds);
+                              options.slow_part_seconds, options.later_feasibility_iterations);
     }
     const LpResult& r = joined.r;
     // Round 1's iterate over the whole LP, for first_iterate and (an optimum) for the alternatives.

@@ -20,6 +20,9 @@ namespace shapematch::detail {
 // many pivots per column of the part (at least 1 000 columns' worth), and the part goes to
 // `solver` as where it gives up. With `warm_weight` (one value per column, 0: none) a part solved
 // by `solver` starts from the geometric mean of its columns' positive values as its primal weight.
+// With `feasibility_iterations` > 0 such a part is first solved at zero cost for at most that many
+// iterations (RoundingOptions::later_feasibility_iterations): proved infeasible there, that is its
+// result.
 struct JoinedSolve {
   LpResult r;
   std::vector<double> proof;
@@ -67,7 +70,7 @@ JoinedSolve solve_in_parts(const LpProblem& lp, SolverParams params, LpSolver& s
                            double exact_pivots_per_column = 0.0, ExactCache* cache = nullptr,
                            const std::vector<double>* warm_weight = nullptr,
                            const std::function<void(const LpProblem&)>& slow_part = {},
-                           double slow_part_seconds = 10.0);
+                           double slow_part_seconds = 10.0, int64_t feasibility_iterations = 0);
 
 }  // namespace shapematch::detail
 

@@ -156,6 +156,14 @@ struct RoundingOptions {
   // and 4-9 % in mean error for it (match --feasibility-first 1024 is the measured setting).
   // 0: off.
   int64_t feasibility_iterations = 0;
+  // The same for the later rounds: each part the first-order solver would solve is first solved
+  // at zero cost from its warm start for at most this many iterations; proved infeasible there,
+  // that proof stands for the part (no costed solve), otherwise the costed solve runs as before.
+  // Why: at full resolution a later round's infeasible LP takes the costed solve 13 000-23 000
+  // iterations to prove (FAUST_r 043-063 without WKS, level 6: 70-900 s per round on one core, a
+  // dozen such rounds in a row), and a failed part proved again at zero cost took 320-1 920
+  // (sixtieth session). 0: off.
+  int64_t later_feasibility_iterations = 0;
   // Where the LPs after fixings have failed (infeasible, or looking it at their cap) round after
   // round, at least stuck_rounds of them taking over this many times round 1's seconds in all,
   // give up with a StuckError naming the last failed parts' rows and carrying the fixings to 1
