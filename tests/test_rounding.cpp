@@ -1568,7 +1568,7 @@ public:
 };
 }  // namespace
 
-TEST_CASE("rounding: a later round's part solved first at zero cost is proved infeasible there alone") {
+TEST_CASE("rounding: a later round's parts solved first at zero cost: a proof there ends the round's solve") {
   // Two parts: the clash (rows 0-2) and q's row, feasible.
   const LpProblem lp = clash_beside_costs(100.0);
   SolverParams params;
@@ -1590,8 +1590,8 @@ TEST_CASE("rounding: a later round's part solved first at zero cost is proved in
   CHECK(std::abs(b.proof[2]) > 0.0);
   // Without it: the clash costed, then again at zero cost for its proof; q's part costed.
   CHECK(plain.zero == std::vector<bool>{false, true, false});
-  // With it: the clash at zero cost only; q's part at zero cost (feasible) and then costed.
-  CHECK(tested.zero == std::vector<bool>{true, true, false});
+  // With it: both parts at zero cost, and no costed solve after the clash's proof there.
+  CHECK(tested.zero == std::vector<bool>{true, true});
   // A feasible LP: the same solution, the pre-test's iterations added.
   const LpProblem ok = clash_beside_costs(100.0, true);
   ZeroCostNoting plain_ok, tested_ok;
@@ -1603,7 +1603,7 @@ TEST_CASE("rounding: a later round's part solved first at zero cost is proved in
   CHECK(d.r.objective == doctest::Approx(c.r.objective).epsilon(1e-9));
   CHECK(d.r.x == c.r.x);
   CHECK(d.r.iterations > c.r.iterations);
-  CHECK(tested_ok.zero == std::vector<bool>{true, false, true, false});
+  CHECK(tested_ok.zero == std::vector<bool>{true, true, false, false});
 }
 
 namespace {

@@ -366,7 +366,41 @@ JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpS
     params.initial_x.clear();
     params.initial_y.clear();
   }
-  for (const Part& part : parts) {
+  // First every part the first-order solver would take, at zero cost for at most
+  // feasibility_iterations, cold: without costs PDHG's dual grows along the Farkas ray alone, so an
+  // infeasible part is proved in a fraction of the costed iterations (see solve_at_zero_cost's
+  // callers). Where one is, the round has failed, and the other parts' costed solves (up to the
+  // cap each, at full resolution minutes) would go unused: none runs.
+  std::vector<int64_t> pretested(parts.size(), 0);  // iterations, added to the part's costed solve
+  if (feasibility_iterations > 0 && solver.name().rfind("pdhg", 0) == 0) {
+    for (size_t k = 0; k < parts.size(); ++k) {
+      const LpProblem& plp = whole ? lp : parts[k].lp;
+      if (exact && plp.cols() < exact_below) continue;
+      SolverParams zp = params;
+      if (weighted) zp.initial_primal_weight = part_weight(*warm_weight, parts[k].cols);
+      zp.max_iterations = std::min(params.max_iterations, feasibility_iterations);
+      zp.stop_on_divergence = false;
+      zp.patient_divergence_watch = false;
+      LpProblem zero = plp;  // (a part of a const LP)
+      const LpResult z = solve_at_zero_cost(zero, zp, solver);
+      spdlog::debug("rounding: a part of {} variables at zero cost: {} in {} iterations ({:.2f} s)", plp.cols(),
+                    to_string(z.status), z.iterations, z.seconds);
+      pretested[k] = z.iterations;
+      r.iterations = std::max(r.iterations, z.iterations);
+      if (z.status != LpStatus::Infeasible) continue;
+      infeasible = true;
+      out.failed_rows.insert(out.failed_rows.end(), parts[k].rows.begin(), parts[k].rows.end());
+      for (size_t i = 0; i < parts[k].rows.size() && i < z.y.size(); ++i) out.proof[parts[k].rows[i]] = z.y[i];
+    }
+    if (infeasible) {
+      r.status = LpStatus::Infeasible;
+      r.objective = std::numeric_limits<double>::quiet_NaN();
+      spdlog::debug("LP in {} independent parts: proved infeasible at zero cost, no costed solve", parts.size());
+      return out;
+    }
+  }
+  for (size_t k = 0; k < parts.size(); ++k) {
+    const Part& part = parts[k];
     const LpProblem& plp = whole ? lp : part.lp;
     largest = std::max<int64_t>(largest, plp.cols());
     const bool use_exact = exact && plp.cols() < exact_below;
@@ -388,30 +422,11 @@ JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpS
       return own;
     };
     double asked = 0.0;  // the ω this part's first-order solve was asked to start from
-    bool proved_at_zero = false;  // by the pre-test (feasibility_iterations)
     auto first_order_solve = [&]() {
       const SolverParams& p = first_order();
       asked = p.initial_primal_weight;
-      int64_t pretest = 0;
-      if (feasibility_iterations > 0 && solver.name().rfind("pdhg", 0) == 0) {
-        // Without costs PDHG's dual grows along the Farkas ray alone (see solve_at_zero_cost's
-        // callers): an infeasible part is proved in a fraction of the costed iterations.
-        SolverParams zp = p;
-        zp.max_iterations = std::min(p.max_iterations, feasibility_iterations);
-        zp.stop_on_divergence = false;
-        zp.patient_divergence_watch = false;
-        LpProblem zero = plp;  // (a part of a const LP)
-        LpResult z = solve_at_zero_cost(zero, zp, solver);
-        spdlog::debug("rounding: a part of {} variables at zero cost: {} in {} iterations ({:.2f} s)", plp.cols(),
-                      to_string(z.status), z.iterations, z.seconds);
-        if (z.status == LpStatus::Infeasible) {
-          proved_at_zero = true;
-          return z;
-        }
-        pretest = z.iterations;
-      }
       LpResult costed = solver.solve(plp, p);
-      costed.iterations += pretest;
+      costed.iterations += pretested[k];
       return costed;
     };
     exactly += use_exact;
@@ -472,8 +487,7 @@ JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpS
       r.status = s.status;
       return out;
     }
-    if (s.status == LpStatus::Infeasible && !proved_at_zero && s.solver == solver.name() &&
-        s.solver.rfind("pdhg", 0) == 0 && !s.y.empty() &&
+    if (s.status == LpStatus::Infeasible && s.solver == solver.name() && s.solver.rfind("pdhg", 0) == 0 && !s.y.empty() &&
         std::any_of(plp.c.begin(), plp.c.end(), [](double c) { return c != 0.0; })) {
       // A first-order proof is a dual point whose bound passed the largest objective. Next to a
       // ray still short, its ordinary duals (about the costs) can be its large entries and name

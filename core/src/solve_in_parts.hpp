@@ -20,9 +20,9 @@ namespace shapematch::detail {
 // many pivots per column of the part (at least 1 000 columns' worth), and the part goes to
 // `solver` as where it gives up. With `warm_weight` (one value per column, 0: none) a part solved
 // by `solver` starts from the geometric mean of its columns' positive values as its primal weight.
-// With `feasibility_iterations` > 0 such a part is first solved at zero cost for at most that many
-// iterations (RoundingOptions::later_feasibility_iterations): proved infeasible there, that is its
-// result.
+// With `feasibility_iterations` > 0 every such part is first solved at zero cost for at most that
+// many iterations (RoundingOptions::later_feasibility_iterations); where one is proved infeasible
+// there, the join is infeasible with those parts' certificates, and nothing else is solved.
 struct JoinedSolve {
   LpResult r;
   std::vector<double> proof;

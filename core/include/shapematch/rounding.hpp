@@ -157,8 +157,9 @@ struct RoundingOptions {
   // 0: off.
   int64_t feasibility_iterations = 0;
   // The same for the later rounds: each part the first-order solver would solve is first solved
-  // at zero cost from its warm start for at most this many iterations; proved infeasible there,
-  // that proof stands for the part (no costed solve), otherwise the costed solve runs as before.
+  // at zero cost, cold, for at most this many iterations; where one is proved infeasible there,
+  // its certificate is the round's proof and no costed solve runs (the round has failed);
+  // otherwise the costed solves run as before.
   // Why: at full resolution a later round's infeasible LP takes the costed solve 13 000-23 000
   // iterations to prove (FAUST_r 043-063 without WKS, level 6: 70-900 s per round on one core, a
   // dozen such rounds in a row), and a failed part proved again at zero cost took 320-1 920
