@@ -153,7 +153,9 @@ struct RoundingOptions {
   // costs not always sooner than with them (192-3 072 against 1 216-3 136 cold): the cap bounds
   // what the pre-test costs them. Off by default: a proof widens less than the divergence watch's
   // suspicion with its margin, and at 3 000 faces two of three pairs ended 2-4 % higher in energy
-  // and 4-9 % in mean error for it (match --feasibility-first 1024 is the measured setting).
+  // and 4-9 % in mean error for it (match --feasibility-first 1024 is the measured setting). With
+  // the margin since (CoarseToFineOptions::zero_cost_proof_rings) one of them is back; the other's
+  // loss came from a false suspicion's widening that a pre-test avoids.
   // 0: off.
   int64_t feasibility_iterations = 0;
   // The same for the later rounds: each part the first-order solver would solve is first solved
@@ -163,7 +165,10 @@ struct RoundingOptions {
   // Why: at full resolution a later round's infeasible LP takes the costed solve 13 000-23 000
   // iterations to prove (FAUST_r 043-063 without WKS, level 6: 70-900 s per round on one core, a
   // dozen such rounds in a row), and a failed part proved again at zero cost took 320-1 920
-  // (sixtieth session). 0: off.
+  // (sixtieth session). Measured there with 2 048 (sixty-ninth session): three rounds proved in
+  // 1 344-1 408 iterations (33-38 s against 40-140), one LP proved that the costed solve had left
+  // at its cap; but parts within the tolerance of feasible at zero cost that the costed solve then
+  // proves infeasible pay both, and feasible rounds about 40 s. Hence 0: off.
   int64_t later_feasibility_iterations = 0;
   // Where the LPs after fixings have failed (infeasible, or looking it at their cap) round after
   // round, at least stuck_rounds of them taking over this many times round 1's seconds in all,
