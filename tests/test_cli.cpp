@@ -50,6 +50,12 @@ std::string read_file(const fs::path& p) {
 
 const std::string kTetra = "OFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n";
 
+// How often `what` occurs in `text`.
+size_t count(const std::string& text, const std::string& what) {
+  size_t n = 0;
+  for (size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
+  return n;
+}
 }  // namespace
 
 TEST_CASE("cli: lp on the bundled pair is positive, on an identity pair zero") {
@@ -135,11 +141,6 @@ TEST_CASE("cli: match --feasibility-first tests a refined level's first LPs at z
   // whose spaces contain its space (not tested). Level 1 is the full space (not tested).
   const std::string pair = "match " + straight + " " + bent +
                            " --faces 240 --levels 2 --ring 0 --coarse-ring 0 --backend cpu --threads 1 ";
-  auto count = [](const std::string& text, const std::string& what) {
-    size_t n = 0;
-    for (size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
-    return n;
-  };
   Run r = run("-v " + pair + "--feasibility-first 2000 -o " + (tmp.path / "tested").string());
   REQUIRE_MESSAGE(r.code == 0, r.err);
   CHECK(count(r.err, "round 1's LP at zero cost: optimal") == 1);
@@ -170,11 +171,6 @@ TEST_CASE("cli: match --zero-cost-proof-rings widens around a level's widenings 
   const std::string pair = "match " + bent + " " + straight +
                            " --faces 200 --levels 3 --ring 0 --coarse-ring 0 --widen-margin 0 --backend cpu "
                            "--threads 1 --feasibility-first 4000 ";
-  auto count = [](const std::string& text, const std::string& what) {
-    size_t n = 0;
-    for (size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
-    return n;
-  };
   Run r = run("-v " + pair + "--zero-cost-proof-rings 0 -o " + (tmp.path / "none").string());
   REQUIRE_MESSAGE(r.code == 0, r.err);
   REQUIRE(count(r.err, "proved at zero cost") >= 1);
