@@ -324,6 +324,16 @@ LpResult solve_at_zero_cost(LpProblem& lp, SolverParams params, LpSolver& solver
   return z;
 }
 
+// The parameters of a zero-cost pre-test: at most `cap` iterations, no divergence watch (at zero
+// cost a growing dual is the proof being found, not a reason to stop).
+SolverParams pretest_params(const SolverParams& params, int64_t cap) {
+  SolverParams zp = params;
+  zp.max_iterations = std::min(params.max_iterations, cap);
+  zp.stop_on_divergence = false;
+  zp.patient_divergence_watch = false;
+  return zp;
+}
+
 bool looks_infeasible(const LpResult& r) {
   // Far above: those LPs' bounds were 3-60x their objectives; at 5 % above, feasible LPs that had
   // not converged by the cap (bound 5.34, objective 5.01) were undone round after round.
@@ -371,18 +381,21 @@ JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpS
   // infeasible part is proved in a fraction of the costed iterations (see solve_at_zero_cost's
   // callers). Where one is, the round has failed, and the other parts' costed solves (up to the
   // cap each, at full resolution minutes) would go unused: none runs.
+  // A part's LP at zero cost: a split part's own LP in place (its costs put back after), the
+  // whole LP (const here) as a copy.
+  auto at_zero_cost = [&](Part& part, const SolverParams& p) {
+    if (!whole) return solve_at_zero_cost(part.lp, p, solver);
+    LpProblem zero = lp;
+    return solve_at_zero_cost(zero, p, solver);
+  };
   std::vector<int64_t> pretested(parts.size(), 0);  // iterations, added to the part's costed solve
   if (feasibility_iterations > 0 && solver.name().rfind("pdhg", 0) == 0) {
     for (size_t k = 0; k < parts.size(); ++k) {
       const LpProblem& plp = whole ? lp : parts[k].lp;
       if (exact && plp.cols() < exact_below) continue;
-      SolverParams zp = params;
+      SolverParams zp = pretest_params(params, feasibility_iterations);
       if (weighted) zp.initial_primal_weight = part_weight(*warm_weight, parts[k].cols);
-      zp.max_iterations = std::min(params.max_iterations, feasibility_iterations);
-      zp.stop_on_divergence = false;
-      zp.patient_divergence_watch = false;
-      LpProblem zero = plp;  // (a part of a const LP)
-      const LpResult z = solve_at_zero_cost(zero, zp, solver);
+      const LpResult z = at_zero_cost(parts[k], zp);
       spdlog::debug("rounding: a part of {} variables at zero cost: {} in {} iterations ({:.2f} s)", plp.cols(),
                     to_string(z.status), z.iterations, z.seconds);
       pretested[k] = z.iterations;
@@ -400,7 +413,7 @@ JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpS
     }
   }
   for (size_t k = 0; k < parts.size(); ++k) {
-    const Part& part = parts[k];
+    Part& part = parts[k];
     const LpProblem& plp = whole ? lp : part.lp;
     largest = std::max<int64_t>(largest, plp.cols());
     const bool use_exact = exact && plp.cols() < exact_below;
@@ -494,8 +507,7 @@ JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpS
       // rows that take no part in the clash (measured on the rounding test's two_causes with its
       // alternatives at cost 10: the proof named the other cause, and the round after it failed
       // again). The same part at zero cost has no ordinary duals: its proof is the clash alone.
-      LpProblem zero = plp;  // (a part of a const LP)
-      const LpResult z = solve_at_zero_cost(zero, first_order(), solver);
+      const LpResult z = at_zero_cost(part, first_order());
       spdlog::debug("rounding: a part of {} variables proved infeasible ({} rows carry the proof); at zero cost {} in {} "
                     "iterations ({:.2f} s){}",
                     plp.cols(), carrying_rows(s.y).size(), to_string(z.status), z.iterations, z.seconds,
@@ -1422,11 +1434,8 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
         // Without costs there are no ordinary duals to converge first: PDHG proves an infeasible
         // LP in a fraction of the iterations (and names only the clash); a feasible one's point
         // it finds not always sooner (hence the cap). Only its verdict is kept.
-        SolverParams zp = params;
+        SolverParams zp = pretest_params(params, options.feasibility_iterations);
         zp.initial_primal_weight = 0.0;
-        zp.stop_on_divergence = false;
-        zp.patient_divergence_watch = false;
-        zp.max_iterations = std::min(params.max_iterations, options.feasibility_iterations);
         const LpResult z = solve_at_zero_cost(red.lp, zp, *solver);
         pretest_iterations = z.iterations;
         pretest_seconds = z.seconds;
