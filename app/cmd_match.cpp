@@ -52,6 +52,7 @@ struct MatchArgs {
   int64_t exact_below = RoundingOptions{}.exact_below;
   int64_t feasibility_first = RoundingOptions{}.feasibility_iterations;
   int64_t feasibility_later = RoundingOptions{}.later_feasibility_iterations;
+  double feasibility_tol = RoundingOptions{}.feasibility_tolerance;
   int release_after_trims = RoundingOptions{}.release_after_trims;
   double tolerance = 1e-4;
   double coarse_tolerance = CoarseToFineOptions{}.coarse_tolerance;
@@ -263,6 +264,7 @@ int run_match(const MatchArgs& args) {
   ro.exact_below = args.exact_below;
   ro.feasibility_iterations = args.feasibility_first;
   ro.later_feasibility_iterations = args.feasibility_later;
+  ro.feasibility_tolerance = args.feasibility_tol;
   ro.release_after_trims = args.release_after_trims;
   ro.lp.tolerance = args.tolerance;
   ro.lp.time_limit = args.time_limit;
@@ -509,6 +511,7 @@ int run_match(const MatchArgs& args) {
                               .set("exact_below", args.exact_below)
                               .set("feasibility_first", args.feasibility_first)
                               .set("feasibility_later", args.feasibility_later)
+                              .set("feasibility_tol", args.feasibility_tol)
                               .set("release_after_trims", args.release_after_trims)
                               .set("split_parts", !args.whole_lp)
                               .set("tolerance", args.tolerance)
@@ -704,6 +707,11 @@ Action add_match_command(CLI::App& app) {
   app.add_option("--feasibility-later", a->feasibility_later,
                  "in the later rounds, solve each part PDHG would solve without costs first for at most N "
                  "iterations: an infeasible one is proved there (0: off)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  app.add_option("--feasibility-tol", a->feasibility_tol,
+                 "the tolerance of the zero-cost pre-tests (--feasibility-first, --feasibility-later): a part "
+                 "counts as feasible there only with its relative residual under it (0: --tol's)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   app.add_option("--release-after-trims", a->release_after_trims,

@@ -1576,7 +1576,7 @@ TEST_CASE("rounding: a later round's parts solved first at zero cost: a proof th
   params.threads = 1;
   auto joined = [&](ZeroCostNoting& solver, int64_t feasibility_iterations) {
     return detail::solve_in_parts(lp, params, solver, nullptr, 0, params, true, 0.0, nullptr, nullptr, {}, 10.0,
-                                  feasibility_iterations);
+                                  {feasibility_iterations});
   };
   ZeroCostNoting plain, tested;
   const detail::JoinedSolve a = joined(plain, 0), b = joined(tested, 1000);
@@ -1597,13 +1597,76 @@ TEST_CASE("rounding: a later round's parts solved first at zero cost: a proof th
   ZeroCostNoting plain_ok, tested_ok;
   const detail::JoinedSolve c = detail::solve_in_parts(ok, params, plain_ok, nullptr, 0, params, true),
                             d = detail::solve_in_parts(ok, params, tested_ok, nullptr, 0, params, true, 0.0, nullptr,
-                                                       nullptr, {}, 10.0, 1000);
+                                                       nullptr, {}, 10.0, {1000});
   REQUIRE(c.r.status == LpStatus::Optimal);
   REQUIRE(d.r.status == LpStatus::Optimal);
   CHECK(d.r.objective == doctest::Approx(c.r.objective).epsilon(1e-9));
   CHECK(d.r.x == c.r.x);
   CHECK(d.r.iterations > c.r.iterations);
   CHECK(tested_ok.zero == std::vector<bool>{true, true, false, false});
+}
+
+TEST_CASE("rounding: the later pre-test's own tolerance: a part within the LP's tolerance of feasible is proved "
+          "infeasible under a tighter one") {
+  // a1 + a2 = 1 and a1 + a2 = 1.01: infeasible, yet a point with both rows off by 0.005 has a
+  // relative residual of 0.0029, under the LP's 0.01.
+  const LpProblem lp = test::dense_lp({{1, 1}, {1, 1}}, {1.0, 1.01}, {1.0, 2.0});
+  SolverParams params;
+  params.tolerance = 1e-2;
+  params.threads = 1;
+  auto joined = [&](ZeroCostNoting& solver, double feasibility_tolerance) {
+    return detail::solve_in_parts(lp, params, solver, nullptr, 0, params, true, 0.0, nullptr, nullptr, {}, 10.0,
+                                  {2000, feasibility_tolerance});
+  };
+  ZeroCostNoting loose, tight;
+  const detail::JoinedSolve a = joined(loose, 0.0), b = joined(tight, 1e-7);
+  // At the LP's tolerance the pre-test passes the part and the costed solve calls it optimal.
+  CHECK(a.r.status == LpStatus::Optimal);
+  CHECK(loose.zero == std::vector<bool>{true, false});
+  // Under 1e-7 the pre-test goes on to its proof, and no costed solve runs.
+  CHECK(b.r.status == LpStatus::Infeasible);
+  CHECK(tight.zero == std::vector<bool>{true});
+  CHECK(b.failed_rows == std::vector<int64_t>{0, 1});
+  // The certificate: the two rows against each other, bᵀy > 0.
+  CHECK(b.proof[0] == doctest::Approx(-b.proof[1]).epsilon(1e-3));
+  CHECK(b.proof[0] + 1.01 * b.proof[1] > 0.0);
+}
+
+TEST_CASE("rounding: a part unchanged since the later pre-test passed it is not tested again") {
+  SolverParams params;
+  params.tolerance = 1e-6;
+  params.threads = 1;
+  detail::PretestCache cache;
+  auto joined = [&](const LpProblem& lp, ZeroCostNoting& solver) {
+    return detail::solve_in_parts(lp, params, solver, nullptr, 0, params, true, 0.0, nullptr, nullptr, {}, 10.0,
+                                  {1000, 0.0, &cache});
+  };
+  // Two feasible parts: both tested, then both solved with their costs.
+  const LpProblem ok = clash_beside_costs(100.0, true);
+  ZeroCostNoting first, again, changed;
+  const detail::JoinedSolve a = joined(ok, first);
+  CHECK(first.zero == std::vector<bool>{true, true, false, false});
+  CHECK(cache.entries.size() == 2);
+  // The same LP again: no pre-test, the same solution.
+  const detail::JoinedSolve b = joined(ok, again);
+  CHECK(again.zero == std::vector<bool>{false, false});
+  CHECK(cache.reused == 2);
+  REQUIRE(b.r.status == LpStatus::Optimal);
+  CHECK(b.r.x == a.r.x);
+  // q's right-hand side changed: only q's part is tested.
+  LpProblem moved = ok;
+  moved.b[3] = 0.5;
+  const detail::JoinedSolve c = joined(moved, changed);
+  CHECK(changed.zero == std::vector<bool>{true, false, false});
+  CHECK(cache.reused == 3);
+  CHECK(c.r.status == LpStatus::Optimal);
+  CHECK(detail::constraint_fingerprint(moved) != detail::constraint_fingerprint(ok));
+  // An infeasible part's verdict is not kept: the clash is proved again each time.
+  const LpProblem clash = clash_beside_costs(100.0);
+  ZeroCostNoting proved, proved_again;
+  CHECK(joined(clash, proved).r.status == LpStatus::Infeasible);
+  CHECK(joined(clash, proved_again).r.status == LpStatus::Infeasible);
+  CHECK(proved_again.zero.front());
 }
 
 namespace {

@@ -11,6 +11,7 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <deque>
 #include <exception>
@@ -325,10 +326,12 @@ LpResult solve_at_zero_cost(LpProblem& lp, SolverParams params, LpSolver& solver
 }
 
 // The parameters of a zero-cost pre-test: at most `cap` iterations, no divergence watch (at zero
-// cost a growing dual is the proof being found, not a reason to stop).
-SolverParams pretest_params(const SolverParams& params, int64_t cap) {
+// cost a growing dual is the proof being found, not a reason to stop), and its own tolerance where
+// one is given (> 0): at zero cost "optimal" only says the residual is that small.
+SolverParams pretest_params(const SolverParams& params, int64_t cap, double tolerance) {
   SolverParams zp = params;
   zp.max_iterations = std::min(params.max_iterations, cap);
+  if (tolerance > 0.0) zp.tolerance = tolerance;
   zp.stop_on_divergence = false;
   zp.patient_divergence_watch = false;
   return zp;
@@ -342,12 +345,31 @@ bool looks_infeasible(const LpResult& r) {
 
 }  // namespace
 
+uint64_t detail::constraint_fingerprint(const LpProblem& lp) {
+  // splitmix64's finaliser over each word folded in: a change anywhere changes the result.
+  uint64_t h = 0x9e3779b97f4a7c15ull;
+  auto add = [&h](uint64_t v) {
+    h ^= v + 0x9e3779b97f4a7c15ull + (h << 6) + (h >> 2);
+    h ^= h >> 30;
+    h *= 0xbf58476d1ce4e5b9ull;
+    h ^= h >> 27;
+    h *= 0x94d049bb133111ebull;
+    h ^= h >> 31;
+  };
+  add(uint64_t(lp.a.rows));
+  add(uint64_t(lp.a.cols));
+  for (uint32_t p : lp.a.row_ptr) add(p);
+  for (uint32_t e : lp.a.entry) add(e);
+  for (double v : lp.b) add(std::bit_cast<uint64_t>(v));
+  return h;
+}
+
 JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpSolver& solver, LpSolver* exact,
                                    int64_t exact_below, const SolverParams& exact_params, bool split,
                                    double exact_pivots_per_column, ExactCache* cache,
                                    const std::vector<double>* warm_weight,
                                    const std::function<void(const LpProblem&)>& slow_part, double slow_part_seconds,
-                                   int64_t feasibility_iterations) {
+                                   const ZeroCostPretest& pretest) {
   JoinedSolve out;
   std::vector<Part> parts;
   if (split) parts = split_into_parts(lp);
@@ -377,7 +399,7 @@ JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpS
     params.initial_y.clear();
   }
   // First every part the first-order solver would take, at zero cost for at most
-  // feasibility_iterations, cold: without costs PDHG's dual grows along the Farkas ray alone, so an
+  // pretest.iterations, cold: without costs PDHG's dual grows along the Farkas ray alone, so an
   // infeasible part is proved in a fraction of the costed iterations (see solve_at_zero_cost's
   // callers). Where one is, the round has failed, and the other parts' costed solves (up to the
   // cap each, at full resolution minutes) would go unused: none runs.
@@ -389,21 +411,52 @@ JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpS
     return solve_at_zero_cost(zero, p, solver);
   };
   std::vector<int64_t> pretested(parts.size(), 0);  // iterations, added to the part's costed solve
-  if (feasibility_iterations > 0 && solver.name().rfind("pdhg", 0) == 0) {
+  if (pretest.iterations > 0 && solver.name().rfind("pdhg", 0) == 0) {
+    std::vector<PretestCache::Entry> fresh;  // this call's new verdicts short of a proof, for the next calls
     for (size_t k = 0; k < parts.size(); ++k) {
       const LpProblem& plp = whole ? lp : parts[k].lp;
       if (exact && plp.cols() < exact_below) continue;
-      SolverParams zp = pretest_params(params, feasibility_iterations);
+      SolverParams zp = pretest_params(params, pretest.iterations, pretest.tolerance);
       if (weighted) zp.initial_primal_weight = part_weight(*warm_weight, parts[k].cols);
+      PretestCache::Entry key;
+      if (pretest.cache) {
+        key = {constraint_fingerprint(plp), plp.rows(),      plp.cols(), plp.nonzeros(), zp.max_iterations,
+               zp.tolerance,                 zp.initial_primal_weight};
+        const auto same = [&](const PretestCache::Entry& e) {
+          return e.fingerprint == key.fingerprint && e.rows == key.rows && e.cols == key.cols &&
+                 e.nonzeros == key.nonzeros && e.max_iterations == key.max_iterations &&
+                 e.tolerance == key.tolerance && e.weight == key.weight;
+        };
+        auto it = std::find_if(pretest.cache->entries.begin(), pretest.cache->entries.end(), same);
+        if (it != pretest.cache->entries.end()) {
+          spdlog::debug("rounding: a part of {} variables unchanged since its pre-test, which did not prove it "
+                        "infeasible: not tested again",
+                        plp.cols());
+          ++pretest.cache->reused;
+          it->unused = -1;  // seen in this call (0 after the ageing below)
+          continue;
+        }
+      }
       const LpResult z = at_zero_cost(parts[k], zp);
       spdlog::debug("rounding: a part of {} variables at zero cost: {} in {} iterations ({:.2f} s)", plp.cols(),
                     to_string(z.status), z.iterations, z.seconds);
       pretested[k] = z.iterations;
       r.iterations = std::max(r.iterations, z.iterations);
-      if (z.status != LpStatus::Infeasible) continue;
+      if (z.status != LpStatus::Infeasible) {
+        // (A time limit depends on what is left of the run's time, not on the part.)
+        if (pretest.cache && (z.status == LpStatus::Optimal || z.status == LpStatus::IterationLimit))
+          fresh.push_back(key);
+        continue;
+      }
       infeasible = true;
       out.failed_rows.insert(out.failed_rows.end(), parts[k].rows.begin(), parts[k].rows.end());
       for (size_t i = 0; i < parts[k].rows.size() && i < z.y.size(); ++i) out.proof[parts[k].rows[i]] = z.y[i];
+    }
+    if (pretest.cache) {
+      // Kept until kKeepCalls calls in a row have not had the part (as ExactCache).
+      std::erase_if(pretest.cache->entries,
+                    [](PretestCache::Entry& e) { return ++e.unused >= PretestCache::kKeepCalls; });
+      pretest.cache->entries.insert(pretest.cache->entries.end(), fresh.begin(), fresh.end());
     }
     if (infeasible) {
       r.status = LpStatus::Infeasible;
@@ -1057,6 +1110,7 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
   auto solver = make_solver(options.solver);
   std::unique_ptr<LpSolver> exact_solver;  // for the small last rounds (exact_below)
   detail::ExactCache exact_cache;           // its results on the last round's parts
+  detail::PretestCache pretest_cache;       // the zero-cost pre-test's verdicts on them
   RoundingResult result;
   Fixer fixer(lp);
   if (!fixer.propagate_all())
@@ -1434,7 +1488,7 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
         // Without costs there are no ordinary duals to converge first: PDHG proves an infeasible
         // LP in a fraction of the iterations (and names only the clash); a feasible one's point
         // it finds not always sooner (hence the cap). Only its verdict is kept.
-        SolverParams zp = pretest_params(params, options.feasibility_iterations);
+        SolverParams zp = pretest_params(params, options.feasibility_iterations, options.feasibility_tolerance);
         zp.initial_primal_weight = 0.0;
         const LpResult z = solve_at_zero_cost(red.lp, zp, *solver);
         pretest_iterations = z.iterations;
@@ -1488,7 +1542,8 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
       joined = detail::solve_in_parts(red.lp, std::move(params), *solver, exact ? exact_solver.get() : nullptr,
                               options.exact_below, exact_params, options.split_parts,
                               options.exact_pivots_per_column, &exact_cache, &warm_weight, options.slow_part,
-                              options.slow_part_seconds, options.later_feasibility_iterations);
+                              options.slow_part_seconds,
+                              {options.later_feasibility_iterations, options.feasibility_tolerance, &pretest_cache});
     }
     const LpResult& r = joined.r;
     // Round 1's iterate over the whole LP, for first_iterate and (an optimum) for the alternatives.

@@ -170,6 +170,11 @@ struct RoundingOptions {
   // at its cap; but parts within the tolerance of feasible at zero cost that the costed solve then
   // proves infeasible pay both, and feasible rounds about 40 s. Hence 0: off.
   int64_t later_feasibility_iterations = 0;
+  // The tolerance of both zero-cost pre-tests (0: the LP's own). At zero cost PDHG's "optimal" says
+  // only that the relative residual is under it; at full resolution 3e-3 of 1 + |b| (|b| ~ 140)
+  // let parts through that the costed solve then proved infeasible (sixty-ninth session), so a
+  // tighter one keeps solving those until a proof or the cap.
+  double feasibility_tolerance = 0.0;
   // Where the LPs after fixings have failed (infeasible, or looking it at their cap) round after
   // round, at least stuck_rounds of them taking over this many times round 1's seconds in all,
   // give up with a StuckError naming the last failed parts' rows and carrying the fixings to 1
