@@ -1561,10 +1561,12 @@ public:
   std::string name() const override { return "pdhg-cpu"; }
   LpResult solve(const LpProblem& lp, const SolverParams& params) override {
     zero.push_back(std::all_of(lp.c.begin(), lp.c.end(), [](double c) { return c == 0.0; }));
+    tolerance.push_back(params.tolerance);
     return inner->solve(lp, params);
   }
   std::unique_ptr<LpSolver> inner = make_solver("pdhg-cpu");
   std::vector<bool> zero;
+  std::vector<double> tolerance;
 };
 }  // namespace
 
@@ -1630,6 +1632,15 @@ TEST_CASE("rounding: the later pre-test's own tolerance: a part within the LP's 
   // The certificate: the two rows against each other, bᵀy > 0.
   CHECK(b.proof[0] == doctest::Approx(-b.proof[1]).epsilon(1e-3));
   CHECK(b.proof[0] + 1.01 * b.proof[1] > 0.0);
+  // Without the pre-test, the re-proof of a part the costed solve proved infeasible runs under
+  // that tolerance too (clash_beside_costs: costed, at zero cost, costed).
+  const LpProblem clash = clash_beside_costs(100.0);
+  ZeroCostNoting reproved;
+  const detail::JoinedSolve c = detail::solve_in_parts(clash, params, reproved, nullptr, 0, params, true, 0.0, nullptr,
+                                                       nullptr, {}, 10.0, {0, 1e-7});
+  CHECK(c.r.status == LpStatus::Infeasible);
+  REQUIRE(reproved.zero == std::vector<bool>{false, true, false});
+  CHECK(reproved.tolerance == std::vector<double>{1e-2, 1e-7, 1e-2});
 }
 
 TEST_CASE("rounding: a part unchanged since the later pre-test passed it is not tested again") {

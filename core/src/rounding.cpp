@@ -560,7 +560,11 @@ JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpS
       // rows that take no part in the clash (measured on the rounding test's two_causes with its
       // alternatives at cost 10: the proof named the other cause, and the round after it failed
       // again). The same part at zero cost has no ordinary duals: its proof is the clash alone.
-      const LpResult z = at_zero_cost(part, first_order());
+      // (Under the pre-tests' own tolerance where given: this part has no feasible point, so
+      // "optimal" at zero cost only means the solve stopped short of the narrower proof.)
+      SolverParams zp = first_order();
+      if (pretest.tolerance > 0.0) zp.tolerance = pretest.tolerance;
+      const LpResult z = at_zero_cost(part, zp);
       spdlog::debug("rounding: a part of {} variables proved infeasible ({} rows carry the proof); at zero cost {} in {} "
                     "iterations ({:.2f} s){}",
                     plp.cols(), carrying_rows(s.y).size(), to_string(z.status), z.iterations, z.seconds,
