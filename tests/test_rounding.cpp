@@ -1562,10 +1562,11 @@ public:
   LpResult solve(const LpProblem& lp, const SolverParams& params) override {
     zero.push_back(std::all_of(lp.c.begin(), lp.c.end(), [](double c) { return c == 0.0; }));
     tolerance.push_back(params.tolerance);
+    warm.push_back(!params.initial_x.empty());
     return inner->solve(lp, params);
   }
   std::unique_ptr<LpSolver> inner = make_solver("pdhg-cpu");
-  std::vector<bool> zero;
+  std::vector<bool> zero, warm;
   std::vector<double> tolerance;
 };
 }  // namespace
@@ -1678,6 +1679,18 @@ TEST_CASE("rounding: a part unchanged since the later pre-test passed it is not 
   CHECK(joined(clash, proved).r.status == LpStatus::Infeasible);
   CHECK(joined(clash, proved_again).r.status == LpStatus::Infeasible);
   CHECK(proved_again.zero.front());
+  // Solved whole from a warm start, the pre-test still starts cold (its kept verdicts rely on
+  // it); the costed solve starts warm.
+  SolverParams warm = params;
+  warm.initial_x = a.r.x;
+  warm.initial_y = a.r.y;
+  ZeroCostNoting whole;
+  detail::PretestCache fresh;
+  const detail::JoinedSolve w =
+      detail::solve_in_parts(ok, warm, whole, nullptr, 0, warm, false, 0.0, nullptr, nullptr, {}, 10.0, {1000, 0.0, &fresh});
+  CHECK(w.r.status == LpStatus::Optimal);
+  CHECK(whole.zero == std::vector<bool>{true, false});
+  CHECK(whole.warm == std::vector<bool>{false, true});
 }
 
 namespace {

@@ -325,11 +325,14 @@ LpResult solve_at_zero_cost(LpProblem& lp, SolverParams params, LpSolver& solver
   return z;
 }
 
-// The parameters of a zero-cost pre-test: at most `cap` iterations, no divergence watch (at zero
-// cost a growing dual is the proof being found, not a reason to stop), and its own tolerance where
-// one is given (> 0): at zero cost "optimal" only says the residual is that small.
+// The parameters of a zero-cost pre-test: cold, at most `cap` iterations, no divergence watch (at
+// zero cost a growing dual is the proof being found, not a reason to stop), and its own tolerance
+// where one is given (> 0): at zero cost "optimal" only says the residual is that small. (Cold
+// also where `params` carries the whole LP's warm start: PretestCache's verdicts rely on it.)
 SolverParams pretest_params(const SolverParams& params, int64_t cap, double tolerance) {
   SolverParams zp = params;
+  zp.initial_x.clear();
+  zp.initial_y.clear();
   zp.max_iterations = std::min(params.max_iterations, cap);
   if (tolerance > 0.0) zp.tolerance = tolerance;
   zp.stop_on_divergence = false;
