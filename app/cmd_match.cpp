@@ -710,8 +710,9 @@ Action add_match_command(CLI::App& app) {
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   app.add_option("--feasibility-tol", a->feasibility_tol,
-                 "the tolerance of the zero-cost pre-tests (--feasibility-first, --feasibility-later): a part "
-                 "counts as feasible there only with its relative residual under it (0: --tol's)")
+                 "the tolerance of the zero-cost solves (--feasibility-first, --feasibility-later, the re-proof of "
+                 "a part proved infeasible): a part counts as feasible there only with its relative residual "
+                 "under it (0: --tol's)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   app.add_option("--release-after-trims", a->release_after_trims,

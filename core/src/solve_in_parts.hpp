@@ -24,6 +24,8 @@ namespace shapematch::detail {
 // many iterations (RoundingOptions::later_feasibility_iterations), to `pretest.tolerance` where
 // it is > 0 (RoundingOptions::feasibility_tolerance); where one is proved infeasible
 // there, the join is infeasible with those parts' certificates, and nothing else is solved.
+// `pretest.tolerance` also governs the re-proof at zero cost of a part the costed solve proved
+// infeasible (even with the pre-test off); `pretest.cache` keeps its verdicts (PretestCache).
 struct JoinedSolve {
   LpResult r;
   std::vector<double> proof;
