@@ -421,16 +421,12 @@ JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpS
       if (exact && plp.cols() < exact_below) continue;
       SolverParams zp = pretest_params(params, pretest.iterations, pretest.tolerance);
       if (weighted) zp.initial_primal_weight = part_weight(*warm_weight, parts[k].cols);
-      PretestCache::Entry key;
+      PretestCache::Key key;
       if (pretest.cache) {
         key = {constraint_fingerprint(plp), plp.rows(),      plp.cols(), plp.nonzeros(), zp.max_iterations,
                zp.tolerance,                 zp.initial_primal_weight};
-        const auto same = [&](const PretestCache::Entry& e) {
-          return e.fingerprint == key.fingerprint && e.rows == key.rows && e.cols == key.cols &&
-                 e.nonzeros == key.nonzeros && e.max_iterations == key.max_iterations &&
-                 e.tolerance == key.tolerance && e.weight == key.weight;
-        };
-        auto it = std::find_if(pretest.cache->entries.begin(), pretest.cache->entries.end(), same);
+        auto it = std::find_if(pretest.cache->entries.begin(), pretest.cache->entries.end(),
+                               [&](const PretestCache::Entry& e) { return e.key == key; });
         if (it != pretest.cache->entries.end()) {
           spdlog::debug("rounding: a part of {} variables unchanged since its pre-test, which did not prove it "
                         "infeasible: not tested again",
@@ -448,7 +444,7 @@ JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpS
       if (z.status != LpStatus::Infeasible) {
         // (A time limit depends on what is left of the run's time, not on the part.)
         if (pretest.cache && (z.status == LpStatus::Optimal || z.status == LpStatus::IterationLimit))
-          fresh.push_back(key);
+          fresh.push_back({key});
         continue;
       }
       infeasible = true;

@@ -77,10 +77,15 @@ struct ExactCache {
 // rows and right-hand side (and its sizes), not a copy: the parts are millions of entries.
 struct PretestCache {
   static constexpr int kKeepCalls = 4;
-  struct Entry {
+  // What the verdict depends on: the part's constraints, the cap, the tolerance, the starting ω.
+  struct Key {
     uint64_t fingerprint = 0;
     int64_t rows = 0, cols = 0, nonzeros = 0, max_iterations = 0;
     double tolerance = 0.0, weight = 0.0;
+    bool operator==(const Key&) const = default;
+  };
+  struct Entry {
+    Key key;
     int unused = 0;  // calls since its part was last seen
   };
   std::vector<Entry> entries;
