@@ -49,6 +49,7 @@ struct MatchArgs {
   int64_t search_below = RoundingOptions{}.search_below;
   bool converged_first = RoundingOptions{}.converged_first;
   double exact_pivots_per_column = RoundingOptions{}.exact_pivots_per_column;
+  double exact_part_seconds = RoundingOptions{}.exact_part_seconds;
   int64_t exact_below = RoundingOptions{}.exact_below;
   int64_t feasibility_first = RoundingOptions{}.feasibility_iterations;
   int64_t feasibility_later = RoundingOptions{}.later_feasibility_iterations;
@@ -261,6 +262,7 @@ int run_match(const MatchArgs& args) {
   ro.stuck_stalled = args.stuck_stalled;
   ro.converged_first = args.converged_first;
   ro.exact_pivots_per_column = args.exact_pivots_per_column;
+  ro.exact_part_seconds = args.exact_part_seconds;
   ro.exact_below = args.exact_below;
   ro.feasibility_iterations = args.feasibility_first;
   ro.later_feasibility_iterations = args.feasibility_later;
@@ -508,6 +510,7 @@ int run_match(const MatchArgs& args) {
                               .set("search_below", args.search_below)
                               .set("converged_first", args.converged_first)
                               .set("exact_pivots_per_column", args.exact_pivots_per_column)
+                              .set("exact_part_seconds", args.exact_part_seconds)
                               .set("exact_below", args.exact_below)
                               .set("feasibility_first", args.feasibility_first)
                               .set("feasibility_later", args.feasibility_later)
@@ -692,6 +695,11 @@ Action add_match_command(CLI::App& app) {
   app.add_option("--exact-pivots-per-column", a->exact_pivots_per_column,
                  "stop Clp after this many pivots per column of a later round's part (at least 1 000 columns' worth) "
                  "and give the part to PDHG (0: no cap)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  app.add_option("--exact-part-seconds", a->exact_part_seconds,
+                 "stop Clp after this many seconds on a later round's part and give it to PDHG, with the parts of "
+                 "its size or larger for the rest of the level (0: no limit)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   app.add_option("--exact-below", a->exact_below,

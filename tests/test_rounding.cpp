@@ -11,6 +11,7 @@
 #include <doctest/doctest.h>
 
 #include <map>
+#include <set>
 #include <numeric>
 
 using namespace shapematch;
@@ -1193,13 +1194,13 @@ TEST_CASE("rounding: a part that reaches the exact solver's pivot cap goes to th
   CHECK(a.r.objective == doctest::Approx(exact.objective).epsilon(1e-9));
   // A cap Clp's solve stays under: still Clp's vertex.
   const double roomy = 2.0 * double(exact.iterations) / double(std::max<int64_t>(n, 1000));
-  const detail::JoinedSolve b = detail::solve_in_parts(m.lp, params, *pdhg, clp.get(), n + 1, params, false, roomy);
+  const detail::JoinedSolve b = detail::solve_in_parts(m.lp, params, *pdhg, clp.get(), n + 1, params, false, {roomy});
   CHECK(b.exact_parts == 1);
   CHECK(b.r.status == LpStatus::Optimal);
   CHECK(b.r.objective == doctest::Approx(exact.objective).epsilon(1e-9));
   // One pivot: Clp stops at its cap and PDHG solves the part to its tolerance instead.
   const double one = 1.0 / double(std::max<int64_t>(n, 1000));
-  const detail::JoinedSolve c = detail::solve_in_parts(m.lp, params, *pdhg, clp.get(), n + 1, params, false, one);
+  const detail::JoinedSolve c = detail::solve_in_parts(m.lp, params, *pdhg, clp.get(), n + 1, params, false, {one});
   CHECK(c.exact_parts == 0);
   CHECK(c.r.status == LpStatus::Optimal);
   CHECK(c.r.objective == doctest::Approx(exact.objective).epsilon(1e-4));
@@ -1230,11 +1231,11 @@ TEST_CASE("rounding: a part solved exactly in one of the last rounds takes that 
   CountingClp clp;
   detail::ExactCache cache;
   const int64_t n = m.lp.cols();
-  const detail::JoinedSolve a = detail::solve_in_parts(m.lp, params, *pdhg, &clp, n + 1, params, false, 0.0, &cache);
+  const detail::JoinedSolve a = detail::solve_in_parts(m.lp, params, *pdhg, &clp, n + 1, params, false, {}, &cache);
   REQUIRE(a.r.status == LpStatus::Optimal);
   CHECK(clp.calls == 1);
   // The same LP: no solve, the same result to the last bit.
-  const detail::JoinedSolve b = detail::solve_in_parts(m.lp, params, *pdhg, &clp, n + 1, params, false, 0.0, &cache);
+  const detail::JoinedSolve b = detail::solve_in_parts(m.lp, params, *pdhg, &clp, n + 1, params, false, {}, &cache);
   CHECK(clp.calls == 1);
   CHECK(cache.reused == 1);
   CHECK(b.r.objective == a.r.objective);
@@ -1244,25 +1245,25 @@ TEST_CASE("rounding: a part solved exactly in one of the last rounds takes that 
   // One cost changed: solved again.
   LpProblem other = m.lp;
   other.c[0] += 1.0;
-  const detail::JoinedSolve c = detail::solve_in_parts(other, params, *pdhg, &clp, n + 1, params, false, 0.0, &cache);
+  const detail::JoinedSolve c = detail::solve_in_parts(other, params, *pdhg, &clp, n + 1, params, false, {}, &cache);
   CHECK(clp.calls == 2);
   CHECK(cache.reused == 1);
   // A call between that lacked it: still kept (FAUST_r 021-024 had such a round).
-  const detail::JoinedSolve d = detail::solve_in_parts(m.lp, params, *pdhg, &clp, n + 1, params, false, 0.0, &cache);
+  const detail::JoinedSolve d = detail::solve_in_parts(m.lp, params, *pdhg, &clp, n + 1, params, false, {}, &cache);
   CHECK(clp.calls == 2);
   CHECK(cache.reused == 2);
   CHECK(d.r.x == a.r.x);
   // Another pivot cap (one Clp's solve stays under) is another solve.
   const double roomy = 2.0 * double(a.r.iterations) / double(std::max<int64_t>(n, 1000));
   REQUIRE(roomy * double(std::max<int64_t>(n, 1000)) < double(params.max_iterations));
-  const detail::JoinedSolve e = detail::solve_in_parts(m.lp, params, *pdhg, &clp, n + 1, params, false, roomy, &cache);
+  const detail::JoinedSolve e = detail::solve_in_parts(m.lp, params, *pdhg, &clp, n + 1, params, false, {roomy}, &cache);
   CHECK(clp.calls == 3);
   CHECK(e.r.objective == a.r.objective);
   // kKeepCalls calls in a row without it: dropped, solved again.
   for (int k = 0; k < detail::ExactCache::kKeepCalls; ++k)
-    detail::solve_in_parts(other, params, *pdhg, &clp, n + 1, params, false, 0.0, &cache);
+    detail::solve_in_parts(other, params, *pdhg, &clp, n + 1, params, false, {}, &cache);
   CHECK(clp.calls == 3);  // `other` itself was kept
-  detail::solve_in_parts(m.lp, params, *pdhg, &clp, n + 1, params, false, 0.0, &cache);
+  detail::solve_in_parts(m.lp, params, *pdhg, &clp, n + 1, params, false, {}, &cache);
   CHECK(clp.calls == 4);
 }
 
@@ -1282,21 +1283,29 @@ TEST_CASE("rounding: a part the exact solver failed on in one of the last rounds
   detail::ExactCache cache;
   const int64_t n = m.lp.cols();
   const double one = 1.0 / double(std::max<int64_t>(n, 1000));
-  const detail::JoinedSolve a = detail::solve_in_parts(m.lp, params, *pdhg, &clp, n + 1, params, false, one, &cache);
+  const detail::JoinedSolve a = detail::solve_in_parts(m.lp, params, *pdhg, &clp, n + 1, params, false, {one}, &cache);
   CHECK(clp.calls == 1);
   CHECK(a.exact_parts == 0);
   REQUIRE(a.r.status == LpStatus::Optimal);
-  const detail::JoinedSolve b = detail::solve_in_parts(m.lp, params, *pdhg, &clp, n + 1, params, false, one, &cache);
+  CHECK(cache.capped_below == n);  // parts of its size go to PDHG from now on
+  const detail::JoinedSolve b = detail::solve_in_parts(m.lp, params, *pdhg, &clp, n + 1, params, false, {one}, &cache);
   CHECK(clp.calls == 1);
-  CHECK(cache.reused == 1);
   CHECK(b.exact_parts == 0);
   CHECK(b.r.status == LpStatus::Optimal);
   CHECK(b.r.objective == a.r.objective);
+  // Without capped_below the kept failure does it (as for numerical trouble): still no Clp.
+  cache.capped_below = std::numeric_limits<int64_t>::max();
+  const detail::JoinedSolve c = detail::solve_in_parts(m.lp, params, *pdhg, &clp, n + 1, params, false, {one}, &cache);
+  CHECK(clp.calls == 1);
+  CHECK(cache.reused == 1);
+  CHECK(c.exact_parts == 0);
+  CHECK(c.r.objective == a.r.objective);
   // Without the cap it is another question: Clp solves it.
-  const detail::JoinedSolve c = detail::solve_in_parts(m.lp, params, *pdhg, &clp, n + 1, params, false, 0.0, &cache);
+  detail::ExactCache fresh;
+  const detail::JoinedSolve d = detail::solve_in_parts(m.lp, params, *pdhg, &clp, n + 1, params, false, {}, &fresh);
   CHECK(clp.calls == 2);
-  CHECK(c.exact_parts == 1);
-  CHECK(c.r.objective == doctest::Approx(exact.objective).epsilon(1e-9));
+  CHECK(d.exact_parts == 1);
+  CHECK(d.r.objective == doctest::Approx(exact.objective).epsilon(1e-9));
 }
 
 TEST_CASE("rounding: a part the exact solver was slow on is handed out as solved, once") {
@@ -1312,7 +1321,7 @@ TEST_CASE("rounding: a part the exact solver was slow on is handed out as solved
   std::vector<LpProblem> seen;
   const std::function<void(const LpProblem&)> keep = [&](const LpProblem& part) { seen.push_back(part); };
   const detail::JoinedSolve a =
-      detail::solve_in_parts(lp, params, *pdhg, &clp, 10, params, true, 0.0, &cache, nullptr, keep, 0.0);
+      detail::solve_in_parts(lp, params, *pdhg, &clp, 10, params, true, {}, &cache, nullptr, keep, 0.0);
   REQUIRE(a.r.status == LpStatus::Optimal);
   CHECK(a.r.objective == doctest::Approx(2.0));
   CHECK(clp.calls == 2);
@@ -1323,11 +1332,11 @@ TEST_CASE("rounding: a part the exact solver was slow on is handed out as solved
   }
   CHECK(((seen[0].c == std::vector<double>{1, 2} && seen[1].c == std::vector<double>{3, 1}) ||
          (seen[0].c == std::vector<double>{3, 1} && seen[1].c == std::vector<double>{1, 2})));
-  detail::solve_in_parts(lp, params, *pdhg, &clp, 10, params, true, 0.0, &cache, nullptr, keep, 0.0);
+  detail::solve_in_parts(lp, params, *pdhg, &clp, 10, params, true, {}, &cache, nullptr, keep, 0.0);
   CHECK(clp.calls == 2);  // both from the cache
   CHECK(seen.size() == 2);
   detail::ExactCache fresh;
-  detail::solve_in_parts(lp, params, *pdhg, &clp, 10, params, true, 0.0, &fresh, nullptr, keep, 3600.0);
+  detail::solve_in_parts(lp, params, *pdhg, &clp, 10, params, true, {}, &fresh, nullptr, keep, 3600.0);
   CHECK(clp.calls == 4);
   CHECK(seen.size() == 2);
 }
@@ -1578,7 +1587,7 @@ TEST_CASE("rounding: a later round's parts solved first at zero cost: a proof th
   params.tolerance = 1e-6;
   params.threads = 1;
   auto joined = [&](ZeroCostNoting& solver, int64_t feasibility_iterations) {
-    return detail::solve_in_parts(lp, params, solver, nullptr, 0, params, true, 0.0, nullptr, nullptr, {}, 10.0,
+    return detail::solve_in_parts(lp, params, solver, nullptr, 0, params, true, {}, nullptr, nullptr, {}, 10.0,
                                   {feasibility_iterations});
   };
   ZeroCostNoting plain, tested;
@@ -1599,7 +1608,7 @@ TEST_CASE("rounding: a later round's parts solved first at zero cost: a proof th
   const LpProblem ok = clash_beside_costs(100.0, true);
   ZeroCostNoting plain_ok, tested_ok;
   const detail::JoinedSolve c = detail::solve_in_parts(ok, params, plain_ok, nullptr, 0, params, true),
-                            d = detail::solve_in_parts(ok, params, tested_ok, nullptr, 0, params, true, 0.0, nullptr,
+                            d = detail::solve_in_parts(ok, params, tested_ok, nullptr, 0, params, true, {}, nullptr,
                                                        nullptr, {}, 10.0, {1000});
   REQUIRE(c.r.status == LpStatus::Optimal);
   REQUIRE(d.r.status == LpStatus::Optimal);
@@ -1618,7 +1627,7 @@ TEST_CASE("rounding: the later pre-test's own tolerance: a part within the LP's 
   params.tolerance = 1e-2;
   params.threads = 1;
   auto joined = [&](ZeroCostNoting& solver, double feasibility_tolerance) {
-    return detail::solve_in_parts(lp, params, solver, nullptr, 0, params, true, 0.0, nullptr, nullptr, {}, 10.0,
+    return detail::solve_in_parts(lp, params, solver, nullptr, 0, params, true, {}, nullptr, nullptr, {}, 10.0,
                                   {2000, feasibility_tolerance});
   };
   ZeroCostNoting loose, tight;
@@ -1637,7 +1646,7 @@ TEST_CASE("rounding: the later pre-test's own tolerance: a part within the LP's 
   // that tolerance too (clash_beside_costs: costed, at zero cost, costed).
   const LpProblem clash = clash_beside_costs(100.0);
   ZeroCostNoting reproved;
-  const detail::JoinedSolve c = detail::solve_in_parts(clash, params, reproved, nullptr, 0, params, true, 0.0, nullptr,
+  const detail::JoinedSolve c = detail::solve_in_parts(clash, params, reproved, nullptr, 0, params, true, {}, nullptr,
                                                        nullptr, {}, 10.0, {0, 1e-7});
   CHECK(c.r.status == LpStatus::Infeasible);
   REQUIRE(reproved.zero == std::vector<bool>{false, true, false});
@@ -1650,7 +1659,7 @@ TEST_CASE("rounding: a part unchanged since the later pre-test passed it is not 
   params.threads = 1;
   detail::PretestCache cache;
   auto joined = [&](const LpProblem& lp, ZeroCostNoting& solver) {
-    return detail::solve_in_parts(lp, params, solver, nullptr, 0, params, true, 0.0, nullptr, nullptr, {}, 10.0,
+    return detail::solve_in_parts(lp, params, solver, nullptr, 0, params, true, {}, nullptr, nullptr, {}, 10.0,
                                   {1000, 0.0, &cache});
   };
   // Two feasible parts: both tested, then both solved with their costs.
@@ -1687,7 +1696,7 @@ TEST_CASE("rounding: a part unchanged since the later pre-test passed it is not 
   ZeroCostNoting whole;
   detail::PretestCache fresh;
   const detail::JoinedSolve w =
-      detail::solve_in_parts(ok, warm, whole, nullptr, 0, warm, false, 0.0, nullptr, nullptr, {}, 10.0, {1000, 0.0, &fresh});
+      detail::solve_in_parts(ok, warm, whole, nullptr, 0, warm, false, {}, nullptr, nullptr, {}, 10.0, {1000, 0.0, &fresh});
   CHECK(w.r.status == LpStatus::Optimal);
   CHECK(whole.zero == std::vector<bool>{true, false});
   CHECK(whole.warm == std::vector<bool>{false, true});
@@ -1751,14 +1760,14 @@ TEST_CASE("rounding: a later round's parts start from the primal weight their co
   for (int64_t j = n; j < 2 * n; ++j) w[j] = 5.0;
   const int64_t ones = (n + 1) / 3, twos = n / 3;  // j % 3 == 1 and j % 3 == 2 below n
   pdhg.asked.clear();
-  detail::solve_in_parts(lp, params, pdhg, nullptr, 0, params, true, 0.0, nullptr, &w);
+  detail::solve_in_parts(lp, params, pdhg, nullptr, 0, params, true, {}, nullptr, &w);
   REQUIRE(pdhg.asked.size() == 2);
   CHECK(pdhg.asked[0] == doctest::Approx(std::exp((ones * std::log(2.0) + twos * std::log(8.0)) / double(ones + twos))));
   CHECK(pdhg.asked[1] == doctest::Approx(5.0));
   // The whole LP as one part (not split): the mean over all its columns.
   pdhg.asked.clear();
   std::vector<double> w1(n, 3.0);
-  detail::solve_in_parts(m.lp, params, pdhg, nullptr, 0, params, false, 0.0, nullptr, &w1);
+  detail::solve_in_parts(m.lp, params, pdhg, nullptr, 0, params, false, {}, nullptr, &w1);
   REQUIRE(pdhg.asked.size() == 1);
   CHECK(pdhg.asked[0] == doctest::Approx(3.0));
 }
@@ -1816,4 +1825,77 @@ TEST_CASE("rounding: where no candidate of a big round stands away, only the lar
     CHECK(satisfies_exactly(lp, r->gamma));
     CHECK(r->gamma.size() == 3);
   }
+}
+
+namespace {
+// Clp as if it took `seconds_per_column` per column of a part: past its time limit it stops
+// there, as Clp does (status TimeLimit, its point so far); the column counts of its parts noted.
+class ClockedClp final : public LpSolver {
+public:
+  explicit ClockedClp(double seconds_per_column) : per_column(seconds_per_column) {}
+  std::string name() const override { return "clocked-clp"; }
+  LpResult solve(const LpProblem& lp, const SolverParams& params) override {
+    cols.push_back(lp.cols());
+    const double takes = per_column * double(lp.cols());
+    if (takes <= params.time_limit) return clp->solve(lp, params);
+    LpResult r;
+    r.solver = name();
+    r.status = LpStatus::TimeLimit;
+    r.seconds = params.time_limit;
+    r.x.assign(lp.cols(), 0.0);
+    r.y.assign(lp.rows(), 0.0);
+    return r;
+  }
+  double per_column;
+  std::vector<int64_t> cols;
+  std::unique_ptr<LpSolver> clp = make_solver("clp-dual");
+};
+}  // namespace
+
+TEST_CASE("rounding: a part that reaches the exact solver's time cap goes to the first-order one, and so do "
+          "parts of its size from then on") {
+  // Two parts: rows 0-2 on columns 0-3, row 3 on columns 4-5. At 10 s a column the first takes
+  // Clp 40 s, the second 20 s; the cap is 30 s.
+  const LpProblem lp = clash_beside_costs(1.0, true);
+  const LpResult whole = solve_lp(lp, "clp-dual");
+  REQUIRE(whole.status == LpStatus::Optimal);
+  SolverParams params;
+  params.tolerance = 1e-7;
+  params.threads = 1;
+  const auto pdhg = make_solver("pdhg-cpu");
+  ClockedClp clp(10.0);
+  detail::ExactCache cache;
+  const detail::ExactCap cap{0.0, 30.0};
+  const detail::JoinedSolve a = detail::solve_in_parts(lp, params, *pdhg, &clp, 10, params, true, cap, &cache);
+  REQUIRE(a.parts == 2);
+  CHECK(a.r.status == LpStatus::Optimal);
+  CHECK(a.r.objective == doctest::Approx(whole.objective).epsilon(1e-5));
+  CHECK(a.exact_parts == 1);  // the small part; the large one went to PDHG after Clp's 30 s
+  CHECK(std::multiset<int64_t>(clp.cols.begin(), clp.cols.end()) == std::multiset<int64_t>{2, 4});
+  CHECK(cache.capped_below == 4);
+  // Both parts changed (no kept results): the large one goes to PDHG without Clp, the small one
+  // to Clp as before.
+  LpProblem other = lp;
+  other.c[0] += 0.125;
+  other.c[5] += 0.125;
+  clp.cols.clear();
+  const detail::JoinedSolve b = detail::solve_in_parts(other, params, *pdhg, &clp, 10, params, true, cap, &cache);
+  CHECK(b.r.status == LpStatus::Optimal);
+  CHECK(clp.cols == std::vector<int64_t>{2});
+  CHECK(b.exact_parts == 1);
+  // The LP's own time limit under the cap is not the part's: its end is the LP's (TimeLimit, no
+  // PDHG, nothing learned about the part).
+  detail::ExactCache fresh;
+  SolverParams short_lp = params;
+  short_lp.time_limit = 25.0;
+  clp.cols.clear();
+  const detail::JoinedSolve c = detail::solve_in_parts(lp, params, *pdhg, &clp, 10, short_lp, true, cap, &fresh);
+  CHECK(c.r.status == LpStatus::TimeLimit);
+  CHECK(c.exact_parts == 2);
+  CHECK(fresh.capped_below == std::numeric_limits<int64_t>::max());
+  // No cap: Clp's 40 s on the large part.
+  clp.cols.clear();
+  const detail::JoinedSolve d = detail::solve_in_parts(lp, params, *pdhg, &clp, 10, params, true, {}, &fresh);
+  CHECK(d.exact_parts == 2);
+  CHECK(d.r.objective == doctest::Approx(whole.objective).epsilon(1e-9));
 }

@@ -369,7 +369,7 @@ uint64_t detail::constraint_fingerprint(const LpProblem& lp) {
 
 JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpSolver& solver, LpSolver* exact,
                                    int64_t exact_below, const SolverParams& exact_params, bool split,
-                                   double exact_pivots_per_column, ExactCache* cache,
+                                   const ExactCap& cap, ExactCache* cache,
                                    const std::vector<double>* warm_weight,
                                    const std::function<void(const LpProblem&)>& slow_part, double slow_part_seconds,
                                    const ZeroCostPretest& pretest) {
@@ -392,6 +392,8 @@ JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpS
   bool infeasible = false;
   int64_t exactly = 0, largest = 0, reused = 0, first_order_largest = 0;
   std::vector<ExactCache::Entry> kept;  // this call's new exact results, for the next calls (cache)
+  // The parts below this go to the exact solver: exact_below, or less where parts reached its cap.
+  int64_t below = cache ? std::min(exact_below, cache->capped_below) : exact_below;
   // A part's parameters: `params` with its own slice of the whole LP's warm start, which is
   // moved out first so that copying `params` per part does not copy it.
   std::vector<double> warm_x, warm_y;
@@ -418,7 +420,7 @@ JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpS
     std::vector<PretestCache::Entry> fresh;  // this call's new verdicts short of a proof, for the next calls
     for (size_t k = 0; k < parts.size(); ++k) {
       const LpProblem& plp = whole ? lp : parts[k].lp;
-      if (exact && plp.cols() < exact_below) continue;
+      if (exact && plp.cols() < below) continue;
       SolverParams zp = pretest_params(params, pretest.iterations, pretest.tolerance);
       if (weighted) zp.initial_primal_weight = part_weight(*warm_weight, parts[k].cols);
       PretestCache::Key key;
@@ -468,7 +470,7 @@ JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpS
     Part& part = parts[k];
     const LpProblem& plp = whole ? lp : part.lp;
     largest = std::max<int64_t>(largest, plp.cols());
-    const bool use_exact = exact && plp.cols() < exact_below;
+    const bool use_exact = exact && plp.cols() < below;
     // The first-order solver's parameters: `params` with the part's slice of the warm start (made
     // only where that solver runs).
     SolverParams own;
@@ -495,19 +497,22 @@ JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpS
       return costed;
     };
     exactly += use_exact;
-    // The exact solver's parameters: with a pivot cap where asked (its iterations are pivots).
+    // The exact solver's parameters: with a pivot cap where asked (its iterations are pivots), and
+    // a time cap where asked and shorter than the LP's own limit (whose end is not the part's).
     SolverParams capped_exact;
-    const bool pivot_cap = use_exact && exact_pivots_per_column > 0.0;
+    const bool pivot_cap = use_exact && cap.pivots_per_column > 0.0;
+    const bool time_cap = use_exact && cap.seconds > 0.0 && cap.seconds < exact_params.time_limit;
+    if (pivot_cap || time_cap) capped_exact = exact_params;
     if (pivot_cap) {
-      capped_exact = exact_params;
-      const double cap = exact_pivots_per_column * double(std::max<int64_t>(plp.cols(), 1000));
-      capped_exact.max_iterations = std::min<int64_t>(exact_params.max_iterations, std::max<int64_t>(int64_t(cap), 1));
+      const double pivots = cap.pivots_per_column * double(std::max<int64_t>(plp.cols(), 1000));
+      capped_exact.max_iterations = std::min<int64_t>(exact_params.max_iterations, std::max<int64_t>(int64_t(pivots), 1));
     }
-    const SolverParams& exact_own = pivot_cap ? capped_exact : exact_params;
+    if (time_cap) capped_exact.time_limit = cap.seconds;
+    const SolverParams& exact_own = pivot_cap || time_cap ? capped_exact : exact_params;
     ExactCache::Entry* same = nullptr;
     if (use_exact && cache)
       for (ExactCache::Entry& e : cache->entries)
-        if (e.max_iterations == exact_own.max_iterations && same_lp(e.lp, plp)) {
+        if (e.max_iterations == exact_own.max_iterations && e.time_limit == exact_own.time_limit && same_lp(e.lp, plp)) {
           same = &e;
           break;
         }
@@ -530,14 +535,22 @@ JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpS
     // part of FAUST_r 043-063's finest rounding (round 19 of a 24-minute run), which ended it.
     // (The exact solver only where a part is not far above its size: Clp on millions of columns
     // takes hours.)
+    const bool at_cap = (pivot_cap && s.status == LpStatus::IterationLimit) ||
+                        (time_cap && s.status == LpStatus::TimeLimit);
     const bool failed = s.status == LpStatus::NumericalTrouble ||
-                        (s.status != LpStatus::Infeasible && s.x.size() != size_t(plp.cols())) ||
-                        (pivot_cap && s.status == LpStatus::IterationLimit);
+                        (s.status != LpStatus::Infeasible && s.x.size() != size_t(plp.cols())) || at_cap;
+    if (at_cap && cache && plp.cols() < below) {
+      below = plp.cols();
+      cache->capped_below = below;
+      spdlog::info("rounding: {} stopped at its cap on a part of {} variables: parts of that size or larger go to {} "
+                   "from now on",
+                   exact->name(), plp.cols(), solver.name());
+    }
     // The exact solver's failures are kept too: the same part would fail the same way (measured,
     // deformation-transfer cat 0002-0009 at full resolution with --exact-pivots-per-column 2:
     // rounds 13 and 15 of level 6 each spent 10 minutes of Clp at its cap on the same 29 011-
     // column part before PDHG took it).
-    if (use_exact && cache && !same) kept.push_back({plp, exact_own.max_iterations, s, -1});
+    if (use_exact && cache && !same) kept.push_back({plp, exact_own.max_iterations, exact_own.time_limit, s, -1});
     if (failed && (use_exact || (exact && plp.cols() <= 10 * std::max<int64_t>(exact_below, 1)))) {
       spdlog::warn("rounding: {} {} on a part of {} variables ({}); trying {}",
                    use_exact ? exact->name() : solver.name(), same ? "failed before" : "failed", plp.cols(),
@@ -1544,7 +1557,7 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
       }
       joined = detail::solve_in_parts(red.lp, std::move(params), *solver, exact ? exact_solver.get() : nullptr,
                               options.exact_below, exact_params, options.split_parts,
-                              options.exact_pivots_per_column, &exact_cache, &warm_weight, options.slow_part,
+                              {options.exact_pivots_per_column, options.exact_part_seconds}, &exact_cache, &warm_weight, options.slow_part,
                               options.slow_part_seconds,
                               {options.later_feasibility_iterations, options.feasibility_tolerance, &pretest_cache});
     }

@@ -16,9 +16,10 @@ namespace shapematch::detail {
 // is) that behave like it at their cap (`suspect`: certified bound far above the objective),
 // zero elsewhere, so that the blame stays with them. A part that one solver gives up on
 // (numerical trouble) goes to the other (`exact` up to 10 × exact_below columns); where both
-// fail, so does the join. With `exact_pivots_per_column` > 0 the exact solver stops after that
-// many pivots per column of the part (at least 1 000 columns' worth), and the part goes to
-// `solver` as where it gives up. With `warm_weight` (one value per column, 0: none) a part solved
+// fail, so does the join. With `cap.pivots_per_column` > 0 the exact solver stops after that
+// many pivots per column of the part (at least 1 000 columns' worth), with `cap.seconds` > 0 after
+// that many seconds, and the part goes to `solver` as where it gives up; with a `cache`, the parts
+// of its size or larger go to `solver` from then on (ExactCache::capped_below). With `warm_weight` (one value per column, 0: none) a part solved
 // by `solver` starts from the geometric mean of its columns' positive values as its primal weight.
 // With `pretest.iterations` > 0 every such part is first solved at zero cost for at most that
 // many iterations (RoundingOptions::later_feasibility_iterations), to `pretest.tolerance` where
@@ -61,11 +62,25 @@ struct ExactCache {
   struct Entry {
     LpProblem lp;
     int64_t max_iterations = 0;
+    double time_limit = 0.0;
     LpResult r;
     int unused = 0;  // calls since its part was last seen
   };
   std::vector<Entry> entries;
   int64_t reused = 0;  // over all calls
+  // The fewest columns of a part that reached the exact solver's cap (ExactCap): the parts of
+  // this size or larger go to the first-order solver from then on, as if exact_below were this.
+  // Measured (seventieth session, FAUST_r 043-063's level 6 at full resolution): Clp stopped at
+  // its cap on parts of 24-26 k columns after 150-165 s, round after round, and took 400 s to
+  // prove one infeasible, where PDHG proved such parts in 0.1-8 s; with them under exact_below
+  // 10 000 the level finished in 39 s after 30 minutes of trims.
+  int64_t capped_below = std::numeric_limits<int64_t>::max();
+};
+
+// Where the exact solver stops on a part and gives it to the first-order solver (0: no cap).
+struct ExactCap {
+  double pivots_per_column = 0.0;  // RoundingOptions::exact_pivots_per_column
+  double seconds = 0.0;            // RoundingOptions::exact_part_seconds
 };
 
 // The zero-cost pre-test's verdicts on the parts of the last calls: a part whose constraints have
@@ -104,7 +119,7 @@ uint64_t constraint_fingerprint(const LpProblem& lp);
 
 JoinedSolve solve_in_parts(const LpProblem& lp, SolverParams params, LpSolver& solver, LpSolver* exact,
                            int64_t exact_below, const SolverParams& exact_params, bool split,
-                           double exact_pivots_per_column = 0.0, ExactCache* cache = nullptr,
+                           const ExactCap& cap = {}, ExactCache* cache = nullptr,
                            const std::vector<double>* warm_weight = nullptr,
                            const std::function<void(const LpProblem&)>& slow_part = {},
                            double slow_part_seconds = 10.0, const ZeroCostPretest& pretest = {});
