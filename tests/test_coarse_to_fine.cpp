@@ -1514,6 +1514,18 @@ TEST_CASE("coarse to fine: a run gone on from an attempt of a level in progress 
   CHECK(loaded.attempt.local == a.local);
   CHECK(loaded.attempt.propagated == a.propagated);
   CHECK(loaded.attempt.report.widened_faces == a.report.widened_faces);
+  CHECK(loaded.attempt.zero_cost_margin_given == a.zero_cost_margin_given);
+  {  // (The margin's flag through a checkpoint, version 9, not through a version-8 one.)
+    LevelCheckpoint given = last;
+    given.attempt.zero_cost_margin_given = true;
+    const std::string other = (tmp.path / "given.ckpt").string();
+    save_checkpoint(other, given);
+    CHECK(load_checkpoint(other).attempt.zero_cost_margin_given);
+    CHECK(load_checkpoint(other).attempt.extra == a.extra);
+    detail::save_checkpoint_as(other, given, 8);
+    CHECK_FALSE(load_checkpoint(other).attempt.zero_cost_margin_given);
+    CHECK(load_checkpoint(other).attempt.extra == a.extra);
+  }
   int more = 0;
   const CoarseToFineResult r = matcher.run({}, &loaded, [&](const LevelCheckpoint& c) { more += !c.attempt.empty(); });
   CHECK(more == 0);  // the whole run's last attempt was the one that finished

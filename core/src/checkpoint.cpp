@@ -17,8 +17,9 @@ constexpr char kMagic[] = "shapematch level checkpoint\n";
 // rounding (LevelAttempt::Rounding) follows the attempt. 4: LevelReport::stuck_restarts. 5: the
 // lookahead's chains (LevelCheckpoint::chains) follow. 6: each chain's attempt follows it. 7:
 // LevelReport::lookahead_other_bound and lookahead_other_stuck. 8: branch_roundings,
-// branch_energy and branch_kept. 1 to 7 are read too.
-constexpr uint32_t kVersion = 8;
+// branch_energy and branch_kept. 9: LevelAttempt::zero_cost_margin_given follows `trusted`.
+// 1 to 8 are read too.
+constexpr uint32_t kVersion = 9;
 
 // Every number of a report, in the file's order (the Γ follows on its own). A field added to
 // LevelReport goes here too, with kVersion one higher; the size check below is the reminder.
@@ -120,6 +121,7 @@ void write_attempt(Writer& w, const LevelAttempt& a, uint32_t version) {
   if (a.empty()) return;
   w(a.ring), w(a.local), w(a.propagated), w(a.priced), w(a.regional_done), w(a.around_done);
   w(a.suspicions), w(a.trusted);
+  if (version >= 9) w(a.zero_cost_margin_given);
   each_field(a.report, w, version);
   w.array(a.extra);
   if (version < 3) return;
@@ -136,6 +138,7 @@ void read_attempt(Reader& r, LevelAttempt& a, uint32_t version, const std::strin
   if (!held) return;
   r(a.ring), r(a.local), r(a.propagated), r(a.priced), r(a.regional_done), r(a.around_done);
   r(a.suspicions), r(a.trusted);
+  if (version >= 9) r(a.zero_cost_margin_given);
   each_field(a.report, r, version);
   r.array(a.extra);
   LevelAttempt::Rounding& g = a.rounding;

@@ -1067,6 +1067,8 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
   // Widenings where propagation found the conflict have a budget of their own
   // (max_propagation_widenings): they cost a rebuild, not an LP.
   int propagated = 0;
+  // The margin after a zero-cost proof (zero_cost_proof_rings) was given at this ring.
+  bool zero_cost_margin_given = false;
   if (resume) {
     rep = resume->report;
     ring = resume->ring;
@@ -1076,6 +1078,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
     regional_done = resume->regional_done;
     around_done = resume->around_done;
     suspicions.restore(resume->suspicions, resume->trusted);
+    zero_cost_margin_given = resume->zero_cost_margin_given;
     spdlog::info("level {}: going on from its checkpointed attempt: ring {}, {} faces with extra rings{}", l + 1, ring,
                  std::count_if(extra.begin(), extra.end(), [](int e) { return e > 0; }),
                  resume->rounding.empty() ? std::string()
@@ -1114,8 +1117,6 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
   // columns are new), so it is feasible too, and the zero-cost pre-test would only cost. (Not
   // after the ring grows: the extra rings beyond max_ring are cut back there.)
   bool feasible_seen = false;
-  // The margin after a zero-cost proof (zero_cost_proof_rings) was given at this ring.
-  bool zero_cost_margin_given = false;
   bool propagating = false;
   detail::RecurringConflicts recurring;  // π rows where propagation failed, by face
   // One more fine ring on these faces (up to `cap` rings); false if none could grow. `last`: the
@@ -1226,6 +1227,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
     a.around_done = around_done;
     a.suspicions = suspicions.count();
     a.trusted = suspicions.trusted();
+    a.zero_cost_margin_given = zero_cost_margin_given;
     a.report = rep;
     a.report.gamma.clear();
     return a;

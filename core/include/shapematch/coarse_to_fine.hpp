@@ -435,6 +435,9 @@ struct LevelAttempt {
   bool regional_done = false, around_done = false;
   int suspicions = 0;            // diverging first LPs in a row, and whether the watch is trusted
   bool trusted = true;
+  // The margin after a proof at zero cost (zero_cost_proof_rings) was given at this ring: once per
+  // ring, also across a stop (version 9; before, a run gone on from here could give it again).
+  bool zero_cost_margin_given = false;
   LevelReport report;            // its counts so far (widenings, widened faces, …); no Γ
   // Where the attempt's rounding had got, saved after its rounds (at most every few seconds): a
   // run gone on from it builds the same LP, fixes `ones` before its round 1 and keeps round 1's
