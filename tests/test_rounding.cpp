@@ -616,6 +616,25 @@ TEST_CASE("rounding: an infeasible LP after a fixing undoes only the fixings its
   CHECK(infeasible == 1);
 }
 
+TEST_CASE("rounding: a search right after a fixing whose LP has no solution leaves it to the LP round, not a release") {
+  // cycle_behind_a_fixing with the search at once (no stall needed): round 1 fixes b1, b2 and a,
+  // and with a = 1 the cycle's LP has no solution. The search's root LP finds that; it hands the
+  // round to the LP, whose proof trims a alone, as without the search (a release instead would
+  // free every fixing within two steps of the part, b1 and b2 with a).
+  RoundingOptions options;
+  options.search_stall = 0;
+  const RoundingResult r = round_cycle(options);
+  CHECK(r.energy == 10.0);
+  REQUIRE(r.rounds.size() >= 3);
+  CHECK(r.rounds[0].fixed_to_one == 3);
+  CHECK_FALSE(r.rounds[1].search);
+  CHECK(r.rounds[1].status == LpStatus::Infeasible);
+  CHECK(r.rounds[1].undone);
+  CHECK(r.rounds[1].fixed_to_one == 2);  // b1 and b2 kept
+  for (const RoundingRound& k : r.rounds) CHECK(k.released == 0);
+  CHECK(r.rounds.back().search);  // and the rest finished by search
+}
+
 TEST_CASE("rounding: a fixing from an LP at its iteration cap is undone whole, and the LP solved again longer") {
   // cycle_behind_a_fixing as above, with round 1 stopped at its cap, its iterate already past
   // the threshold on a, b1 and b2. The proof after it blames a alone, but an iterate at its cap

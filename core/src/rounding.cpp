@@ -856,14 +856,15 @@ std::vector<std::pair<int64_t, int>> away_from_undecided(const LpProblem& lp, co
   return {batch.begin(), batch.begin() + static_cast<std::ptrdiff_t>(take)};
 }
 
-// How a depth-first search for a binary solution of one part ended.
-enum class SearchEnd { found, none, node_limit };
+// How a depth-first search for a binary solution of one part ended. `infeasible`: the part's LP
+// itself, at the root, has no solution (its fixings are wrong as an LP round would find them).
+enum class SearchEnd { found, none, node_limit, infeasible };
 
 // A binary solution of A x = b (one part of a late round's LP), by depth-first search: at each
 // node the exact LP over what is still free; an integral optimum ends it, otherwise it branches
 // on the largest fractional variable, 1 before 0, with propagation after every fixing. Complete:
-// `none` is a proof that no binary solution exists (the fixings around the part are wrong).
-// `value` gets one 0/1 per column on `found`.
+// `none` is a proof that no binary solution exists (the fixings around the part are wrong),
+// `infeasible` one that not even the LP has a solution. `value` gets one 0/1 per column on `found`.
 SearchEnd search_part(const LpProblem& plp, LpSolver& exact, const SolverParams& params, int64_t max_nodes,
                       std::vector<int8_t>& value, int64_t& nodes) {
   Fixer f(plp);
@@ -899,6 +900,7 @@ SearchEnd search_part(const LpProblem& plp, LpSolver& exact, const SolverParams&
     const Reduced red = reduce(plp, f.state());
     const LpResult s = exact.solve(red.lp, params);
     if (s.status == LpStatus::Infeasible) {
+      if (stack.empty()) return SearchEnd::infeasible;
       alive = false;
     } else if (s.status != LpStatus::Optimal || s.x.size() != red.cols.size()) {
       return SearchEnd::node_limit;  // no answer: as good as running out of nodes
@@ -1323,7 +1325,11 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
                           fixer.unsatisfied_rows());
   };
   // Finishes every part of `red` by search; parts without a binary solution release the fixings
-  // around them. Fills the round's counts.
+  // around them. Fills the round's counts. False, with nothing fixed or released, where a part's
+  // LP has no solution at all: that is an LP round's question, whose proof trims the last fixing
+  // (a release frees the fixings of whole regions: measured, FAUST_r 043-063's level 6 at full
+  // resolution, a search right after a fixing found a 16 321-variable part's root LP infeasible
+  // and released 634 fixings, 825 k variables; the same part later 2 243, 2.8 M).
   auto search_round = [&](const Reduced& red, RoundingRound& info) {
     if (!search_solver) search_solver = make_solver("clp-dual");
     std::vector<Part> parts = split_into_parts(red.lp);
@@ -1335,7 +1341,14 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
     for (const Part& part : parts) {
       std::vector<int8_t> value;
       const LpProblem& plp = whole ? red.lp : part.lp;
-      if (search_part(plp, *search_solver, base_params, options.search_nodes, value, nodes) == SearchEnd::found) {
+      const SearchEnd end = search_part(plp, *search_solver, base_params, options.search_nodes, value, nodes);
+      if (end == SearchEnd::infeasible) {
+        spdlog::debug("rounding: a part of {} variables has no LP solution at its search's root: solved as a round "
+                      "instead",
+                      plp.cols());
+        return false;
+      }
+      if (end == SearchEnd::found) {
         ++info.searched_parts;
         for (size_t k = 0; k < part.cols.size(); ++k) found.push_back({red.cols[part.cols[k]], value[k]});
       } else {
@@ -1363,6 +1376,7 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
       if (fixer.state().value[j] == 1) cost += lp.c[j];
     info.objective = lp.objective_scale * cost;
     spdlog::debug("rounding: searched {} parts in {} nodes, {} finished", parts.size(), nodes, info.searched_parts);
+    return true;
   };
   int64_t fewest_free = std::numeric_limits<int64_t>::max();
   int stalled = 0;
@@ -1426,25 +1440,27 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
     }
     if (round > 1 && options.search_below > 0 && red.lp.cols() <= options.search_below &&
         stalled >= options.search_stall) {
-      ++forward;
       RoundingRound info;
       info.round = round;
       info.variables = red.lp.cols();
       info.constraints = red.lp.rows();
       info.search = true;
-      search_round(red, info);
-      if (info.undone) {
-        // A release frees far more than the rounds after it fix at once: the stall rule starts
-        // afresh, as after a release on a failed LP (below). Measured, TOSCA_r horse0-horse5 at
-        // full resolution: a search released 2 955 fixings, the stall clock ran on from the low
-        // before it, and 57 rounds later, right after the first round after another release (a
-        // 5.6 M-variable LP, 22 minutes), the rounding was called stuck: 3 498 of 3 758 faces widened.
-        fewest_free = std::numeric_limits<int64_t>::max();
-        stalled = 0;
-        since_low.reset();
+      if (search_round(red, info)) {
+        ++forward;
+        if (info.undone) {
+          // A release frees far more than the rounds after it fix at once: the stall rule starts
+          // afresh, as after a release on a failed LP (below). Measured, TOSCA_r horse0-horse5 at
+          // full resolution: a search released 2 955 fixings, the stall clock ran on from the low
+          // before it, and 57 rounds later, right after the first round after another release (a
+          // 5.6 M-variable LP, 22 minutes), the rounding was called stuck: 3 498 of 3 758 faces
+          // widened.
+          fewest_free = std::numeric_limits<int64_t>::max();
+          stalled = 0;
+          since_low.reset();
+        }
+        record(info, clock);
+        continue;
       }
-      record(info, clock);
-      continue;
     }
     if (options.give_up_after > 0.0 && round > 1 && first_work > 0.0 && later_work > options.give_up_after * first_work)
       throw stuck("rounding: gave up, its rounds after the first took " + fmt::format("{:.2f}", later_work / first_work) +
