@@ -699,7 +699,7 @@ Action add_match_command(CLI::App& app) {
       ->capture_default_str();
   app.add_option("--exact-part-seconds", a->exact_part_seconds,
                  "stop Clp after this many seconds on a later round's part and give it to PDHG, with the parts of "
-                 "its size or larger for the rest of the level (0: no limit)")
+                 "its size or larger for the rest of that rounding (0: no limit)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   app.add_option("--exact-below", a->exact_below,

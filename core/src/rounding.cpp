@@ -497,18 +497,17 @@ JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpS
       return costed;
     };
     exactly += use_exact;
-    // The exact solver's parameters: with a pivot cap where asked (its iterations are pivots), and
-    // a time cap where asked and shorter than the LP's own limit (whose end is not the part's).
-    SolverParams capped_exact;
-    const bool pivot_cap = use_exact && cap.pivots_per_column > 0.0;
-    const bool time_cap = use_exact && cap.seconds > 0.0 && cap.seconds < exact_params.time_limit;
-    if (pivot_cap || time_cap) capped_exact = exact_params;
+    // The exact solver's parameters (first, or after the first-order solver's numerical trouble):
+    // a pivot cap where asked (its iterations are pivots), and a time cap, the shorter of the cap
+    // and the LP's own limit. (A copy: exact_params holds no warm start.)
+    SolverParams exact_own = exact_params;
+    const bool pivot_cap = cap.pivots_per_column > 0.0;
     if (pivot_cap) {
       const double pivots = cap.pivots_per_column * double(std::max<int64_t>(plp.cols(), 1000));
-      capped_exact.max_iterations = std::min<int64_t>(exact_params.max_iterations, std::max<int64_t>(int64_t(pivots), 1));
+      exact_own.max_iterations = std::min<int64_t>(exact_params.max_iterations, std::max<int64_t>(int64_t(pivots), 1));
     }
-    if (time_cap) capped_exact.time_limit = cap.seconds;
-    const SolverParams& exact_own = pivot_cap || time_cap ? capped_exact : exact_params;
+    if (cap.seconds > 0.0) exact_own.time_limit = std::min(exact_params.time_limit, cap.seconds);
+    const bool time_cap = std::isfinite(exact_own.time_limit);
     ExactCache::Entry* same = nullptr;
     if (use_exact && cache)
       for (ExactCache::Entry& e : cache->entries)
@@ -535,8 +534,10 @@ JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpS
     // part of FAUST_r 043-063's finest rounding (round 19 of a 24-minute run), which ended it.
     // (The exact solver only where a part is not far above its size: Clp on millions of columns
     // takes hours.)
-    const bool at_cap = (pivot_cap && s.status == LpStatus::IterationLimit) ||
-                        (time_cap && s.status == LpStatus::TimeLimit);
+    // Stopped at a cap, Clp has no answer (its point is a dual simplex's, not primal feasible):
+    // the part is the first-order solver's.
+    const bool at_cap = use_exact && ((pivot_cap && s.status == LpStatus::IterationLimit) ||
+                                      (time_cap && s.status == LpStatus::TimeLimit));
     const bool failed = s.status == LpStatus::NumericalTrouble ||
                         (s.status != LpStatus::Infeasible && s.x.size() != size_t(plp.cols())) || at_cap;
     if (at_cap && cache && plp.cols() < below) {
@@ -546,17 +547,18 @@ JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpS
                    "from now on",
                    exact->name(), plp.cols(), solver.name());
     }
-    // The exact solver's failures are kept too: the same part would fail the same way (measured,
-    // deformation-transfer cat 0002-0009 at full resolution with --exact-pivots-per-column 2:
-    // rounds 13 and 15 of level 6 each spent 10 minutes of Clp at its cap on the same 29 011-
-    // column part before PDHG took it).
-    if (use_exact && cache && !same) kept.push_back({plp, exact_own.max_iterations, exact_own.time_limit, s, -1});
+    // The exact solver's failures are kept too: the same part would fail the same way. (Not one at
+    // its cap: capped_below sends that part elsewhere from now on. Measured, deformation-transfer
+    // cat 0002-0009 at full resolution with --exact-pivots-per-column 2: rounds 13 and 15 of level
+    // 6 each spent 10 minutes of Clp at its cap on the same 29 011-column part before PDHG took it.)
+    if (use_exact && cache && !same && !at_cap)
+      kept.push_back({plp, exact_own.max_iterations, exact_own.time_limit, s, -1});
     if (failed && (use_exact || (exact && plp.cols() <= 10 * std::max<int64_t>(exact_below, 1)))) {
       spdlog::warn("rounding: {} {} on a part of {} variables ({}); trying {}",
                    use_exact ? exact->name() : solver.name(), same ? "failed before" : "failed", plp.cols(),
                    to_string(s.status), use_exact ? solver.name() : exact->name());
       const int64_t before = s.iterations;
-      s = use_exact ? first_order_solve() : exact->solve(plp, exact_params);
+      s = use_exact ? first_order_solve() : exact->solve(plp, exact_own);
       s.iterations = std::max(s.iterations, before);
       exactly += use_exact ? -1 : 1;
     }
@@ -1338,19 +1340,31 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
     std::vector<std::pair<int64_t, int>> found;
     std::vector<int64_t> stuck;
     int64_t nodes = 0;
-    for (const Part& part : parts) {
-      std::vector<int8_t> value;
-      const LpProblem& plp = whole ? red.lp : part.lp;
-      const SearchEnd end = search_part(plp, *search_solver, base_params, options.search_nodes, value, nodes);
-      if (end == SearchEnd::infeasible) {
+    // Every part's root first (one node each), so that no search is spent on a round that goes
+    // to the LP; a part whose root is integral is finished there.
+    std::vector<SearchEnd> root(parts.size());
+    std::vector<std::vector<int8_t>> value(parts.size());
+    for (size_t k = 0; k < parts.size(); ++k) {
+      const LpProblem& plp = whole ? red.lp : parts[k].lp;
+      int64_t one = 0;
+      root[k] = search_part(plp, *search_solver, base_params, 1, value[k], one);
+      nodes += one;
+      if (root[k] == SearchEnd::infeasible) {
         spdlog::debug("rounding: a part of {} variables has no LP solution at its search's root: solved as a round "
                       "instead",
                       plp.cols());
         return false;
       }
+    }
+    for (size_t k = 0; k < parts.size(); ++k) {
+      const Part& part = parts[k];
+      const LpProblem& plp = whole ? red.lp : part.lp;
+      SearchEnd end = root[k];
+      if (end == SearchEnd::node_limit)
+        end = search_part(plp, *search_solver, base_params, options.search_nodes, value[k], nodes);
       if (end == SearchEnd::found) {
         ++info.searched_parts;
-        for (size_t k = 0; k < part.cols.size(); ++k) found.push_back({red.cols[part.cols[k]], value[k]});
+        for (size_t j = 0; j < part.cols.size(); ++j) found.push_back({red.cols[part.cols[j]], value[k][j]});
       } else {
         for (int64_t i : part.rows) stuck.push_back(red.rows[i]);
       }

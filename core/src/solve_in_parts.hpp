@@ -18,7 +18,7 @@ namespace shapematch::detail {
 // (numerical trouble) goes to the other (`exact` up to 10 × exact_below columns); where both
 // fail, so does the join. With `cap.pivots_per_column` > 0 the exact solver stops after that
 // many pivots per column of the part (at least 1 000 columns' worth), with `cap.seconds` > 0 after
-// that many seconds, and the part goes to `solver` as where it gives up; with a `cache`, the parts
+// that many seconds (or the LP's own time limit where shorter), and the part goes to `solver` as where it gives up; with a `cache`, the parts
 // of its size or larger go to `solver` from then on (ExactCache::capped_below). With `warm_weight` (one value per column, 0: none) a part solved
 // by `solver` starts from the geometric mean of its columns' positive values as its primal weight.
 // With `pretest.iterations` > 0 every such part is first solved at zero cost for at most that

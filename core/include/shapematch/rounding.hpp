@@ -31,7 +31,7 @@ struct RoundingOptions {
   double exact_pivots_per_column = 0.0;
   // Stops the exact solver on a part after this many seconds (Clp's clock: CPU time; 0: no limit);
   // the part goes to the first-order solver, and so do the parts of its size or larger for the
-  // rest of the level's rounding (after the pivot cap's too). Measured (seventieth session, FAUST_r 043-063's level 6
+  // rest of this rounding (after the pivot cap's too; the LP's own time limit caps it as well). Measured (seventieth session, FAUST_r 043-063's level 6
   // at full resolution): 30 minutes of trims at 40-45 k free variables, Clp at 150-165 s on parts
   // of 24-26 k columns and 400 s to prove one infeasible, where PDHG proved such parts in 0.1-8 s;
   // those parts given to PDHG (--exact-below 10000), the level finished in 39 s. A minute is
