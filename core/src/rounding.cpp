@@ -1331,7 +1331,7 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
   // LP has no solution at all: that is an LP round's question, whose proof trims the last fixing
   // (a release frees the fixings of whole regions: measured, FAUST_r 043-063's level 6 at full
   // resolution, a search right after a fixing found a 16 321-variable part's root LP infeasible
-  // and released 634 fixings, 825 k variables; the same part later 2 243, 2.8 M).
+  // and released 634 fixings, 825 k variables, where trimming the last fixing was due).
   auto search_round = [&](const Reduced& red, RoundingRound& info) {
     if (!search_solver) search_solver = make_solver("clp-dual");
     std::vector<Part> parts = split_into_parts(red.lp);
