@@ -18,6 +18,7 @@
 #include <limits>
 #include <map>
 #include <numeric>
+#include <optional>
 #include <set>
 #include <unordered_map>
 #include <unordered_set>
@@ -867,8 +868,10 @@ enum class SearchEnd { found, none, node_limit, infeasible };
 // on the largest fractional variable, 1 before 0, with propagation after every fixing. Complete:
 // `none` is a proof that no binary solution exists (the fixings around the part are wrong),
 // `infeasible` one that not even the LP has a solution. `value` gets one 0/1 per column on `found`.
+// With `root`, the root node's LP result is kept there, or taken from there where it holds one (a
+// search that goes on from a call that stopped after the root solves it once).
 SearchEnd search_part(const LpProblem& plp, LpSolver& exact, const SolverParams& params, int64_t max_nodes,
-                      std::vector<int8_t>& value, int64_t& nodes) {
+                      std::vector<int8_t>& value, int64_t& nodes, std::optional<LpResult>* root = nullptr) {
   Fixer f(plp);
   if (!f.propagate_all()) return SearchEnd::none;
   struct Branch {
@@ -900,7 +903,10 @@ SearchEnd search_part(const LpProblem& plp, LpSolver& exact, const SolverParams&
     if (f.state().unsatisfied == 0) return finish();  // what is still free is 0
     if (++nodes > max_nodes) return SearchEnd::node_limit;
     const Reduced red = reduce(plp, f.state());
-    const LpResult s = exact.solve(red.lp, params);
+    // (The stack is empty at the root only: a retreat that empties it ends the search.)
+    const bool at_root = stack.empty() && root;
+    if (at_root && !root->has_value()) *root = exact.solve(red.lp, params);
+    const LpResult s = at_root ? **root : exact.solve(red.lp, params);
     if (s.status == LpStatus::Infeasible) {
       if (stack.empty()) return SearchEnd::infeasible;
       alive = false;
@@ -1343,11 +1349,12 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
     // Every part's root first (one node each), so that no search is spent on a round that goes
     // to the LP; a part whose root is integral is finished there.
     std::vector<SearchEnd> root(parts.size());
+    std::vector<std::optional<LpResult>> root_lp(parts.size());  // each solved once
     std::vector<std::vector<int8_t>> value(parts.size());
     for (size_t k = 0; k < parts.size(); ++k) {
       const LpProblem& plp = whole ? red.lp : parts[k].lp;
       int64_t one = 0;
-      root[k] = search_part(plp, *search_solver, base_params, 1, value[k], one);
+      root[k] = search_part(plp, *search_solver, base_params, 1, value[k], one, &root_lp[k]);
       nodes += one;
       if (root[k] == SearchEnd::infeasible) {
         spdlog::debug("rounding: a part of {} variables has no LP solution at its search's root: solved as a round "
@@ -1361,7 +1368,7 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
       const LpProblem& plp = whole ? red.lp : part.lp;
       SearchEnd end = root[k];
       if (end == SearchEnd::node_limit)
-        end = search_part(plp, *search_solver, base_params, options.search_nodes, value[k], nodes);
+        end = search_part(plp, *search_solver, base_params, options.search_nodes, value[k], nodes, &root_lp[k]);
       if (end == SearchEnd::found) {
         ++info.searched_parts;
         for (size_t j = 0; j < part.cols.size(); ++j) found.push_back({red.cols[part.cols[j]], value[k][j]});
