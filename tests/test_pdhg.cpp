@@ -119,6 +119,53 @@ TEST_CASE("pdhg-cpu: tiny LPs with known optima") {
   }
 }
 
+TEST_CASE("pdhg-cpu: a bound on every row's residual keeps a local fault from passing as optimal") {
+  // 4 000 rows x_2i + x_2i+1 = 1 at costs 1 and 2, started at their optimum (x_2i = 1, y = 1), and
+  // a chain x_c0 = 1, x_ck − x_ck+1 = 0 of 100 columns at no cost, started at 0: ‖Ax−b‖₂ / (1 +
+  // ‖b‖₂) is 1/64 there, so at --tol 0.02 the relative criterion holds while the chain is still
+  // on its way (a fixing in a rounding round's part of hundreds of thousands of rows is such a
+  // chain).
+  constexpr int kRows = 4000, kChain = 100;
+  std::vector<std::vector<std::pair<int, int>>> rows;
+  std::vector<double> b(kRows, 1.0), c;
+  for (int i = 0; i < kRows; ++i) {
+    rows.push_back({{2 * i, 1}, {2 * i + 1, 1}});
+    c.insert(c.end(), {1.0, 2.0});
+  }
+  const int c0 = 2 * kRows;
+  rows.push_back({{c0, 1}});
+  b.push_back(1.0);
+  for (int k = 0; k + 1 < kChain; ++k) {
+    rows.push_back({{c0 + k, 1}, {c0 + k + 1, -1}});
+    b.push_back(0.0);
+  }
+  c.resize(c0 + kChain, 0.0);
+  const LpProblem lp = from_rows(c0 + kChain, rows, b, c);
+  SolverParams params;
+  params.tolerance = 0.02;
+  params.threads = 1;
+  params.initial_x.assign(c0 + kChain, 0.0);
+  for (int i = 0; i < kRows; ++i) params.initial_x[2 * i] = 1.0;
+  params.initial_y.assign(lp.rows(), 0.0);
+  std::fill(params.initial_y.begin(), params.initial_y.begin() + kRows, 1.0);
+  for (const char* solver : kNative) {
+    CAPTURE(solver);
+    params.max_row_residual = 0.0;
+    const LpResult loose = solve_lp(lp, solver, params);
+    REQUIRE(loose.status == LpStatus::Optimal);
+    CHECK(loose.primal_residual <= 0.02);
+    CHECK(loose.row_residual > 1e-2);  // what the relative criterion lets through
+    params.max_row_residual = 1e-3;
+    const LpResult bounded = solve_lp(lp, solver, params);
+    REQUIRE(bounded.status == LpStatus::Optimal);
+    CHECK(bounded.row_residual <= 1e-3);
+    CHECK(bounded.iterations > loose.iterations);
+    CHECK(bounded.objective == doctest::Approx(kRows).epsilon(1e-3));
+    MESSAGE(solver << ": " << loose.iterations << " iterations, row residual " << loose.row_residual << "; bounded "
+                   << bounded.iterations << ", " << bounded.row_residual);
+  }
+}
+
 TEST_CASE("pdhg-cpu: infeasibility is a status, found quickly") {
   // x0 + x1 = 3 is outside the box: found by presolve.
   for (const char* solver : kNative) {

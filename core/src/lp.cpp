@@ -4,6 +4,7 @@
 #include "shapematch/errors.hpp"
 #include "shapematch/files.hpp"
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
@@ -101,13 +102,15 @@ void evaluate_solution(const LpProblem& p, LpResult& r) {
   if (r.x.size() == size_t(p.cols())) {
     std::vector<double> ax(p.rows());
     spmv(p.a, r.x.data(), ax.data());
-    double res = 0.0, nb = 0.0, cx = 0.0;
+    double res = 0.0, nb = 0.0, cx = 0.0, worst = 0.0;
     for (int64_t i = 0; i < p.rows(); ++i) {
       res += (ax[i] - p.b[i]) * (ax[i] - p.b[i]);
       nb += p.b[i] * p.b[i];
+      worst = std::max(worst, std::abs(ax[i] - p.b[i]));
     }
     for (int64_t j = 0; j < p.cols(); ++j) cx += p.c[j] * r.x[j];
     r.primal_residual = std::sqrt(res) / (1.0 + std::sqrt(nb));
+    r.row_residual = worst;
     r.objective = p.objective_scale * cx;
   }
   if (r.y.size() == size_t(p.rows())) {
