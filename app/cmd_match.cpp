@@ -50,7 +50,6 @@ struct MatchArgs {
   bool converged_first = RoundingOptions{}.converged_first;
   double exact_pivots_per_column = RoundingOptions{}.exact_pivots_per_column;
   double exact_part_seconds = RoundingOptions{}.exact_part_seconds;
-  double later_row_residual = RoundingOptions{}.later_row_residual;
   int64_t exact_below = RoundingOptions{}.exact_below;
   int64_t feasibility_first = RoundingOptions{}.feasibility_iterations;
   int64_t feasibility_later = RoundingOptions{}.later_feasibility_iterations;
@@ -264,7 +263,6 @@ int run_match(const MatchArgs& args) {
   ro.converged_first = args.converged_first;
   ro.exact_pivots_per_column = args.exact_pivots_per_column;
   ro.exact_part_seconds = args.exact_part_seconds;
-  ro.later_row_residual = args.later_row_residual;
   ro.exact_below = args.exact_below;
   ro.feasibility_iterations = args.feasibility_first;
   ro.later_feasibility_iterations = args.feasibility_later;
@@ -513,7 +511,6 @@ int run_match(const MatchArgs& args) {
                               .set("converged_first", args.converged_first)
                               .set("exact_pivots_per_column", args.exact_pivots_per_column)
                               .set("exact_part_seconds", args.exact_part_seconds)
-                              .set("later_row_residual", args.later_row_residual)
                               .set("exact_below", args.exact_below)
                               .set("feasibility_first", args.feasibility_first)
                               .set("feasibility_later", args.feasibility_later)
@@ -703,11 +700,6 @@ Action add_match_command(CLI::App& app) {
   app.add_option("--exact-part-seconds", a->exact_part_seconds,
                  "stop Clp after this many seconds on a later round's part and give it to PDHG, with the parts of "
                  "its size or larger for the rest of that rounding (0: no limit)")
-      ->check(CLI::NonNegativeNumber)
-      ->capture_default_str();
-  app.add_option("--later-row-residual", a->later_row_residual,
-                 "in the rounds after a fixing, a PDHG solve counts as optimal only with every row's residual "
-                 "|(Ax-b)_i| at most this as well (0: the relative --tol alone)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   app.add_option("--exact-below", a->exact_below,

@@ -119,12 +119,11 @@ TEST_CASE("pdhg-cpu: tiny LPs with known optima") {
   }
 }
 
-TEST_CASE("pdhg-cpu: a bound on every row's residual keeps a local fault from passing as optimal") {
+TEST_CASE("pdhg-cpu: the residual in a row shows a local fault the relative residual lets pass") {
   // 4 000 rows x_2i + x_2i+1 = 1 at costs 1 and 2, started at their optimum (x_2i = 1, y = 1), and
   // a chain x_c0 = 1, x_ck − x_ck+1 = 0 of 100 columns at no cost, started at 0: ‖Ax−b‖₂ / (1 +
   // ‖b‖₂) is 1/64 there, so at --tol 0.02 the relative criterion holds while the chain is still
-  // on its way (a fixing in a rounding round's part of hundreds of thousands of rows is such a
-  // chain).
+  // on its way (a fixing in a rounding round's part of 10⁵ rows is such a chain).
   constexpr int kRows = 4000, kChain = 100;
   std::vector<std::vector<std::pair<int, int>>> rows;
   std::vector<double> b(kRows, 1.0), c;
@@ -150,19 +149,19 @@ TEST_CASE("pdhg-cpu: a bound on every row's residual keeps a local fault from pa
   std::fill(params.initial_y.begin(), params.initial_y.begin() + kRows, 1.0);
   for (const char* solver : kNative) {
     CAPTURE(solver);
-    params.max_row_residual = 0.0;
     const LpResult loose = solve_lp(lp, solver, params);
     REQUIRE(loose.status == LpStatus::Optimal);
     CHECK(loose.primal_residual <= 0.02);
-    CHECK(loose.row_residual > 1e-2);  // what the relative criterion lets through
-    params.max_row_residual = 1e-3;
-    const LpResult bounded = solve_lp(lp, solver, params);
-    REQUIRE(bounded.status == LpStatus::Optimal);
-    CHECK(bounded.row_residual <= 1e-3);
-    CHECK(bounded.iterations > loose.iterations);
-    CHECK(bounded.objective == doctest::Approx(kRows).epsilon(1e-3));
-    MESSAGE(solver << ": " << loose.iterations << " iterations, row residual " << loose.row_residual << "; bounded "
-                   << bounded.iterations << ", " << bounded.row_residual);
+    // The worst row, recomputed here from x.
+    double worst = 0.0;
+    for (size_t i = 0; i < rows.size(); ++i) {
+      double ax = 0.0;
+      for (const auto& [j, sgn] : rows[i]) ax += sgn * loose.x[j];
+      worst = std::max(worst, std::abs(ax - b[i]));
+    }
+    CHECK(loose.row_residual == doctest::Approx(worst).epsilon(1e-12));
+    CHECK(loose.row_residual > 1e-2);
+    CHECK(loose.row_residual > 5.0 * loose.primal_residual);
   }
 }
 

@@ -338,7 +338,6 @@ SolverParams pretest_params(const SolverParams& params, int64_t cap, double tole
   if (tolerance > 0.0) zp.tolerance = tolerance;
   zp.stop_on_divergence = false;
   zp.patient_divergence_watch = false;
-  zp.max_row_residual = 0.0;  // (a pre-test asks for a proof, not a point)
   return zp;
 }
 
@@ -1509,10 +1508,7 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
     // parts, capped, its failures undone), only its bound is no one's.
     const bool after_fixing = round > 1 || carried;
     // After a fixing, an infeasible LP undoes it: that needs a proof, not a suspicion.
-    if (after_fixing) {
-      params.stop_on_divergence = false;
-      params.max_row_residual = options.later_row_residual;
-    }
+    if (after_fixing) params.stop_on_divergence = false;
     // (Not the first round: its relaxation and bound are the chosen solver's.)
     const bool exact = after_fixing && options.exact_below > 0 && options.solver != "clp-dual";
     if (exact && !exact_solver) exact_solver = make_solver("clp-dual");

@@ -37,11 +37,6 @@ struct RoundingOptions {
   // those parts given to PDHG (--exact-below 10000), the level finished in 39 s. A minute is
   // several times what Clp took on an optimal part of that run.
   double exact_part_seconds = 60.0;
-  // In the rounds after a fixing, the first-order solver's "optimal" also needs every row's
-  // residual |(Ax−b)_i| at most this (SolverParams::max_row_residual; 0: the relative criteria
-  // alone). A fixing changes a few rows of a part with hundreds of thousands: the relative
-  // criterion took the last iterate with those rows still far off as optimal.
-  double later_row_residual = 0.0;
   // Where no variable exceeds the threshold (a fractional LP), DESIGN.md fixes the single
   // largest. On fractional levels that cost one full LP solve per face (TOSCA cat, 200 faces:
   // 9 rounds of 20–150 s fixed 36 variables to 1). Instead fix the largest variables of up to
