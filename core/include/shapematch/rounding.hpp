@@ -91,8 +91,9 @@ struct RoundingOptions {
   // after round; with it, none of rounds 2-5 (docs/results-log.md, seventh session).
   double greedy_unsure = 0.1;
   int greedy_margin = 1;
-  // Where no candidate qualifies even then, the largest this share of the batch (at least one)
-  // instead of the whole batch (1: the whole batch, the default up to the fifty-first session).
+  // Where no candidate qualifies even then, the largest of each undecided region, at most this
+  // share of the batch (at least one); up to the seventy-first session the largest share alone,
+  // up to the fifty-first the whole batch (see away_from_undecided for the regions' measurement).
   // Counted in the -v logs of eighteen full-resolution runs or segments (tools/greedy_rounds.py;
   // docs/results-log.md, fifty-first session): after a whole-batch fallback the next LP was
   // infeasible 16 times in 30 (from an optimal LP) and 5 in 5 (from one at its cap), against
