@@ -1913,3 +1913,33 @@ TEST_CASE("rounding: a part that reaches the exact solver's time cap goes to the
   CHECK(d.exact_parts == 2);
   CHECK(d.r.objective == doctest::Approx(whole.objective).epsilon(1e-9));
 }
+
+TEST_CASE("rounding: the budget of undone fixings counts since the last round with fewer free variables than any before") {
+  // Two disjoint copies of odd_cycle_behind_a (the second's a' at 20): each a = 1 leaves an odd
+  // cycle, and the rounding undoes its way to a' = 1 in each, five fixings undone in all, at most
+  // three between two lows of the free variables (10, 6 undone, 8, 6 undone, 3 undone, 5, 3 undone).
+  // Counted over the whole rounding, a budget of 3 or 4 gave up; since the last low, 3 suffices.
+  std::vector<std::vector<int>> rows;
+  const std::vector<std::vector<int>> one = {{1, 1, 0, 0, 0}, {0, 1, 1, 1, 0}, {0, 1, 0, 1, 1}, {0, 1, 1, 0, 1}};
+  for (const auto& r : one) {
+    std::vector<int> first = r, second(5, 0);
+    first.resize(10, 0);
+    second.insert(second.end(), r.begin(), r.end());
+    rows.push_back(first);
+    rows.push_back(second);
+  }
+  const std::vector<double> cost = {0, 10, 0, 0, 0, 0, 20, 0, 0, 0};
+  const LpProblem lp = test::dense_lp(rows, std::vector<double>(8, 1.0), cost);
+  const ProductSpace space = stand_in_space(lp);
+  RoundingOptions options;
+  options.solver = "clp-dual";  // vertices: the cycles at exactly 1/2
+  options.max_backtracks = 3;
+  const RoundingResult r = round_to_graph_surface(space, lp, cost, options);
+  CHECK(r.gamma == std::vector<int64_t>{1, 6});
+  CHECK(r.energy == 30.0);
+  int undone = 0;
+  for (const RoundingRound& k : r.rounds) undone += k.undone;
+  CHECK(undone >= 4);
+  options.max_backtracks = 2;
+  CHECK_THROWS_AS(round_to_graph_surface(space, lp, cost, options), InfeasibleError);
+}

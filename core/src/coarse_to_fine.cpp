@@ -1577,6 +1577,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
         }
       }
       carried_ones.clear();  // the widenings below start afresh
+      if (!s) spdlog::info("level {}: {}", l + 1, e.what());  // (a proof, or rounding giving up: the line below does not say)
       if (!s && widen_at(m, proof, e.certified() ? "infeasible" : "probably infeasible (PDHG diverging)")) {
         // A suspicion that keeps coming back is checked: the next first LPs are watched patiently.
         // A proof restores the watch.

@@ -133,7 +133,8 @@ struct RoundingOptions {
   // the pair's first completed run; docs/results-log.md, thirtieth session).
   int release_after_trims = 0;
   int max_backtracks = 200;    // fixings undone after an infeasible LP (each one more, smaller LP
-                               // solve), then fail with InfeasibleError naming the open rows
+                               // solve) since the last round with fewer free variables than any
+                               // before it, then fail with InfeasibleError naming the open rows
   // Fixings to 1 made before round 1: a partial Γ carried over from an attempt in a narrower
   // space (coarse to fine, after widening where that attempt got stuck). Each that fits is
   // fixed (in order; the rest are dropped), and round 1 solves what they leave, so its bound is
