@@ -754,7 +754,7 @@ Action add_match_command(CLI::App& app) {
       ->capture_default_str();
   app.add_option("--greedy-fallback", a->greedy_fallback,
                  "where no candidate of such a round stands away from the undecided part, fix the largest of each "
-                 "undecided region, at most this share of them (at least one)")
+                 "undecided region, at most this share of them (at least one; 1: the whole batch)")
       ->check(CLI::Range(0.0, 1.0))
       ->capture_default_str();
   app.add_flag("--whole-lp", a->whole_lp,

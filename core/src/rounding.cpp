@@ -822,8 +822,9 @@ std::vector<int64_t> undecided_regions(const LpProblem& lp, const Reduced& red, 
 // rows (b = 0; a face's coverage row reaches a thousand candidates and would spread everywhere).
 // Why: a candidate next to a split region fixes that region's boundary to one of the LP's mixed
 // alternatives, which the narrow reduced space often cannot complete; propagation does not see
-// it, the next LP is infeasible, and every infeasibility proof costs a solve. The whole batch
-// (or its largest `fallback` share) where nothing would be left.
+// it, the next LP is infeasible, and every infeasibility proof costs a solve. Where nothing
+// would be left: the largest candidate of each undecided region, at most the `fallback` share
+// of the batch (the whole batch with a share of 1).
 std::vector<std::pair<int64_t, int>> away_from_undecided(const LpProblem& lp, const Reduced& red,
                                                          const std::vector<int8_t>& value, const std::vector<double>& x,
                                                          const std::vector<std::pair<int64_t, int>>& batch,
@@ -874,21 +875,25 @@ std::vector<std::pair<int64_t, int>> away_from_undecided(const LpProblem& lp, co
   };
   // A converged LP repeats its iterate, so a round that keeps few candidates keeps few again
   // (full resolution: 2-3 % of 8 800, 150 fixings per round). Then only the strongly split
-  // variables count, and where even they surround every candidate, the whole batch goes in.
+  // variables count, and where even they surround every candidate, the fallback below.
   auto kept = away(unsure);
   if (4 * kept.size() >= batch.size()) return kept;
   if (unsure < 0.3) kept = away(0.3);
   if (!kept.empty()) return kept;
-  // Nothing stands away: the largest share of the batch (it is sorted largest first), at most one
-  // candidate per undecided region (undecided_regions): two fixed in one region pick two of its
-  // mixed alternatives, which seldom fit together. Measured, FAUST_r 043-065 without WKS, level 6
-  // at full resolution: with the largest eighth (57 of 451 candidates, all next to undecided
-  // variables) 10 of 12 such rounds left an infeasible LP (one proof blamed 56 of the 57), and
-  // 20 rounds at 595 k free variables went fix, fail, trim (13 365 fixings to 1 before and
-  // after); one per region (2-3 regions, 2-3 fixings) went on from 789 k free variables to 245 k
-  // in 14 minutes, 13 246 fixings to 1 to 13 373 in the last 7.
+  // Nothing stands away: the whole batch with a share of 1 (the default up to the fifty-first
+  // session); otherwise the largest candidate of each undecided region (undecided_regions), at
+  // most the share of the batch (it is sorted largest first). Two fixed in one region pick two of
+  // its mixed alternatives. Measured, FAUST_r 043-065 without WKS, level 6 at full resolution
+  // (two stretches of one run, not one state): with the largest eighth (57 of 451 candidates, all
+  // next to undecided variables) 10 of 12 such rounds left an infeasible LP (one proof blamed 56
+  // of the 57), and 20 rounds at 595 k free variables went fix, fail, trim (13 365 fixings to 1
+  // before and after); one per region (2-3 fixings) left an infeasible LP after 81 of 110, but
+  // each trim cost one fixing and 1-3 s: from 789 k free variables to 245 k in 14 minutes.
+  if (fallback >= 1.0) return batch;
   const size_t take = std::clamp<size_t>(static_cast<size_t>(std::ceil(fallback * double(batch.size()))), 1, batch.size());
   const std::vector<int64_t> region = undecided_regions(lp, red, x, unsure);
+  // (A candidate in no region, kept out only by the margin's closedness steps, counts as in one
+  // region shared by all such: -2.)
   std::unordered_set<int64_t> used;
   std::vector<std::pair<int64_t, int>> out;
   for (const auto& a : batch) {
@@ -898,12 +903,13 @@ std::vector<std::pair<int64_t, int>> away_from_undecided(const LpProblem& lp, co
       const int64_t r = region[col_of(lp.at.entry[q])];
       if (r >= 0) mine.push_back(r);
     }
+    if (mine.empty()) mine.push_back(-2);
     if (std::any_of(mine.begin(), mine.end(), [&](int64_t r) { return used.count(r) > 0; })) continue;
     used.insert(mine.begin(), mine.end());
     out.push_back(a);
   }
-  spdlog::debug("rounding: none stands away; the largest of {} undecided regions, {} of {} candidates (at most {})",
-                used.size(), out.size(), batch.size(), take);
+  spdlog::debug("rounding: none stands away; {} of {} candidates, one per undecided region they lie in (at most {})",
+                out.size(), batch.size(), take);
   return out;
 }
 
@@ -1243,7 +1249,8 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
       if (history.empty() || ++backtracks > options.max_backtracks)
         throw InfeasibleError(history.empty() ? "rounding: no consistent fixing exists (no binary solution)"
                                               : "rounding: no binary solution found within " +
-                                                    std::to_string(options.max_backtracks) + " undone fixings",
+                                                    std::to_string(options.max_backtracks) +
+                                                    " undone fixings since the last low of free variables",
                               std::move(open));
       Step& step = history.back();
       fixer.undo_to(step.mark);
@@ -1508,7 +1515,8 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
       // stuck, not for a long end game. Measured, FAUST_r 043-065 at full resolution: 176 rounds
       // from 789 k free variables to 220 k, 161 of them trims, the rounding gave up at its 201st
       // undone fixing (at most 61 trims between two lows) and the level started afresh in a
-      // widened space (an 11.5 M-variable first LP).
+      // widened space (an 11.5 M-variable first LP). (The round after a release is such a low too:
+      // the budget starts afresh there, as the stall rule does; max_releases bounds those.)
       backtracks = 0;
     } else {
       ++stalled;

@@ -77,9 +77,10 @@ struct LpResult {
   double objective = std::numeric_limits<double>::quiet_NaN();    // objective_scale * cᵀx
   double lower_bound = -std::numeric_limits<double>::infinity();  // certified, see certified_lower_bound
   double primal_residual = std::numeric_limits<double>::quiet_NaN();  // ‖Ax−b‖₂ / (1 + ‖b‖₂)
-  // ‖Ax−b‖∞: the relative residual can hide a row far off in an LP of 10⁵ rows (at 3e-3 and
-  // ‖b‖₂ ≈ 200, one row off by a half). Measured, FAUST_r 043-065's level 6 at full resolution:
-  // 467 of rounding's PDHG solves ended with at most 0.018 in a row (seventy-second session).
+  // ‖Ax−b‖∞ (NaN without x, e.g. a Diverging PDHG result). The relative residual could hide a
+  // row far off in an LP of 10⁵ rows (at 3e-3 and ‖b‖₂ ≈ 200, one row off by a half); measured,
+  // FAUST_r 043-065's level 6 at full resolution: 467 of rounding's PDHG solves ended with at
+  // most 0.018 in a row (seventy-second session).
   double row_residual = std::numeric_limits<double>::quiet_NaN();
   double dual_residual = std::numeric_limits<double>::quiet_NaN();    // relative
   double gap = std::numeric_limits<double>::quiet_NaN();  // |objective − bound| / (1 + |objective| + |bound|)

@@ -86,14 +86,15 @@ struct RoundingOptions {
   // A greedy round fixes only candidates away from the LP's undecided part: none of their rows
   // holds a free variable valued in (greedy_unsure, 1 − greedy_unsure), nor lies within
   // greedy_margin − 1 closedness steps of one (0: fix every candidate). Where under a quarter of
-  // the batch qualifies, only values in (0.3, 0.7) count; where none does then, the whole batch.
+  // the batch qualifies, only values in (0.3, 0.7) count; where none does then, greedy_fallback.
   // Measured at full resolution: without it the LPs after greedy rounds were infeasible round
   // after round; with it, none of rounds 2-5 (docs/results-log.md, seventh session).
   double greedy_unsure = 0.1;
   int greedy_margin = 1;
   // Where no candidate qualifies even then, the largest of each undecided region, at most this
-  // share of the batch (at least one); up to the seventy-first session the largest share alone,
-  // up to the fifty-first the whole batch (see away_from_undecided for the regions' measurement).
+  // share of the batch (at least one); 1: the whole batch (the default up to the fifty-first
+  // session). Up to the seventy-first session the largest share regardless of regions (see
+  // away_from_undecided for the regions' measurement).
   // Counted in the -v logs of eighteen full-resolution runs or segments (tools/greedy_rounds.py;
   // docs/results-log.md, fifty-first session): after a whole-batch fallback the next LP was
   // infeasible 16 times in 30 (from an optimal LP) and 5 in 5 (from one at its cap), against
@@ -134,7 +135,8 @@ struct RoundingOptions {
   int release_after_trims = 0;
   int max_backtracks = 200;    // fixings undone after an infeasible LP (each one more, smaller LP
                                // solve) since the last round with fewer free variables than any
-                               // before it, then fail with InfeasibleError naming the open rows
+                               // before it (the round after a release is one), then fail with
+                               // InfeasibleError naming the open rows
   // Fixings to 1 made before round 1: a partial Γ carried over from an attempt in a narrower
   // space (coarse to fine, after widening where that attempt got stuck). Each that fits is
   // fixed (in order; the rest are dropped), and round 1 solves what they leave, so its bound is
