@@ -5,10 +5,11 @@
 
 A greedy round (more free variables than --greedy-above) fixes only candidates that stand away
 from the LP's undecided part: first variables in (0.1, 0.9), then, where under a quarter of the
-batch is left, (0.3, 0.7); where none is left then, the largest candidate of each undecided region,
-at most the --greedy-fallback share (the whole batch with a share of 1). For each such round followed by another round of its level, this
-counts the rounds by that outcome and by whether the round's own LP was optimal or stopped at its
-cap, and how many of them the next LP found infeasible.
+batch is left, (0.3, 0.7); where none is left then, the largest candidate of each undecided
+region, at most the --greedy-fallback share (the whole batch with a share of 1). For each such
+round followed by another round of its level, this counts the rounds by that outcome and by
+whether the round's own LP was optimal or stopped at its cap, and how many of them the next LP
+found infeasible.
 """
 import re
 import sys
