@@ -295,14 +295,15 @@ LpResult PdhgSolver::solve(const LpProblem& problem, const SolverParams& params)
   result.iterations = total;
   result.primal_weight = omega;
   result.seconds = clock.seconds();
-  if (result.status == LpStatus::Infeasible) {
+  // The summary line (its max |y| a pass over the duals: only where it is logged).
+  if (result.status == LpStatus::Infeasible && spdlog::should_log(spdlog::level::debug)) {
     double top = 0.0;
     for (double v : result.y) top = std::max(top, std::abs(v));
     spdlog::debug("{}: infeasible after {} iterations and {} restarts ({:.3f} s); its proof's bound {:.4g} against "
                   "{:.4g}, max |y| {:.3g}",
                   name(), total, restarts, result.seconds, result.lower_bound,
                   problem.objective_scale * largest_objective, top);
-  } else {
+  } else if (result.status != LpStatus::Infeasible) {
     spdlog::debug("{}: {} after {} iterations and {} restarts ({:.3f} s); residual {:.3g} relative, {:.3g} in a row",
                   name(), to_string(result.status), total, restarts, result.seconds, result.primal_residual,
                   result.row_residual);
