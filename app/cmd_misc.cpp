@@ -99,6 +99,7 @@ Action add_checkpoint_command(CLI::App& app) {
         rounding = Json::object()
                        .set("rounds", g.rounds)
                        .set("fixings_to_one", static_cast<int64_t>(g.ones.size()))
+                       .set("fixing_steps", g.step_count())
                        .set("iterations", g.iterations)
                        .set("lower_bound", g.lower_bound)
                        .set("variables", g.columns)

@@ -1565,6 +1565,14 @@ TEST_CASE("coarse to fine: a run gone on from an attempt of a level in progress 
   CHECK(v4.attempt.report.stuck_restarts == 2);
   CHECK(v4.levels.front().stuck_restarts == 1);
   CHECK(v4.attempt.rounding.ones == marked.attempt.rounding.ones);
+  // The ninth (no steps of the rounding's fixings: one step).
+  marked.attempt.rounding.steps.assign(marked.attempt.rounding.ones.size(), 1);
+  detail::save_checkpoint_as(file, marked, 9);
+  const LevelCheckpoint v9 = load_checkpoint(file);
+  CHECK(v9.attempt.rounding.ones == marked.attempt.rounding.ones);
+  CHECK(v9.attempt.rounding.steps.empty());
+  save_checkpoint(file, marked);
+  CHECK(load_checkpoint(file).attempt.rounding.steps == marked.attempt.rounding.steps);
   save_checkpoint(file, marked);
   std::string bytes;
   {
@@ -1572,8 +1580,8 @@ TEST_CASE("coarse to fine: a run gone on from an attempt of a level in progress 
     bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
   }
   const size_t at = std::string("shapematch level checkpoint\n").size();
-  REQUIRE(bytes[at] == 9);
-  bytes[at] = 10;  // a later version than this build's
+  REQUIRE(bytes[at] == 10);
+  bytes[at] = 11;  // a later version than this build's
   std::ofstream(file, std::ios::binary) << bytes;
   CHECK_THROWS_AS(load_checkpoint(file), IoError);
   detail::save_checkpoint_as(file, marked, 1);
@@ -1622,6 +1630,7 @@ TEST_CASE("coarse to fine: a run gone on from a checkpoint inside a rounding fix
     CHECK(g.rows == finest.constraints);
     CHECK(g.lower_bound == finest.lower_bound);
     CHECK(std::is_sorted(g.ones.begin(), g.ones.end()));
+    CHECK(g.steps.size() == g.ones.size());
     if (k > 0) CHECK(g.iterations > last[k - 1].attempt.rounding.iterations);
   }
   CHECK(last.back().attempt.rounding.iterations == finest.iterations);
@@ -1634,6 +1643,7 @@ TEST_CASE("coarse to fine: a run gone on from a checkpoint inside a rounding fix
   const LevelCheckpoint loaded = load_checkpoint(file);
   const LevelAttempt::Rounding& g = loaded.attempt.rounding;
   CHECK(g.ones == last.front().attempt.rounding.ones);
+  CHECK(g.steps == last.front().attempt.rounding.steps);
   CHECK(g.rounds == 1);
   CHECK(g.columns == finest.variables);
   CHECK(g.lower_bound == finest.lower_bound);
@@ -1668,9 +1678,12 @@ TEST_CASE("coarse to fine: a run gone on from a checkpoint inside a rounding fix
   CHECK(afresh.levels.back().energy == doctest::Approx(finest.energy).epsilon(1e-12));
   CHECK(afresh.levels.back().gamma == finest.gamma);
   CHECK(afresh.levels.back().rounds == finest.rounds);
-  // Decisions that name no column are refused.
+  // Decisions that name no column are refused, and steps that do not fit them.
   LevelCheckpoint wrong = last.front();
   wrong.attempt.rounding.ones.push_back(g.columns);
+  CHECK_THROWS_AS(matcher.run({}, &wrong), InvalidInputError);
+  wrong = last.front();
+  wrong.attempt.rounding.steps.push_back(0);
   CHECK_THROWS_AS(matcher.run({}, &wrong), InvalidInputError);
 }
 

@@ -135,12 +135,12 @@ TEST_CASE("rounding: after each round it hands out its decisions, and a rounding
   struct Call {
     int round;
     std::vector<int64_t> ones;
+    std::vector<int32_t> steps;
     double bound;
   };
   std::vector<Call> calls;
-  o.decided = [&](const RoundingRound& r, const std::vector<int64_t>& ones, double bound) {
-    calls.push_back({r.round, ones, bound});
-  };
+  o.decided = [&](const RoundingRound& r, const std::vector<int64_t>& ones, const std::vector<int32_t>& steps,
+                  double bound) { calls.push_back({r.round, ones, steps, bound}); };
   const RoundingResult r = round_to_graph_surface(m.space, m.lp, m.energy, o);
   REQUIRE(r.rounds.size() >= 2);
   REQUIRE(calls.size() == r.rounds.size());
@@ -149,6 +149,8 @@ TEST_CASE("rounding: after each round it hands out its decisions, and a rounding
     CHECK(calls[k].round == int(k) + 1);
     CHECK(std::is_sorted(calls[k].ones.begin(), calls[k].ones.end()));
     CHECK(std::adjacent_find(calls[k].ones.begin(), calls[k].ones.end()) == calls[k].ones.end());
+    CHECK(calls[k].steps.size() == calls[k].ones.size());
+    for (int32_t step : calls[k].steps) CHECK((step >= 0 && step <= int(k)));  // a step per round at most
     CHECK(calls[k].bound == r.first_lp.lower_bound);
   }
   REQUIRE_FALSE(calls.front().ones.empty());
@@ -161,6 +163,59 @@ TEST_CASE("rounding: after each round it hands out its decisions, and a rounding
   CHECK(satisfies_exactly(m.lp, g.gamma));
   CHECK(check_graph_surface(m.space, g.gamma).ok());
   for (int64_t j : calls.front().ones) CHECK(std::binary_search(g.gamma.begin(), g.gamma.end(), j));
+}
+
+TEST_CASE("rounding: a rounding gone on from decisions with their steps keeps the steps apart") {
+  // The dolphin and the bumpy ball round in several rounds (see the budget test). Gone on from
+  // the decisions before the last round, with their steps: those stay apart in the undo history,
+  // as the next round's decisions show (a failing LP undoes the last of them first, as the
+  // rounding that made them would have); without the steps they are one.
+  const MatchingLp& m = dolphin_ball_60();
+  RoundingOptions o;
+  o.solver = "pdhg-cpu";
+  o.lp.tolerance = 1e-3;
+  std::vector<std::pair<std::vector<int64_t>, std::vector<int32_t>>> calls;
+  o.decided = [&](const RoundingRound&, const std::vector<int64_t>& ones, const std::vector<int32_t>& steps, double) {
+    calls.push_back({ones, steps});
+  };
+  const RoundingResult plain = round_to_graph_surface(m.space, m.lp, m.energy, o);
+  REQUIRE(calls.size() > 2);
+  REQUIRE(calls.size() == plain.rounds.size());
+  const auto& [ones, steps] = calls[calls.size() - 2];
+  REQUIRE(steps.size() == ones.size());
+  REQUIRE(std::set<int32_t>(steps.begin(), steps.end()).size() >= 2);
+  for (bool with_steps : {true, false}) {
+    CAPTURE(with_steps);
+    RoundingOptions from = o;
+    from.start_ones = ones;
+    from.start_steps = with_steps ? steps : std::vector<int32_t>{};
+    std::vector<std::pair<std::vector<int64_t>, std::vector<int32_t>>> after;
+    from.decided = [&](const RoundingRound&, const std::vector<int64_t>& a, const std::vector<int32_t>& s, double) {
+      after.push_back({a, s});
+    };
+    const RoundingResult g = round_to_graph_surface(m.space, m.lp, m.energy, from);
+    CHECK(satisfies_exactly(m.lp, g.gamma));
+    REQUIRE_FALSE(after.empty());
+    REQUIRE_FALSE(g.rounds.front().undone);
+    std::map<int64_t, int32_t> step_of;
+    for (size_t k = 0; k < after.front().first.size(); ++k) step_of[after.front().first[k]] = after.front().second[k];
+    // (Steps that fixed nothing that stayed are not kept: renumbered in order.)
+    std::map<int32_t, int32_t> renumbered;
+    for (int32_t k : steps) renumbered.emplace(k, 0);
+    int32_t next = 0;
+    for (auto& [k, to] : renumbered) to = next++;
+    for (size_t k = 0; k < ones.size(); ++k) {
+      REQUIRE(step_of.count(ones[k]));
+      CHECK(step_of[ones[k]] == (with_steps ? renumbered[steps[k]] : 0));
+    }
+  }
+  // Steps that do not fit the fixings are refused.
+  RoundingOptions wrong = o;
+  wrong.start_ones = ones;
+  wrong.start_steps = {0};
+  CHECK_THROWS_AS(round_to_graph_surface(m.space, m.lp, m.energy, wrong), InvalidInputError);
+  wrong.start_steps.assign(ones.size(), -1);
+  CHECK_THROWS_AS(round_to_graph_surface(m.space, m.lp, m.energy, wrong), InvalidInputError);
 }
 
 TEST_CASE("rounding: later rounds stop at their iteration cap and still end exact") {

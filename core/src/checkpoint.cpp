@@ -18,8 +18,8 @@ constexpr char kMagic[] = "shapematch level checkpoint\n";
 // lookahead's chains (LevelCheckpoint::chains) follow. 6: each chain's attempt follows it. 7:
 // LevelReport::lookahead_other_bound and lookahead_other_stuck. 8: branch_roundings,
 // branch_energy and branch_kept. 9: LevelAttempt::zero_cost_margin_given follows `trusted`.
-// 1 to 8 are read too.
-constexpr uint32_t kVersion = 9;
+// 10: LevelAttempt::Rounding::steps follows its ones. 1 to 9 are read too.
+constexpr uint32_t kVersion = 10;
 
 // Every number of a report, in the file's order (the Γ follows on its own). A field added to
 // LevelReport goes here too, with kVersion one higher; the size check below is the reminder.
@@ -130,6 +130,7 @@ void write_attempt(Writer& w, const LevelAttempt& a, uint32_t version) {
   if (!g.empty()) {
     w(g.columns), w(g.rows), w(g.iterations), w(g.lower_bound), w(g.reference_seconds), w(g.reference_iterations);
     w.array(g.ones);
+    if (version >= 10) w.array(g.steps);
   }
 }
 void read_attempt(Reader& r, LevelAttempt& a, uint32_t version, const std::string& path) {
@@ -147,6 +148,7 @@ void read_attempt(Reader& r, LevelAttempt& a, uint32_t version, const std::strin
   if (!g.empty()) {
     r(g.columns), r(g.rows), r(g.iterations), r(g.lower_bound), r(g.reference_seconds), r(g.reference_iterations);
     r.array(g.ones);
+    if (version >= 10) r.array(g.steps);
   }
   if (a.ring < 0) throw IoError(path + ": not a shapematch checkpoint (an attempt at ring " + std::to_string(a.ring) + ")");
 }

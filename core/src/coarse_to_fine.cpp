@@ -872,7 +872,9 @@ void CoarseToFineMatcher::check(const LevelCheckpoint& c) const {
     throw InvalidInputError("the checkpoint's attempt of level " + std::to_string(done + 1) + " does not fit it");
   const LevelAttempt::Rounding& g = a.rounding;
   if (!g.empty() && (a.empty() || g.columns <= 0 || g.rows <= 0 || g.iterations < 0 ||
-                     std::any_of(g.ones.begin(), g.ones.end(), [&](int64_t j) { return j < 0 || j >= g.columns; })))
+                     std::any_of(g.ones.begin(), g.ones.end(), [&](int64_t j) { return j < 0 || j >= g.columns; }) ||
+                     (!g.steps.empty() && g.steps.size() != g.ones.size()) ||
+                     std::any_of(g.steps.begin(), g.steps.end(), [](int32_t k) { return k < 0; })))
     throw InvalidInputError("the checkpoint's rounding of level " + std::to_string(done + 1) + " does not fit it");
 }
 
@@ -1267,10 +1269,11 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
     rep.variables = m.lp.cols();
     rep.constraints = m.lp.rows();
     // This attempt's rounding where it has got, with these fixings to 1: for a checkpoint or a restart.
-    const auto rounding_now = [&](const std::vector<int64_t>& ones) {
+    const auto rounding_now = [&](const std::vector<int64_t>& ones, const std::vector<int32_t>& steps) {
       return LevelAttempt::Rounding{.columns = m.lp.cols(),
                                     .rows = m.lp.rows(),
                                     .ones = ones,
+                                    .steps = steps,
                                     .rounds = rounds_so_far,
                                     .iterations = iterations_so_far,
                                     .lower_bound = first_bound,
@@ -1421,14 +1424,15 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
       }
       if (going_on) {  // its round 1 solves what the checkpointed fixings leave
         ro.start_ones = going_on->ones;
-        // Unwatched, as a later round: where those fixings leave no solution, the proof undoes
-        // some of them (a diverging first LP would widen the space instead).
+        ro.start_steps = going_on->steps;
+        // Unwatched, as a later round: where those fixings leave no solution, the last step's are
+        // undone first (a diverging first LP would widen the space instead).
         ro.lp.stop_on_divergence = false;
         cold_seconds = reference_seconds = ro.reference_seconds = going_on->reference_seconds;
         cold_iterations = reference_iterations = first_iterations = ro.reference_iterations =
             going_on->reference_iterations;
-        spdlog::info("level {}: rounding goes on after round {} from its {} fixings to 1", l + 1, going_on->rounds,
-                     going_on->ones.size());
+        spdlog::info("level {}: rounding goes on after round {} from its {} fixings to 1 ({} steps)", l + 1,
+                     going_on->rounds, going_on->ones.size(), going_on->step_count());
       }
       // Where the rounding has got, saved as it goes and kept for a restart (not where
       // alternatives would run: a run gone on from fixings runs none).
@@ -1439,13 +1443,14 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
       iterations_so_far = going_on ? going_on->iterations : 0;
       Stopwatch since_saved;
       if (tracking)
-        ro.decided = [&](const RoundingRound& r, const std::vector<int64_t>& ones, double bound) {
+        ro.decided = [&](const RoundingRound& r, const std::vector<int64_t>& ones, const std::vector<int32_t>& steps,
+                         double bound) {
           iterations_so_far += r.iterations;
           rounds_so_far = (going_on ? going_on->rounds : 0) + r.round;
           if (r.round == 1 && !going_on) first_bound = bound;
           if (!attempted || since_saved.seconds() < options_.rounding_checkpoint_seconds) return;
           LevelAttempt a = current_attempt();
-          a.rounding = rounding_now(ones);
+          a.rounding = rounding_now(ones, steps);
           attempted(a);
           since_saved.reset();
         };
@@ -1458,9 +1463,10 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
         } else {
           ro.decided = [inner = std::move(ro.decided), beat = rules.beat](const RoundingRound& r,
                                                                           const std::vector<int64_t>& ones,
+                                                                          const std::vector<int32_t>& steps,
                                                                           double bound) {
             if (r.round == 1 && bound >= beat) throw Outmatched{bound};  // (before a checkpoint of it)
-            if (inner) inner(r, ones, bound);
+            if (inner) inner(r, ones, steps, bound);
           };
         }
       }
@@ -1552,7 +1558,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
           std::isfinite(first_bound)) {
         ++restarts;
         ++rep.stuck_restarts;
-        restart = rounding_now(s->ones());
+        restart = rounding_now(s->ones(), {});  // (one step: its history is not at hand)
         spdlog::warn("level {}: {}; starting its rounding again from its {} fixings to 1 ({} of {})", l + 1,
                      e.what(), s->ones().size(), restarts, options_.stuck_restarts);
         continue;
@@ -1677,7 +1683,7 @@ void CoarseToFineMatcher::branch_coarsest(MatchingLp& m, RoundingResult& rr, con
       // No Γ of a side whose LP's bound reaches the best energy, or the other side's (a tie
       // keeps the first), can win or be the side to go on from: not rounded.
       const double beat = lower ? std::min(best_energy, lower->rr.energy) : best_energy;
-      ro.decided = [&](const RoundingRound& r, const std::vector<int64_t>&, double b) {
+      ro.decided = [&](const RoundingRound& r, const std::vector<int64_t>&, const std::vector<int32_t>&, double b) {
         if (r.round == 1 && b >= beat) throw Pruned{b};
       };
       const char* which = place == &s.first ? "first" : "second";

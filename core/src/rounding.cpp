@@ -1209,18 +1209,29 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
   std::vector<Step> history;  // the fixings so far, to undo when a later LP is infeasible
   std::unordered_set<int64_t> refuted;  // fixings to 1 an infeasibility proof blamed, not tried again
   int backtracks = 0;
-  // A partial Γ carried over (start_ones): one fixing like any other, which backtracking may trim.
+  // A partial Γ carried over (start_ones): fixings like any other, which backtracking may trim,
+  // one per step of start_steps (or one in all).
   bool carried = false;
   if (!options.start_ones.empty()) {
     for (int64_t j : options.start_ones)
       if (j < 0 || j >= lp.cols()) throw InvalidInputError("rounding: a start fixing names no variable");
-    std::vector<std::pair<int64_t, int>> batch;
-    for (int64_t j : options.start_ones) batch.push_back({j, 1});
-    Step step{fixer.mark(), fixer.state().ones, fixer.state().zeros, {}, false};
-    step.batch = shrink_and_fix(fixer, batch, step.mark, true);
-    spdlog::debug("rounding: starts from {} of {} carried fixings to 1", step.batch.size(), batch.size());
-    carried = !step.batch.empty();
-    if (carried) history.push_back(std::move(step));
+    const std::vector<int32_t>& steps = options.start_steps;
+    if (!steps.empty() && (steps.size() != options.start_ones.size() ||
+                           std::any_of(steps.begin(), steps.end(), [](int32_t k) { return k < 0; })))
+      throw InvalidInputError("rounding: the start fixings' steps do not fit them");
+    std::map<int32_t, std::vector<std::pair<int64_t, int>>> batches;  // by step, in order
+    for (size_t k = 0; k < options.start_ones.size(); ++k)
+      batches[steps.empty() ? 0 : steps[k]].push_back({options.start_ones[k], 1});
+    size_t kept = 0;
+    for (auto& [index, batch] : batches) {
+      Step step{fixer.mark(), fixer.state().ones, fixer.state().zeros, {}, false};
+      step.batch = shrink_and_fix(fixer, std::move(batch), step.mark, true);
+      kept += step.batch.size();
+      if (!step.batch.empty()) history.push_back(std::move(step));
+    }
+    spdlog::debug("rounding: starts from {} of {} carried fixings to 1 in {} steps", kept, options.start_ones.size(),
+                  history.size());
+    carried = !history.empty();
   }
   // Rounds in a row whose LP failed, and their seconds (stuck_after).
   int failing_rounds = 0;
@@ -1463,13 +1474,22 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
   double first_work = 0.0, later_work = 0.0;
   // The fixings to 1 made so far, sorted. Only the decisions: what propagation forced to 1 in
   // this space need not follow in a wider one, and follows from them in this one.
-  const auto decisions = [&] {
+  // With `steps`, the step of each (parallel; a fixing in two steps, after a release, in its first).
+  const auto decisions = [&](std::vector<int32_t>* steps = nullptr) {
+    std::vector<std::pair<int64_t, int32_t>> made;
+    for (size_t k = 0; k < history.size(); ++k)
+      for (const auto& a : history[k].batch)
+        if (a.second == 1 && fixer.state().value[a.first] == 1) made.push_back({a.first, static_cast<int32_t>(k)});
+    std::sort(made.begin(), made.end());
+    made.erase(std::unique(made.begin(), made.end(), [](const auto& a, const auto& b) { return a.first == b.first; }),
+               made.end());
     std::vector<int64_t> ones;
-    for (const Step& st : history)
-      for (const auto& a : st.batch)
-        if (a.second == 1 && fixer.state().value[a.first] == 1) ones.push_back(a.first);
-    std::sort(ones.begin(), ones.end());
-    ones.erase(std::unique(ones.begin(), ones.end()), ones.end());
+    ones.reserve(made.size());
+    if (steps) steps->clear();
+    for (const auto& [j, k] : made) {
+      ones.push_back(j);
+      if (steps) steps->push_back(k);
+    }
     return ones;
   };
   const auto record = [&](RoundingRound& info, const Stopwatch& clock) {
@@ -1477,7 +1497,11 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
     if (info.round > 1) later_work += double(info.iterations) * double(info.variables);
     result.rounds.push_back(info);
     if (progress) progress(info);
-    if (options.decided) options.decided(info, decisions(), result.first_lp.lower_bound);
+    if (options.decided) {
+      std::vector<int32_t> steps;
+      const std::vector<int64_t> ones = decisions(&steps);
+      options.decided(info, ones, steps, result.first_lp.lower_bound);
+    }
   };
   // Giving up where the caller can widen (stuck_after): the fixings to 1 so far and the iterate go with it.
   const auto stuck = [&](const std::string& what, std::vector<int64_t> rows) {

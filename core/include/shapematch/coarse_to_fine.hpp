@@ -444,16 +444,25 @@ struct LevelAttempt {
   // bound (measured on the H200, 17 runs at once: a finest level's rounding takes 100-300 s, which
   // a stop inside it lost). Empty (no rounds) where it had not finished round 1. Not kept: the
   // rounding's own state (undo history, stall and stuck counts, the warm start), which begins
-  // afresh; and it is not saved where the level's LP is small enough for alternative thresholds.
+  // afresh, but for the steps its fixings were made in; and it is not saved where the level's LP
+  // is small enough for alternative thresholds.
   struct Rounding {
     int64_t columns = 0, rows = 0;   // of the attempt's LP, which a run gone on from it checks
     std::vector<int64_t> ones;       // the rounding's fixings to 1 so far (RoundingOptions::decided)
+    std::vector<int32_t> steps;      // the undo step of each (parallel; version 10; empty: one step)
     int rounds = 0;                  // done, and their LP iterations
     int64_t iterations = 0;
     double lower_bound = 0.0;        // certified by round 1
     double reference_seconds = 0.0;  // round 1's cold solve (RoundingOptions::reference_*)
     int64_t reference_iterations = 0;
     bool empty() const { return rounds == 0; }
+    // How many steps its fixings form (one where `steps` is empty, none without fixings).
+    int64_t step_count() const {
+      if (steps.empty()) return ones.empty() ? 0 : 1;
+      std::vector<int32_t> s = steps;
+      std::sort(s.begin(), s.end());
+      return std::unique(s.begin(), s.end()) - s.begin();
+    }
   } rounding;
   bool empty() const { return ring < 0; }
   int widenings() const { return report.widenings + report.local_widenings; }  // so far

@@ -143,6 +143,11 @@ struct RoundingOptions {
   // no bound of the whole LP: the result's lower_bound is then certified from `start_dual` (one
   // value per row, e.g. an earlier first LP's dual mapped over; −∞ without it).
   std::vector<int64_t> start_ones;
+  // With start_ones: the step of the undo history each was fixed in (parallel to it, as `decided`
+  // gives them), each step then fixed as its own, in order: a run gone on from a checkpoint
+  // undoes its last step first where its LP fails, as the run that saved it would have, rather
+  // than trimming all of them as one fixing. Empty: one step.
+  std::vector<int32_t> start_steps;
   std::vector<double> start_dual;
   // A cold solve of the whole LP, where round 1 is a warm LP that understates it: a start from
   // carried fixings (a smaller LP) or coarse to fine's re-solve after pricing (from a nearby
@@ -235,10 +240,13 @@ struct RoundingOptions {
   std::function<void(const LpProblem& part)> slow_part;
   double slow_part_seconds = 10.0;
   // Called after each round (after `progress`) with the decisions so far, the fixings to 1 that
-  // rounding chose (sorted; not what propagation forced, which follows from them), and round 1's
-  // certified bound: where the rounding has got, for a checkpoint (coarse to fine) that a later
-  // run goes on from with start_ones.
-  std::function<void(const RoundingRound& round, const std::vector<int64_t>& ones, double first_bound)> decided;
+  // rounding chose (sorted; not what propagation forced, which follows from them), the step of
+  // its undo history each belongs to (0 the oldest; parallel to them), and round 1's certified
+  // bound: where the rounding has got, for a checkpoint (coarse to fine) that a later run goes on
+  // from with start_ones and start_steps.
+  std::function<void(const RoundingRound& round, const std::vector<int64_t>& ones, const std::vector<int32_t>& steps,
+                     double first_bound)>
+      decided;
   // Where probe_tolerance is above lp.tolerance and `probe` is set, round 1's LP is solved first
   // to probe_tolerance and `probe` gets that iterate (over the whole LP, as first_iterate's) if it
   // was optimal there; it may throw to abandon the rounding (coarse to fine prices a wider space
