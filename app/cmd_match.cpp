@@ -46,6 +46,7 @@ struct MatchArgs {
   int64_t greedy_above = RoundingOptions{}.greedy_above;
   int greedy_margin = RoundingOptions{}.greedy_margin;
   double greedy_fallback = RoundingOptions{}.greedy_fallback;
+  bool remember_refuted = RoundingOptions{}.remember_refuted;
   int64_t search_below = RoundingOptions{}.search_below;
   bool converged_first = RoundingOptions{}.converged_first;
   double exact_pivots_per_column = RoundingOptions{}.exact_pivots_per_column;
@@ -258,6 +259,7 @@ int run_match(const MatchArgs& args) {
   ro.greedy_above = args.greedy_above;
   ro.greedy_margin = args.greedy_margin;
   ro.greedy_fallback = args.greedy_fallback;
+  ro.remember_refuted = args.remember_refuted;
   ro.search_below = args.search_below;
   ro.stuck_stalled = args.stuck_stalled;
   ro.converged_first = args.converged_first;
@@ -507,6 +509,7 @@ int run_match(const MatchArgs& args) {
                               .set("greedy_above", args.greedy_above)
                               .set("greedy_margin", args.greedy_margin)
                               .set("greedy_fallback", args.greedy_fallback)
+                              .set("remember_refuted", args.remember_refuted)
                               .set("search_below", args.search_below)
                               .set("converged_first", args.converged_first)
                               .set("exact_pivots_per_column", args.exact_pivots_per_column)
@@ -757,6 +760,9 @@ Action add_match_command(CLI::App& app) {
                  "undecided region, at most this share of them (at least one; 1: the whole batch)")
       ->check(CLI::Range(0.0, 1.0))
       ->capture_default_str();
+  app.add_flag("--remember-refuted,!--no-remember-refuted", a->remember_refuted,
+               "fixings an infeasibility proof blamed are not made again from the state they were made from, also "
+               "after backtracking away from it and back (default on)");
   app.add_flag("--whole-lp", a->whole_lp,
                "solve each rounding LP after the first as one, not as its independent parts (small parts exactly)");
   app.add_option("--tol", a->tolerance, "LP tolerance")->capture_default_str();

@@ -3,6 +3,7 @@
 #include "shapematch/matching.hpp"
 #include "shapematch/rounding.hpp"
 #include "shapematch/shapes.hpp"
+#include "failed_from.hpp"
 #include "failing_again.hpp"
 #include "release_reach.hpp"
 #include "solve_in_parts.hpp"
@@ -1423,6 +1424,46 @@ TEST_CASE("rounding: a release reaches further only where the same part fails ag
   r.released({9}, 64);
   CHECK(r.first_depth({9}) == 64);    // no further than 64 to start with
   CHECK(r.first_depth({}) == 2);
+}
+
+TEST_CASE("rounding: fixings a proof blamed are remembered at the state they were made from") {
+  // The memory behind remember_refuted. A state is the values of all variables: equal values
+  // hash equal whatever led to them; one value changed anywhere (a tail shorter than a word
+  // too) changes the hash.
+  std::vector<int8_t> s(21, -1);
+  s[3] = 1;
+  s[4] = 0;
+  const uint64_t h = detail::state_hash(s);
+  std::vector<int8_t> same(21, -1);
+  same[4] = 0;
+  same[3] = 1;
+  CHECK(detail::state_hash(same) == h);
+  std::set<uint64_t> others{h};
+  for (size_t k = 0; k < s.size(); ++k)
+    for (int8_t v : {-1, 0, 1}) {
+      if (v == s[k]) continue;
+      std::vector<int8_t> t = s;
+      t[k] = v;
+      CHECK(others.insert(detail::state_hash(t)).second);
+    }
+  CHECK(detail::state_hash(std::vector<int8_t>(20, -1)) != detail::state_hash(std::vector<int8_t>(21, -1)));
+  // Blamed from one state: recalled there, not at another, and what is blamed there later joins.
+  detail::FailedFrom f;
+  CHECK(f.empty());
+  f.blamed(h, {});
+  CHECK(f.empty());
+  f.blamed(h, {10, 12});
+  const uint64_t other = detail::state_hash(std::vector<int8_t>(21, 0));
+  f.blamed(other, {7});
+  std::vector<int64_t> back = f.recall(h);
+  std::sort(back.begin(), back.end());
+  CHECK(back == std::vector<int64_t>{10, 12});
+  f.blamed(h, {12, 3});
+  back = f.recall(h);
+  std::sort(back.begin(), back.end());
+  CHECK(back == std::vector<int64_t>{3, 10, 12});
+  CHECK(f.recall(other) == std::vector<int64_t>{7});
+  CHECK(f.recall(detail::state_hash(std::vector<int8_t>(21, 1))).empty());
 }
 
 TEST_CASE("rounding: trims in a row count only while the same part fails after each") {

@@ -1,5 +1,6 @@
 #include "shapematch/rounding.hpp"
 #include "parallel.hpp"
+#include "failed_from.hpp"
 #include "failing_again.hpp"
 #include "release_reach.hpp"
 #include "solve_in_parts.hpp"
@@ -1208,6 +1209,7 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
   };
   std::vector<Step> history;  // the fixings so far, to undo when a later LP is infeasible
   std::unordered_set<int64_t> refuted;  // fixings to 1 an infeasibility proof blamed, not tried again
+  detail::FailedFrom failed_from;        // and per state they were made from (remember_refuted)
   int backtracks = 0;
   // A partial Γ carried over (start_ones): fixings like any other, which backtracking may trim,
   // one per step of start_steps (or one in all).
@@ -1293,8 +1295,12 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
         // undo, for 100 rounds).
         std::unordered_set<int64_t> kept;
         for (const auto& k : away_from_proof) kept.insert(k.first);
+        std::vector<int64_t> blamed_ones;
         for (const auto& a : step.batch)
-          if (a.second == 1 && !kept.count(a.first)) refuted.insert(a.first);
+          if (a.second == 1 && !kept.count(a.first)) blamed_ones.push_back(a.first);
+        refuted.insert(blamed_ones.begin(), blamed_ones.end());
+        // (the fixer is back at the state the step was made from)
+        if (options.remember_refuted) failed_from.blamed(detail::state_hash(fixer.state().value), blamed_ones);
         smaller = std::move(away_from_proof);
       }
       else shrinkable = shrink_once(smaller);  // (a single variable that cannot be 1 must be 0)
@@ -1847,7 +1853,15 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
     std::vector<int64_t> order(red.cols.size());
     std::iota(order.begin(), order.end(), 0);
     std::sort(order.begin(), order.end(), [&](int64_t p, int64_t q) { return r.x[p] > r.x[q]; });
-    // Refuted fixings are left out while anything else remains.
+    // Refuted fixings are left out while anything else remains, with those blamed from this
+    // state before, where the rounding has been here already.
+    if (!failed_from.empty()) {
+      const std::vector<int64_t> again = failed_from.recall(detail::state_hash(fixer.state().value));
+      size_t added = 0;
+      for (int64_t j : again) added += refuted.insert(j).second;
+      if (added > 0)
+        spdlog::debug("rounding: back at a state seen before: {} fixings blamed from it are left out", added);
+    }
     if (!refuted.empty()) {
       std::vector<int64_t> open;
       for (int64_t k : order)

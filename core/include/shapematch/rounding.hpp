@@ -103,6 +103,13 @@ struct RoundingOptions {
   // against 23, FAUST_r 016-020 36 min against over 100 (the whole batch: stuck three times in
   // its level 6 and not finished), and FAUST_r 024-043, which had never finished, in 23 min.
   double greedy_fallback = 0.125;
+  // The fixings to 1 an infeasibility proof blamed are left out of the candidates (while any
+  // other remains) at the state they were made from also after undoing earlier fixings took the
+  // rounding away from it and back (a state is its variables' values). Without it they were
+  // forgotten there: measured, FAUST_r 043-065 at full resolution (seventy-second session), level
+  // 6's rounding went round one cycle of 17 rounds (the same states, LP iterations and
+  // objectives, the same two candidates fixed by the fallback and blamed) at least four times.
+  bool remember_refuted = true;
   // Rounds after the first solve each connected component of their LP (rows joined through a
   // shared column) on its own: the parts below exact_below exactly, the others with the
   // first-order solver and their own cap, and an infeasible part's proof blames only the
