@@ -1431,7 +1431,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
         cold_seconds = reference_seconds = ro.reference_seconds = going_on->reference_seconds;
         cold_iterations = reference_iterations = first_iterations = ro.reference_iterations =
             going_on->reference_iterations;
-        spdlog::info("level {}: rounding goes on after round {} from its {} fixings to 1 ({} steps)", l + 1,
+        spdlog::info("level {}: rounding goes on after round {} from its {} fixings to 1 (undo steps: {})", l + 1,
                      going_on->rounds, going_on->ones.size(), going_on->step_count());
       }
       // Where the rounding has got, saved as it goes and kept for a restart (not where
