@@ -1565,14 +1565,17 @@ TEST_CASE("coarse to fine: a run gone on from an attempt of a level in progress 
   CHECK(v4.attempt.report.stuck_restarts == 2);
   CHECK(v4.levels.front().stuck_restarts == 1);
   CHECK(v4.attempt.rounding.ones == marked.attempt.rounding.ones);
-  // The ninth (no steps of the rounding's fixings: one step).
-  marked.attempt.rounding.steps.assign(marked.attempt.rounding.ones.size(), 1);
-  detail::save_checkpoint_as(file, marked, 9);
+  // The ninth (no steps of the rounding's fixings: one step), on a rounding made up for it.
+  LevelCheckpoint stepped = marked;
+  stepped.attempt.rounding = {.columns = 100, .rows = 50, .ones = {3, 7, 9}, .steps = {0, 0, 1}, .rounds = 2};
+  detail::save_checkpoint_as(file, stepped, 9);
   const LevelCheckpoint v9 = load_checkpoint(file);
-  CHECK(v9.attempt.rounding.ones == marked.attempt.rounding.ones);
+  CHECK(v9.attempt.rounding.ones == stepped.attempt.rounding.ones);
   CHECK(v9.attempt.rounding.steps.empty());
-  save_checkpoint(file, marked);
-  CHECK(load_checkpoint(file).attempt.rounding.steps == marked.attempt.rounding.steps);
+  CHECK(v9.attempt.rounding.step_count() == 1);
+  save_checkpoint(file, stepped);
+  CHECK(load_checkpoint(file).attempt.rounding.steps == stepped.attempt.rounding.steps);
+  CHECK(load_checkpoint(file).attempt.rounding.step_count() == 2);
   save_checkpoint(file, marked);
   std::string bytes;
   {
@@ -1601,7 +1604,7 @@ TEST_CASE("coarse to fine: a run gone on from an attempt of a level in progress 
   CHECK(v3.attempt.report.widened_faces == a.report.widened_faces);
   CHECK(v3.attempt.report.stuck_restarts == 0);
   CHECK(v3.levels.back().gamma == last.levels.back().gamma);
-  CHECK_THROWS_AS(detail::save_checkpoint_as(file, marked, 10), InvalidInputError);
+  CHECK_THROWS_AS(detail::save_checkpoint_as(file, marked, 11), InvalidInputError);
 }
 
 TEST_CASE("coarse to fine: a run gone on from a checkpoint inside a rounding fixes its decisions and keeps its bound") {

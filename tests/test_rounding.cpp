@@ -212,10 +212,14 @@ TEST_CASE("rounding: a rounding gone on from decisions with their steps keeps th
   }
   // Steps that do not fit the fixings are refused.
   RoundingOptions wrong = o;
+  wrong.decided = {};
   wrong.start_ones = ones;
   wrong.start_steps = {0};
   CHECK_THROWS_AS(round_to_graph_surface(m.space, m.lp, m.energy, wrong), InvalidInputError);
   wrong.start_steps.assign(ones.size(), -1);
+  CHECK_THROWS_AS(round_to_graph_surface(m.space, m.lp, m.energy, wrong), InvalidInputError);
+  wrong.start_ones.clear();
+  wrong.start_steps = {0};
   CHECK_THROWS_AS(round_to_graph_surface(m.space, m.lp, m.energy, wrong), InvalidInputError);
 }
 

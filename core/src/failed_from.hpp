@@ -12,7 +12,7 @@
 namespace shapematch::detail {
 
 // A hash of a rounding's state: one value per variable (−1 free, 0, 1). Equal states hash equal;
-// others collide with chance 2⁻⁶⁴ per pair, which costs a skipped candidate, not a wrong result.
+// others rarely collide, and a collision costs candidates left out, not a wrong result.
 inline uint64_t state_hash(const std::vector<int8_t>& value) {
   uint64_t h = 0x9e3779b97f4a7c15ull ^ value.size();
   const auto mix = [&](uint64_t w) {

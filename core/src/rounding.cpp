@@ -1214,6 +1214,8 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
   // A partial Γ carried over (start_ones): fixings like any other, which backtracking may trim,
   // one per step of start_steps (or one in all).
   bool carried = false;
+  if (options.start_ones.empty() && !options.start_steps.empty())
+    throw InvalidInputError("rounding: steps of start fixings without the fixings");
   if (!options.start_ones.empty()) {
     for (int64_t j : options.start_ones)
       if (j < 0 || j >= lp.cols()) throw InvalidInputError("rounding: a start fixing names no variable");
@@ -1300,7 +1302,8 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
           if (a.second == 1 && !kept.count(a.first)) blamed_ones.push_back(a.first);
         refuted.insert(blamed_ones.begin(), blamed_ones.end());
         // (the fixer is back at the state the step was made from)
-        if (options.remember_refuted) failed_from.blamed(detail::state_hash(fixer.state().value), blamed_ones);
+        if (options.remember_refuted && !blamed_ones.empty())
+          failed_from.blamed(detail::state_hash(fixer.state().value), blamed_ones);
         smaller = std::move(away_from_proof);
       }
       else shrinkable = shrink_once(smaller);  // (a single variable that cannot be 1 must be 0)
@@ -1480,7 +1483,7 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
   double first_work = 0.0, later_work = 0.0;
   // The fixings to 1 made so far, sorted. Only the decisions: what propagation forced to 1 in
   // this space need not follow in a wider one, and follows from them in this one.
-  // With `steps`, the step of each (parallel; a fixing in two steps, after a release, in its first).
+  // With `steps`, the step of each (parallel; a column in two steps, were there one, in its first).
   const auto decisions = [&](std::vector<int32_t>* steps = nullptr) {
     std::vector<std::pair<int64_t, int32_t>> made;
     for (size_t k = 0; k < history.size(); ++k)

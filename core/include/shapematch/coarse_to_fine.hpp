@@ -188,7 +188,8 @@ struct CoarseToFineOptions {
   // With stuck_after: the first this many times a level's rounding is stuck, it starts again in
   // the same space from its fixings to 1 so far, with its own state afresh (its undo history,
   // refuted fixings, cap scale and warm start: round 1 solves what the fixings leave, cold), as a
-  // run gone on from a rounding checkpoint does; stuck again after that, it widens as above.
+  // run gone on from a rounding checkpoint does, but with its fixings as one step (a checkpoint
+  // keeps their steps since version 10); stuck again after that, it widens as above.
   // Why: FAUST_r 026-029 without WKS at full resolution thrashed for 60 minutes (rounds undone as
   // infeasible, releases, doubled caps) and, gone on from its round-51 checkpoint with that state
   // dropped, finished in 49 rounds and 5:25; a stuck widening solves the whole level again
@@ -444,8 +445,9 @@ struct LevelAttempt {
   // bound (measured on the H200, 17 runs at once: a finest level's rounding takes 100-300 s, which
   // a stop inside it lost). Empty (no rounds) where it had not finished round 1. Not kept: the
   // rounding's own state (undo history, stall and stuck counts, the warm start), which begins
-  // afresh, but for the steps its fixings were made in; and it is not saved where the level's LP
-  // is small enough for alternative thresholds.
+  // afresh (the fixings a proof blamed too, RoundingOptions::remember_refuted), but for the steps
+  // its fixings were made in; and it is not saved where the level's LP is small enough for
+  // alternative thresholds.
   struct Rounding {
     int64_t columns = 0, rows = 0;   // of the attempt's LP, which a run gone on from it checks
     std::vector<int64_t> ones;       // the rounding's fixings to 1 so far (RoundingOptions::decided)

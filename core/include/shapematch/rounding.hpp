@@ -151,7 +151,7 @@ struct RoundingOptions {
   // value per row, e.g. an earlier first LP's dual mapped over; −∞ without it).
   std::vector<int64_t> start_ones;
   // With start_ones: the step of the undo history each was fixed in (parallel to it, as `decided`
-  // gives them), each step then fixed as its own, in order: a run gone on from a checkpoint
+  // gives them), each step then fixed as its own, in the steps' order: a run gone on from a checkpoint
   // undoes its last step first where its LP fails, as the run that saved it would have, rather
   // than trimming all of them as one fixing. Empty: one step.
   std::vector<int32_t> start_steps;
