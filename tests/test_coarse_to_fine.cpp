@@ -1144,6 +1144,8 @@ TEST_CASE("coarse to fine: a stuck rounding starts again from its fixings in the
     CHECK(g.rounds == stuck.rounding.rounds);
     CHECK(g.iterations == stuck.rounding.iterations);
     CHECK(g.ones == stuck.rounding.ones);
+    CHECK(g.steps == stuck.rounding.steps);  // in their undo steps, as a checkpoint keeps them
+    CHECK(g.step_count() > 1);
     CHECK(g.columns == stuck.rounding.columns);
     CHECK(g.lower_bound == stuck.rounding.lower_bound);
     CHECK(saved.front().extra == stuck.extra);

@@ -729,6 +729,7 @@ TEST_CASE("rounding: where the LPs after its fixings keep failing it gives up wi
     CHECK(!e.rows().empty());
     for (int64_t i : e.rows()) CHECK((i >= 1 && i <= 7));  // a' = c and the cycle's rows
     CHECK(e.ones() == std::vector<int64_t>{10, 12});       // b1, b2
+    CHECK(e.steps().size() == e.ones().size());
     CHECK(e.x().size() == size_t(lp.cols()));
     CHECK(e.y().size() == size_t(lp.rows()));
   }

@@ -1558,7 +1558,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
           std::isfinite(first_bound)) {
         ++restarts;
         ++rep.stuck_restarts;
-        restart = rounding_now(s->ones(), {});  // (one step: its history is not at hand)
+        restart = rounding_now(s->ones(), s->steps());
         spdlog::warn("level {}: {}; starting its rounding again from its {} fixings to 1 ({} of {})", l + 1,
                      e.what(), s->ones().size(), restarts, options_.stuck_restarts);
         continue;

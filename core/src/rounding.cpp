@@ -1514,7 +1514,9 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
   };
   // Giving up where the caller can widen (stuck_after): the fixings to 1 so far and the iterate go with it.
   const auto stuck = [&](const std::string& what, std::vector<int64_t> rows) {
-    return StuckError(what, std::move(rows), decisions(), x_full, y_full);
+    std::vector<int32_t> steps;
+    std::vector<int64_t> ones = decisions(&steps);
+    return StuckError(what, std::move(rows), std::move(ones), x_full, y_full, std::move(steps));
   };
   // The round's iterate over the whole LP, the next round's warm start.
   const auto keep_iterate = [&](const Reduced& red, const JoinedSolve& joined) {

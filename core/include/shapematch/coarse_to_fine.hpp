@@ -188,8 +188,8 @@ struct CoarseToFineOptions {
   // With stuck_after: the first this many times a level's rounding is stuck, it starts again in
   // the same space from its fixings to 1 so far, with its own state afresh (its undo history,
   // refuted fixings, cap scale and warm start: round 1 solves what the fixings leave, cold), as a
-  // run gone on from a rounding checkpoint does, but with its fixings as one step (a checkpoint
-  // keeps their steps since version 10); stuck again after that, it widens as above.
+  // run gone on from a rounding checkpoint does (its fixings in their undo steps, as since the
+  // seventy-third session; before, as one step); stuck again after that, it widens as above.
   // Why: FAUST_r 026-029 without WKS at full resolution thrashed for 60 minutes (rounds undone as
   // infeasible, releases, doubled caps) and, gone on from its round-51 checkpoint with that state
   // dropped, finished in 49 rounds and 5:25; a stuck widening solves the whole level again

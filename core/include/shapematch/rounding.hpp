@@ -321,19 +321,23 @@ struct RoundingResult {
 };
 
 // Rounding gave up where the LPs after its fixings kept failing (RoundingOptions::stuck_after):
-// rows() are the failed parts' rows; ones() the fixings to 1 it had made, and x(), y() its last
-// iterate over the whole LP, to go on from in a wider space.
+// rows() are the failed parts' rows; ones() the fixings to 1 it had made and steps() the undo
+// step of each (as RoundingOptions::decided gives them), and x(), y() its last iterate over the
+// whole LP, to go on from in a wider space.
 class StuckError : public InfeasibleError {
 public:
   StuckError(const std::string& what, std::vector<int64_t> rows, std::vector<int64_t> ones, std::vector<double> x,
-             std::vector<double> y)
-      : InfeasibleError(what, std::move(rows)), ones_(std::move(ones)), x_(std::move(x)), y_(std::move(y)) {}
+             std::vector<double> y, std::vector<int32_t> steps = {})
+      : InfeasibleError(what, std::move(rows)), ones_(std::move(ones)), steps_(std::move(steps)), x_(std::move(x)),
+        y_(std::move(y)) {}
   const std::vector<int64_t>& ones() const { return ones_; }
+  const std::vector<int32_t>& steps() const { return steps_; }
   const std::vector<double>& x() const { return x_; }
   const std::vector<double>& y() const { return y_; }
 
 private:
   std::vector<int64_t> ones_;
+  std::vector<int32_t> steps_;
   std::vector<double> x_, y_;
 };
 
