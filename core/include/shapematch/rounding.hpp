@@ -106,9 +106,10 @@ struct RoundingOptions {
   // The fixings to 1 an infeasibility proof blamed are left out of the candidates (while any
   // other remains) at the state they were made from also after undoing earlier fixings took the
   // rounding away from it and back (a state is its variables' values). Without it they were
-  // forgotten there: measured, FAUST_r 043-065 at full resolution (seventy-second session), level
-  // 6's rounding went round one cycle of 17 rounds (the same states, LP iterations and
-  // objectives, the same two candidates fixed by the fallback and blamed) at least four times.
+  // forgotten there: FAUST_r 043-065 at full resolution (a seventy-second session run), level 6's
+  // rounding went round one cycle of 17 rounds (the same states, LP iterations and objectives,
+  // the same two candidates fixed by the fallback and blamed) at least four times
+  // (docs/results-log.md, seventy-third session).
   bool remember_refuted = true;
   // Rounds after the first solve each connected component of their LP (rows joined through a
   // shared column) on its own: the parts below exact_below exactly, the others with the
