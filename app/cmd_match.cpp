@@ -337,8 +337,12 @@ int run_match(const MatchArgs& args) {
                                      r.released)
         : r.undone     ? std::string(" (undone: fixed fewer)")
                        : std::string();
-    spdlog::info("{}round {:>2}: {:>9} variables{}, LP {} in {} it, objective {:.6g}, {}{} ({:.2f} s)", at, r.round,
-                 r.variables, parts, to_string(r.status), r.iterations, r.objective, fixed, undone, r.seconds);
+    const std::string zero_cost =
+        r.later_pretest_seconds > 0.0 ? fmt::format(", {:.2f} s of them at zero cost", r.later_pretest_seconds)
+                                      : std::string();
+    spdlog::info("{}round {:>2}: {:>9} variables{}, LP {} in {} it, objective {:.6g}, {}{} ({:.2f} s{})", at, r.round,
+                 r.variables, parts, to_string(r.status), r.iterations, r.objective, fixed, undone, r.seconds,
+                 zero_cost);
   }, resume ? &*resume : nullptr, checkpointing);
   const MatchingLp& m = c2f.finest;
   const RoundingResult& rr = c2f.rounding;

@@ -1717,6 +1717,9 @@ TEST_CASE("rounding: a later round's parts solved first at zero cost: a proof th
   CHECK(plain.zero == std::vector<bool>{false, true, false});
   // With it: both parts at zero cost, and no costed solve after the clash's proof there.
   CHECK(tested.zero == std::vector<bool>{true, true});
+  // Their seconds are reported apart (only the pre-tests': the re-proof is the costed solve's).
+  CHECK(a.pretest_seconds == 0.0);
+  CHECK(b.pretest_seconds > 0.0);
   // A feasible LP: the same solution, the pre-test's iterations added.
   const LpProblem ok = clash_beside_costs(100.0, true);
   ZeroCostNoting plain_ok, tested_ok;
@@ -1728,6 +1731,8 @@ TEST_CASE("rounding: a later round's parts solved first at zero cost: a proof th
   CHECK(d.r.objective == doctest::Approx(c.r.objective).epsilon(1e-9));
   CHECK(d.r.x == c.r.x);
   CHECK(d.r.iterations > c.r.iterations);
+  CHECK(c.pretest_seconds == 0.0);
+  CHECK(d.pretest_seconds > 0.0);
   CHECK(tested_ok.zero == std::vector<bool>{true, true, false, false});
 }
 

@@ -444,6 +444,7 @@ JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpS
       spdlog::debug("rounding: a part of {} variables at zero cost: {} in {} iterations ({:.2f} s)", plp.cols(),
                     to_string(z.status), z.iterations, z.seconds);
       pretested[k] = z.iterations;
+      out.pretest_seconds += z.seconds;
       r.iterations = std::max(r.iterations, z.iterations);
       if (z.status != LpStatus::Infeasible) {
         // (A time limit depends on what is left of the run's time, not on the part.)
@@ -1741,6 +1742,7 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
     info.objective = r.objective + lp.objective_scale * red.fixed_cost;
     info.feasibility_iterations = pretest_iterations;
     info.feasibility_seconds = pretest_seconds;
+    info.later_pretest_seconds = joined.pretest_seconds;
     if (round == 1) {  // in the units of the full LP: add what propagation fixed to 1 before it
       first_seconds = options.reference_seconds > 0.0 ? options.reference_seconds : clock.seconds() - pretest_seconds;
       first_iterations = options.reference_iterations > 0 ? options.reference_iterations : r.iterations;

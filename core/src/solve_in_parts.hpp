@@ -45,6 +45,7 @@ struct JoinedSolve {
   // where it ended (NaN: no first-order part).
   double start_weight = 0.0;
   double end_weight = std::numeric_limits<double>::quiet_NaN();
+  double pretest_seconds = 0.0;  // of the zero-cost pre-tests (`pretest`), all parts together
 };
 // The exact solver's results on the parts of the last call, for the next one: a part whose LP has
 // not changed since (no fixing reached it) gets its result again instead of a new solve. The

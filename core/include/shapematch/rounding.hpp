@@ -302,6 +302,10 @@ struct RoundingRound {
   // in iterations and seconds.
   int64_t feasibility_iterations = 0;
   double feasibility_seconds = 0.0;
+  // Of a later round's seconds, those of its parts' zero-cost pre-tests
+  // (RoundingOptions::later_feasibility_iterations): measured, FAUST_r 043-065's level 6 spent 79 %
+  // of its end game's seconds there (docs/results-log.md, seventy-third session).
+  double later_pretest_seconds = 0.0;
   bool undone = false;         // the fixing made the LP infeasible and was replaced by a smaller one
   int64_t searched_parts = 0;  // parts finished by search (search_below); iterations: its nodes
   bool search = false;         // finished by search (search_below), not by an LP
