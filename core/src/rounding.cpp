@@ -1215,15 +1215,13 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
   // A partial Γ carried over (start_ones): fixings like any other, which backtracking may trim,
   // one per step of start_steps (or one in all).
   bool carried = false;
-  if (options.start_ones.empty() && !options.start_steps.empty())
-    throw InvalidInputError("rounding: steps of start fixings without the fixings");
+  const std::vector<int32_t>& steps = options.start_steps;
+  if (!steps.empty() && (steps.size() != options.start_ones.size() ||
+                         std::any_of(steps.begin(), steps.end(), [](int32_t k) { return k < 0; })))
+    throw InvalidInputError("rounding: the start fixings' steps do not fit them");
   if (!options.start_ones.empty()) {
     for (int64_t j : options.start_ones)
       if (j < 0 || j >= lp.cols()) throw InvalidInputError("rounding: a start fixing names no variable");
-    const std::vector<int32_t>& steps = options.start_steps;
-    if (!steps.empty() && (steps.size() != options.start_ones.size() ||
-                           std::any_of(steps.begin(), steps.end(), [](int32_t k) { return k < 0; })))
-      throw InvalidInputError("rounding: the start fixings' steps do not fit them");
     std::map<int32_t, std::vector<std::pair<int64_t, int>>> batches;  // by step, in order
     for (size_t k = 0; k < options.start_ones.size(); ++k)
       batches[steps.empty() ? 0 : steps[k]].push_back({options.start_ones[k], 1});
@@ -1484,8 +1482,8 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
   double first_work = 0.0, later_work = 0.0;
   // The fixings to 1 made so far, sorted. Only the decisions: what propagation forced to 1 in
   // this space need not follow in a wider one, and follows from them in this one.
-  // With `steps`, the step of each (parallel; a column in two steps, were there one, in its first).
-  const auto decisions = [&](std::vector<int32_t>* steps = nullptr) {
+  // `steps` gets the step of each (parallel; a column in two steps, were there one, in its first).
+  const auto decisions = [&](std::vector<int32_t>& steps) {
     std::vector<std::pair<int64_t, int32_t>> made;
     for (size_t k = 0; k < history.size(); ++k)
       for (const auto& a : history[k].batch)
@@ -1495,10 +1493,10 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
                made.end());
     std::vector<int64_t> ones;
     ones.reserve(made.size());
-    if (steps) steps->clear();
+    steps.clear();
     for (const auto& [j, k] : made) {
       ones.push_back(j);
-      if (steps) steps->push_back(k);
+      steps.push_back(k);
     }
     return ones;
   };
@@ -1509,14 +1507,14 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
     if (progress) progress(info);
     if (options.decided) {
       std::vector<int32_t> steps;
-      const std::vector<int64_t> ones = decisions(&steps);
+      const std::vector<int64_t> ones = decisions(steps);
       options.decided(info, ones, steps, result.first_lp.lower_bound);
     }
   };
   // Giving up where the caller can widen (stuck_after): the fixings to 1 so far and the iterate go with it.
   const auto stuck = [&](const std::string& what, std::vector<int64_t> rows) {
     std::vector<int32_t> steps;
-    std::vector<int64_t> ones = decisions(&steps);
+    std::vector<int64_t> ones = decisions(steps);
     return StuckError(what, std::move(rows), std::move(ones), x_full, y_full, std::move(steps));
   };
   // The round's iterate over the whole LP, the next round's warm start.
