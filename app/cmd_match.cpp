@@ -55,6 +55,7 @@ struct MatchArgs {
   int64_t feasibility_first = RoundingOptions{}.feasibility_iterations;
   int64_t feasibility_later = RoundingOptions{}.later_feasibility_iterations;
   double feasibility_tol = RoundingOptions{}.feasibility_tolerance;
+  int64_t feasibility_skip_below = RoundingOptions{}.later_feasibility_skip_below;
   int release_after_trims = RoundingOptions{}.release_after_trims;
   double tolerance = 1e-4;
   double coarse_tolerance = CoarseToFineOptions{}.coarse_tolerance;
@@ -269,6 +270,7 @@ int run_match(const MatchArgs& args) {
   ro.feasibility_iterations = args.feasibility_first;
   ro.later_feasibility_iterations = args.feasibility_later;
   ro.feasibility_tolerance = args.feasibility_tol;
+  ro.later_feasibility_skip_below = args.feasibility_skip_below;
   ro.release_after_trims = args.release_after_trims;
   ro.lp.tolerance = args.tolerance;
   ro.lp.time_limit = args.time_limit;
@@ -722,6 +724,11 @@ Action add_match_command(CLI::App& app) {
   app.add_option("--feasibility-later", a->feasibility_later,
                  "in the later rounds, solve each part PDHG would solve without costs first for at most N "
                  "iterations: an infeasible one is proved there (0: off)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  app.add_option("--feasibility-skip-below", a->feasibility_skip_below,
+                 "with --feasibility-later, run each part's costed solve first for N iterations: a part optimal "
+                 "by then skips its zero-cost solve (0: every part has it first)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   app.add_option("--feasibility-tol", a->feasibility_tol,

@@ -1685,11 +1685,13 @@ public:
     zero.push_back(std::all_of(lp.c.begin(), lp.c.end(), [](double c) { return c == 0.0; }));
     tolerance.push_back(params.tolerance);
     warm.push_back(!params.initial_x.empty());
+    cap.push_back(params.max_iterations);
     return inner->solve(lp, params);
   }
   std::unique_ptr<LpSolver> inner = make_solver("pdhg-cpu");
   std::vector<bool> zero, warm;
   std::vector<double> tolerance;
+  std::vector<int64_t> cap;
 };
 }  // namespace
 
@@ -1734,6 +1736,47 @@ TEST_CASE("rounding: a later round's parts solved first at zero cost: a proof th
   CHECK(c.pretest_seconds == 0.0);
   CHECK(d.pretest_seconds > 0.0);
   CHECK(tested_ok.zero == std::vector<bool>{true, true, false, false});
+}
+
+TEST_CASE("rounding: a later round's parts optimal within their first iterations skip the pre-test") {
+  SolverParams params;
+  params.tolerance = 1e-6;
+  params.threads = 1;
+  params.max_iterations = 100000;
+  const auto joined = [&](const LpProblem& lp, ZeroCostNoting& solver, int64_t skip_below) {
+    return detail::solve_in_parts(lp, params, solver, nullptr, 0, params, true, {}, nullptr, nullptr, {}, 10.0,
+                                  {1000, 0.0, nullptr, skip_below});
+  };
+  // A feasible LP in two parts, each optimal well within 5 000 iterations: no zero-cost solve at
+  // all, and the results of the solves without the pre-test, iterate for iterate.
+  const LpProblem ok = clash_beside_costs(100.0, true);
+  ZeroCostNoting none, tested, quick;
+  const detail::JoinedSolve c = detail::solve_in_parts(ok, params, none, nullptr, 0, params, true);
+  const detail::JoinedSolve d = joined(ok, quick, 5000);
+  REQUIRE(c.r.status == LpStatus::Optimal);
+  REQUIRE(d.r.status == LpStatus::Optimal);
+  CHECK(quick.zero == std::vector<bool>{false, false});
+  CHECK(quick.cap == std::vector<int64_t>{5000, 5000});
+  CHECK(d.r.x == c.r.x);
+  CHECK(d.r.iterations == c.r.iterations);
+  CHECK(d.pretest_seconds == 0.0);
+  // Neither part optimal in its first 8 iterations: both pre-tested, then each costed solve goes
+  // on from its first iterations' point (warm) for the rest of the cap, to the same optimum.
+  const detail::JoinedSolve e = joined(ok, tested, 8);
+  REQUIRE(e.r.status == LpStatus::Optimal);
+  CHECK(tested.zero == std::vector<bool>{false, false, true, true, false, false});
+  CHECK(tested.cap[0] == 8);
+  CHECK(tested.cap[4] == params.max_iterations - 8);
+  CHECK(tested.warm[4]);
+  CHECK(e.r.objective == doctest::Approx(c.r.objective).epsilon(1e-5));
+  CHECK(e.pretest_seconds > 0.0);
+  // An infeasible part among them is still proved at zero cost, and nothing runs after.
+  const LpProblem clash = clash_beside_costs(100.0);
+  ZeroCostNoting failing;
+  const detail::JoinedSolve f = joined(clash, failing, 8);
+  CHECK(f.r.status == LpStatus::Infeasible);
+  CHECK(f.failed_rows == std::vector<int64_t>{0, 1, 2});
+  CHECK(failing.zero == std::vector<bool>{false, false, true, true});
 }
 
 TEST_CASE("rounding: the later pre-test's own tolerance: a part within the LP's tolerance of feasible is proved "

@@ -418,11 +418,44 @@ JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpS
     return solve_at_zero_cost(zero, p, solver);
   };
   std::vector<int64_t> pretested(parts.size(), 0);  // iterations, added to the part's costed solve
-  if (pretest.iterations > 0 && solver.name().rfind("pdhg", 0) == 0) {
+  // Part k's first-order parameters: `params` with the part's slice of the warm start (in `own`;
+  // `params` itself for the whole LP) and its ω.
+  const auto first_order_params = [&](size_t k, SolverParams& own) -> const SolverParams& {
+    const double w = weighted ? part_weight(*warm_weight, parts[k].cols) : 0.0;
+    if (whole) {
+      if (w > 0.0) params.initial_primal_weight = w;
+      return params;
+    }
+    own = params;
+    if (w > 0.0) own.initial_primal_weight = w;
+    if (!warm_x.empty()) {
+      for (int64_t j : parts[k].cols) own.initial_x.push_back(warm_x[j]);
+      for (int64_t i : parts[k].rows) own.initial_y.push_back(warm_y[i]);
+    }
+    return own;
+  };
+  const bool first_order_pretest = pretest.iterations > 0 && solver.name().rfind("pdhg", 0) == 0;
+  // With pretest.skip_below: each part's costed solve first, up to that many iterations; one
+  // optimal by then needs no pre-test (its result stands), the others go on from there after it.
+  std::vector<std::optional<LpResult>> quick(parts.size());
+  if (first_order_pretest && pretest.skip_below > 0)
+    for (size_t k = 0; k < parts.size(); ++k) {
+      const LpProblem& plp = whole ? lp : parts[k].lp;
+      if (exact && plp.cols() < below) continue;
+      SolverParams own;
+      SolverParams q = first_order_params(k, own);
+      if (q.max_iterations <= pretest.skip_below) continue;
+      q.max_iterations = pretest.skip_below;
+      quick[k] = solver.solve(plp, q);
+      spdlog::debug("rounding: a part of {} variables, its first {} iterations: {} ({:.2f} s)", plp.cols(),
+                    pretest.skip_below, to_string(quick[k]->status), quick[k]->seconds);
+    }
+  if (first_order_pretest) {
     std::vector<PretestCache::Entry> fresh;  // this call's new verdicts short of a proof, for the next calls
     for (size_t k = 0; k < parts.size(); ++k) {
       const LpProblem& plp = whole ? lp : parts[k].lp;
       if (exact && plp.cols() < below) continue;
+      if (quick[k] && quick[k]->status == LpStatus::Optimal) continue;
       SolverParams zp = pretest_params(params, pretest.iterations, pretest.tolerance);
       if (weighted) zp.initial_primal_weight = part_weight(*warm_weight, parts[k].cols);
       PretestCache::Key key;
@@ -477,25 +510,31 @@ JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpS
     // The first-order solver's parameters: `params` with the part's slice of the warm start (made
     // only where that solver runs).
     SolverParams own;
-    auto first_order = [&]() -> const SolverParams& {
-      const double w = weighted ? part_weight(*warm_weight, part.cols) : 0.0;
-      if (whole) {
-        if (w > 0.0) params.initial_primal_weight = w;
-        return params;
-      }
-      own = params;
-      if (w > 0.0) own.initial_primal_weight = w;
-      if (!warm_x.empty()) {
-        for (int64_t j : part.cols) own.initial_x.push_back(warm_x[j]);
-        for (int64_t i : part.rows) own.initial_y.push_back(warm_y[i]);
-      }
-      return own;
-    };
+    auto first_order = [&]() -> const SolverParams& { return first_order_params(k, own); };
     double asked = 0.0;  // the ω this part's first-order solve was asked to start from
     auto first_order_solve = [&]() {
       const SolverParams& p = first_order();
       asked = p.initial_primal_weight;
-      LpResult costed = solver.solve(plp, p);
+      LpResult costed;
+      if (!quick[k]) {
+        costed = solver.solve(plp, p);
+      } else if (quick[k]->status != LpStatus::IterationLimit || quick[k]->x.size() != size_t(plp.cols()) ||
+                 quick[k]->y.size() != size_t(plp.rows())) {
+        costed = std::move(*quick[k]);  // optimal (or ended otherwise) in its first iterations
+      } else {
+        // On from where the first iterations left it (its restarts' state aside).
+        const LpResult& q = *quick[k];
+        SolverParams rest = p;
+        rest.initial_x = q.x;
+        rest.initial_y = q.y;
+        if (std::isfinite(q.primal_weight) && q.primal_weight > 0.0) rest.initial_primal_weight = q.primal_weight;
+        rest.max_iterations = std::max<int64_t>(p.max_iterations - q.iterations, 1);
+        rest.time_limit -= q.seconds;
+        costed = solver.solve(plp, rest);
+        costed.iterations += q.iterations;
+        costed.seconds += q.seconds;
+      }
+      quick[k].reset();
       costed.iterations += pretested[k];
       return costed;
     };
@@ -1692,7 +1731,8 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
                               options.exact_below, exact_params, options.split_parts,
                               {options.exact_pivots_per_column, options.exact_part_seconds}, &exact_cache, &warm_weight, options.slow_part,
                               options.slow_part_seconds,
-                              {options.later_feasibility_iterations, options.feasibility_tolerance, &pretest_cache});
+                              {options.later_feasibility_iterations, options.feasibility_tolerance, &pretest_cache,
+                               options.later_feasibility_skip_below});
     }
     const LpResult& r = joined.r;
     // Round 1's iterate over the whole LP, for first_iterate and (an optimum) for the alternatives.

@@ -27,6 +27,8 @@ namespace shapematch::detail {
 // there, the join is infeasible with those parts' certificates, and nothing else is solved.
 // `pretest.tolerance` also governs the re-proof at zero cost of a part the costed solve proved
 // infeasible (even with the pre-test off); `pretest.cache` keeps its verdicts (PretestCache).
+// With `pretest.skip_below` > 0 each such part's costed solve runs that many iterations first: a
+// part optimal by then is not pre-tested, the others' costed solves go on from there after it.
 struct JoinedSolve {
   LpResult r;
   std::vector<double> proof;
@@ -113,6 +115,9 @@ struct ZeroCostPretest {
   int64_t iterations = 0;
   double tolerance = 0.0;  // 0: the solve's own
   PretestCache* cache = nullptr;
+  // > 0: each part's costed solve runs first for at most this many iterations; a part optimal by
+  // then is not pre-tested (RoundingOptions::later_feasibility_skip_below).
+  int64_t skip_below = 0;
 };
 
 // A fingerprint of an LP's constraints (sizes, rows of A, b): equal for equal constraints.
