@@ -56,6 +56,7 @@ struct MatchArgs {
   int64_t feasibility_later = RoundingOptions{}.later_feasibility_iterations;
   double feasibility_tol = RoundingOptions{}.feasibility_tolerance;
   int64_t feasibility_skip_below = RoundingOptions{}.later_feasibility_skip_below;
+  double feasibility_skip_residual = RoundingOptions{}.later_feasibility_skip_residual;
   int release_after_trims = RoundingOptions{}.release_after_trims;
   double tolerance = 1e-4;
   double coarse_tolerance = CoarseToFineOptions{}.coarse_tolerance;
@@ -271,6 +272,7 @@ int run_match(const MatchArgs& args) {
   ro.later_feasibility_iterations = args.feasibility_later;
   ro.feasibility_tolerance = args.feasibility_tol;
   ro.later_feasibility_skip_below = args.feasibility_skip_below;
+  ro.later_feasibility_skip_residual = args.feasibility_skip_residual;
   ro.release_after_trims = args.release_after_trims;
   ro.lp.tolerance = args.tolerance;
   ro.lp.time_limit = args.time_limit;
@@ -729,6 +731,11 @@ Action add_match_command(CLI::App& app) {
   app.add_option("--feasibility-skip-below", a->feasibility_skip_below,
                  "with --feasibility-later, run each part's costed solve first for N iterations: a part optimal "
                  "by then skips its zero-cost solve (0: every part has it first)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  app.add_option("--feasibility-skip-residual", a->feasibility_skip_residual,
+                 "with --feasibility-skip-below: skip the zero-cost solve only where the costed one ended with its "
+                 "relative primal residual at most this (0: any)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   app.add_option("--feasibility-tol", a->feasibility_tol,

@@ -1760,6 +1760,16 @@ TEST_CASE("rounding: a later round's parts optimal within their first iterations
   CHECK(d.r.x == c.r.x);
   CHECK(d.r.iterations == c.r.iterations);
   CHECK(d.pretest_seconds == 0.0);
+  // Optimal, but not within a residual bound only an exact point reaches (q's one-row part has
+  // one): the other part pre-tested all the same, and the first iterations' results stand.
+  ZeroCostNoting strict;
+  const detail::JoinedSolve g = detail::solve_in_parts(ok, params, strict, nullptr, 0, params, true, {}, nullptr,
+                                                       nullptr, {}, 10.0, {1000, 0.0, nullptr, 5000, 1e-300});
+  REQUIRE(g.r.status == LpStatus::Optimal);
+  CHECK(std::count(strict.zero.begin(), strict.zero.end(), true) >= 1);
+  CHECK(std::count(strict.zero.begin(), strict.zero.end(), false) == 2);
+  CHECK(g.r.x == c.r.x);
+  CHECK(g.pretest_seconds > 0.0);
   // Neither part optimal in its first 8 iterations: both pre-tested, then each costed solve goes
   // on from its first iterations' point (warm) for the rest of the cap, to the same optimum.
   const detail::JoinedSolve e = joined(ok, tested, 8);

@@ -455,7 +455,9 @@ JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpS
     for (size_t k = 0; k < parts.size(); ++k) {
       const LpProblem& plp = whole ? lp : parts[k].lp;
       if (exact && plp.cols() < below) continue;
-      if (quick[k] && quick[k]->status == LpStatus::Optimal) continue;
+      if (quick[k] && quick[k]->status == LpStatus::Optimal &&
+          (pretest.skip_residual <= 0.0 || quick[k]->primal_residual <= pretest.skip_residual))
+        continue;
       SolverParams zp = pretest_params(params, pretest.iterations, pretest.tolerance);
       if (weighted) zp.initial_primal_weight = part_weight(*warm_weight, parts[k].cols);
       PretestCache::Key key;
@@ -1732,7 +1734,7 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
                               {options.exact_pivots_per_column, options.exact_part_seconds}, &exact_cache, &warm_weight, options.slow_part,
                               options.slow_part_seconds,
                               {options.later_feasibility_iterations, options.feasibility_tolerance, &pretest_cache,
-                               options.later_feasibility_skip_below});
+                               options.later_feasibility_skip_below, options.later_feasibility_skip_residual});
     }
     const LpResult& r = joined.r;
     // Round 1's iterate over the whole LP, for first_iterate and (an optimum) for the alternatives.

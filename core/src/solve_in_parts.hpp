@@ -118,6 +118,8 @@ struct ZeroCostPretest {
   // > 0: each part's costed solve runs first for at most this many iterations; a part optimal by
   // then is not pre-tested (RoundingOptions::later_feasibility_skip_below).
   int64_t skip_below = 0;
+  // … and only where its relative primal residual is at most this (0: any optimal one).
+  double skip_residual = 0.0;
 };
 
 // A fingerprint of an LP's constraints (sizes, rows of A, b): equal for equal constraints.

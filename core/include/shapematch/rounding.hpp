@@ -207,6 +207,14 @@ struct RoundingOptions {
   // none blaming earlier rounds (docs/results-log.md, seventy-fourth session). An infeasible LP
   // pays the first iterations (1-2 s there) before its proof.
   int64_t later_feasibility_skip_below = 512;
+  // … and only where that solve's relative primal residual is at most this (0: any optimal one).
+  // At `tol` 3e-3 a part can end optimal in 64 iterations from its warm start with 2.7e-3, and
+  // FAUST_r 043-065's run that skipped two such rounds' pre-tests had its LPs fail round after
+  // round soon after and released 372 fixings (not shown to be those rounds' doing). With 1e-3 the
+  // same 12 minutes from the same checkpoint went 34 rounds (452 k free variables) against 91
+  // (290 k), on the same path: in those 32 rounds no pre-test it let run proved anything
+  // (docs/results-log.md, seventy-fourth session). Hence 0.
+  double later_feasibility_skip_residual = 0.0;
   // The tolerance of the zero-cost solves: both pre-tests, and the re-proof of a part the costed
   // solve proved infeasible (0: the LP's own). At zero cost PDHG's "optimal" says only that the
   // relative residual is under it; at full resolution 3e-3 of 1 + |b| let parts through that had
