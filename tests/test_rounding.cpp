@@ -1686,12 +1686,15 @@ public:
     tolerance.push_back(params.tolerance);
     warm.push_back(!params.initial_x.empty());
     cap.push_back(params.max_iterations);
-    return inner->solve(lp, params);
+    cols.push_back(lp.cols());
+    LpResult r = inner->solve(lp, params);
+    iterations.push_back(r.iterations);
+    return r;
   }
   std::unique_ptr<LpSolver> inner = make_solver("pdhg-cpu");
   std::vector<bool> zero, warm;
   std::vector<double> tolerance;
-  std::vector<int64_t> cap;
+  std::vector<int64_t> cap, cols, iterations;
 };
 }  // namespace
 
@@ -1760,14 +1763,15 @@ TEST_CASE("rounding: a later round's parts optimal within their first iterations
   CHECK(d.r.x == c.r.x);
   CHECK(d.r.iterations == c.r.iterations);
   CHECK(d.pretest_seconds == 0.0);
-  // Optimal, but not within a residual bound only an exact point reaches (q's one-row part has
-  // one): the other part pre-tested all the same, and the first iterations' results stand.
+  // Optimal, but not within a residual bound of 1e-12: the clash rows' part ends at a point within
+  // rounding error of exact, q's one-row part about 1e-7 away, so q's part alone is pre-tested,
+  // and the first iterations' results stand.
   ZeroCostNoting strict;
   const detail::JoinedSolve g = detail::solve_in_parts(ok, params, strict, nullptr, 0, params, true, {}, nullptr,
-                                                       nullptr, {}, 10.0, {1000, 0.0, nullptr, 5000, 1e-300});
+                                                       nullptr, {}, 10.0, {1000, 0.0, nullptr, 5000, 1e-12});
   REQUIRE(g.r.status == LpStatus::Optimal);
-  CHECK(std::count(strict.zero.begin(), strict.zero.end(), true) >= 1);
-  CHECK(std::count(strict.zero.begin(), strict.zero.end(), false) == 2);
+  CHECK(strict.zero == std::vector<bool>{false, false, true});
+  CHECK(strict.cols == std::vector<int64_t>{4, 2, 2});
   CHECK(g.r.x == c.r.x);
   CHECK(g.pretest_seconds > 0.0);
   // Neither part optimal in its first 8 iterations: both pre-tested, then each costed solve goes
@@ -1779,14 +1783,28 @@ TEST_CASE("rounding: a later round's parts optimal within their first iterations
   CHECK(tested.cap[4] == params.max_iterations - 8);
   CHECK(tested.warm[4]);
   CHECK(e.r.objective == doctest::Approx(c.r.objective).epsilon(1e-5));
+  // A part's iterations: its first ones, its pre-test's and the rest; the join's, the larger part's.
+  REQUIRE(tested.iterations.size() == 6);
+  const std::vector<int64_t>& its = tested.iterations;
+  CHECK(e.r.iterations == std::max(its[0] + its[2] + its[4], its[1] + its[3] + its[5]));
   CHECK(e.pretest_seconds > 0.0);
-  // An infeasible part among them is still proved at zero cost, and nothing runs after.
+  // An infeasible part not proved in its first iteration is still proved at zero cost, and
+  // nothing runs after.
   const LpProblem clash = clash_beside_costs(100.0);
   ZeroCostNoting failing;
-  const detail::JoinedSolve f = joined(clash, failing, 8);
+  const detail::JoinedSolve f = joined(clash, failing, 1);
   CHECK(f.r.status == LpStatus::Infeasible);
   CHECK(f.failed_rows == std::vector<int64_t>{0, 1, 2});
   CHECK(failing.zero == std::vector<bool>{false, false, true, true});
+  // One its first 8 iterations prove infeasible (the clash's costs are small) skips its pre-test:
+  // its costed proof stands, proved again at zero cost for the clash alone, and q's part, pre-tested,
+  // goes on as before.
+  ZeroCostNoting proved;
+  const detail::JoinedSolve h = joined(clash, proved, 8);
+  CHECK(h.r.status == LpStatus::Infeasible);
+  CHECK(h.failed_rows == std::vector<int64_t>{0, 1, 2});
+  CHECK(proved.zero == std::vector<bool>{false, false, true, true, false});
+  CHECK(proved.cols == std::vector<int64_t>{4, 2, 2, 4, 2});
 }
 
 TEST_CASE("rounding: the later pre-test's own tolerance: a part within the LP's tolerance of feasible is proved "

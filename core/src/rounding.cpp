@@ -435,37 +435,52 @@ JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpS
     return own;
   };
   const bool first_order_pretest = pretest.iterations > 0 && solver.name().rfind("pdhg", 0) == 0;
-  // With pretest.skip_below: each part's costed solve first, up to that many iterations; one
+  // Part k's pre-test parameters, and its key in the pre-test's cache.
+  const auto pretest_of = [&](size_t k) {
+    const LpProblem& plp = whole ? lp : parts[k].lp;
+    SolverParams zp = pretest_params(params, pretest.iterations, pretest.tolerance);
+    if (weighted) zp.initial_primal_weight = part_weight(*warm_weight, parts[k].cols);
+    PretestCache::Key key;
+    if (pretest.cache)
+      key = {constraint_fingerprint(plp), plp.rows(),      plp.cols(), plp.nonzeros(), zp.max_iterations,
+             zp.tolerance,                 zp.initial_primal_weight};
+    return std::pair{zp, key};
+  };
+  const auto in_cache = [&](const PretestCache::Key& key) {
+    return std::find_if(pretest.cache->entries.begin(), pretest.cache->entries.end(),
+                        [&](const PretestCache::Entry& e) { return e.key == key; });
+  };
+  // With pretest.skip_below: each part's costed solve first, for at most that many iterations; one
   // optimal by then needs no pre-test (its result stands), the others go on from there after it.
+  // (Not a part the cache already passes: split in two, its solve would only lose its restarts.)
   std::vector<std::optional<LpResult>> quick(parts.size());
   if (first_order_pretest && pretest.skip_below > 0)
     for (size_t k = 0; k < parts.size(); ++k) {
       const LpProblem& plp = whole ? lp : parts[k].lp;
       if (exact && plp.cols() < below) continue;
+      if (pretest.cache && in_cache(pretest_of(k).second) != pretest.cache->entries.end()) continue;
       SolverParams own;
       SolverParams q = first_order_params(k, own);
       if (q.max_iterations <= pretest.skip_below) continue;
       q.max_iterations = pretest.skip_below;
       quick[k] = solver.solve(plp, q);
       spdlog::debug("rounding: a part of {} variables, its first {} iterations: {} ({:.2f} s)", plp.cols(),
-                    pretest.skip_below, to_string(quick[k]->status), quick[k]->seconds);
+                    quick[k]->iterations, to_string(quick[k]->status), quick[k]->seconds);
     }
   if (first_order_pretest) {
     std::vector<PretestCache::Entry> fresh;  // this call's new verdicts short of a proof, for the next calls
     for (size_t k = 0; k < parts.size(); ++k) {
       const LpProblem& plp = whole ? lp : parts[k].lp;
       if (exact && plp.cols() < below) continue;
-      if (quick[k] && quick[k]->status == LpStatus::Optimal &&
-          (pretest.skip_residual <= 0.0 || quick[k]->primal_residual <= pretest.skip_residual))
+      // Optimal in its first iterations (within the residual bound), or proved infeasible there
+      // (its costed proof stands; proved again at zero cost below for the clash alone).
+      if (quick[k] && ((quick[k]->status == LpStatus::Optimal &&
+                        (pretest.skip_residual <= 0.0 || quick[k]->primal_residual <= pretest.skip_residual)) ||
+                       quick[k]->status == LpStatus::Infeasible))
         continue;
-      SolverParams zp = pretest_params(params, pretest.iterations, pretest.tolerance);
-      if (weighted) zp.initial_primal_weight = part_weight(*warm_weight, parts[k].cols);
-      PretestCache::Key key;
+      auto [zp, key] = pretest_of(k);
       if (pretest.cache) {
-        key = {constraint_fingerprint(plp), plp.rows(),      plp.cols(), plp.nonzeros(), zp.max_iterations,
-               zp.tolerance,                 zp.initial_primal_weight};
-        auto it = std::find_if(pretest.cache->entries.begin(), pretest.cache->entries.end(),
-                               [&](const PretestCache::Entry& e) { return e.key == key; });
+        auto it = in_cache(key);
         if (it != pretest.cache->entries.end()) {
           spdlog::debug("rounding: a part of {} variables unchanged since its pre-test, which did not prove it "
                         "infeasible: not tested again",
@@ -498,6 +513,9 @@ JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpS
       pretest.cache->entries.insert(pretest.cache->entries.end(), fresh.begin(), fresh.end());
     }
     if (infeasible) {
+      // (The first iterations of the parts that had them count too.)
+      for (size_t k = 0; k < parts.size(); ++k)
+        if (quick[k]) r.iterations = std::max(r.iterations, quick[k]->iterations + pretested[k]);
       r.status = LpStatus::Infeasible;
       r.objective = std::numeric_limits<double>::quiet_NaN();
       spdlog::debug("LP in {} independent parts: proved infeasible at zero cost, no costed solve", parts.size());
@@ -525,10 +543,10 @@ JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpS
         costed = std::move(*quick[k]);  // optimal (or ended otherwise) in its first iterations
       } else {
         // On from where the first iterations left it (its restarts' state aside).
-        const LpResult& q = *quick[k];
+        LpResult& q = *quick[k];
         SolverParams rest = p;
-        rest.initial_x = q.x;
-        rest.initial_y = q.y;
+        rest.initial_x = std::move(q.x);
+        rest.initial_y = std::move(q.y);
         if (std::isfinite(q.primal_weight) && q.primal_weight > 0.0) rest.initial_primal_weight = q.primal_weight;
         rest.max_iterations = std::max<int64_t>(p.max_iterations - q.iterations, 1);
         rest.time_limit -= q.seconds;

@@ -27,8 +27,10 @@ namespace shapematch::detail {
 // there, the join is infeasible with those parts' certificates, and nothing else is solved.
 // `pretest.tolerance` also governs the re-proof at zero cost of a part the costed solve proved
 // infeasible (even with the pre-test off); `pretest.cache` keeps its verdicts (PretestCache).
-// With `pretest.skip_below` > 0 each such part's costed solve runs that many iterations first: a
-// part optimal by then is not pre-tested, the others' costed solves go on from there after it.
+// With `pretest.skip_below` > 0 each such part (with a larger cap, and not passed by the cache)
+// has its costed solve first, for at most that many iterations: a part optimal by then (within
+// `pretest.skip_residual` where > 0) or proved infeasible there is not pre-tested and that result
+// stands; one at that iteration limit is pre-tested and its costed solve goes on from there.
 struct JoinedSolve {
   LpResult r;
   std::vector<double> proof;

@@ -196,9 +196,10 @@ struct RoundingOptions {
   // proves infeasible pay both, and feasible rounds about 40 s. Hence 0: off.
   int64_t later_feasibility_iterations = 0;
   // With later_feasibility_iterations: each part's costed solve runs first for at most this many
-  // iterations, from the round's warm start; a part optimal by then skips its pre-test (its result
-  // stands), the others are pre-tested and their costed solve goes on from there (0: pre-test
-  // every part first). Why: late in a full-resolution rounding most feasible rounds' costed
+  // iterations, from the round's warm start (where its cap is larger, and the pre-test's cache
+  // does not pass it anyway); a part optimal by then skips its pre-test (its result stands), the
+  // others are pre-tested and their costed solve goes on from there (0: pre-test every part
+  // first). Why: late in a full-resolution rounding most feasible rounds' costed
   // solves end in 64-400 iterations from the warm start, while their pre-tests ran to the cap
   // (7 808 iterations, 22-50 s; a feasible LP at zero cost does not converge to 1e-5 there), 79-97 %
   // of the rounding's time. Measured on FAUST_r 043-065 without WKS, level 6 from one checkpoint
