@@ -198,24 +198,18 @@ struct RoundingOptions {
   // With later_feasibility_iterations: each part's costed solve runs first for at most this many
   // iterations, from the round's warm start (where its cap is larger, and the pre-test's cache
   // does not pass it anyway); a part optimal by then skips its pre-test (its result stands), the
-  // others are pre-tested and their costed solve goes on from there (0: pre-test every part
-  // first). Why: late in a full-resolution rounding most feasible rounds' costed
-  // solves end in 64-400 iterations from the warm start, while their pre-tests ran to the cap
-  // (7 808 iterations, 22-50 s; a feasible LP at zero cost does not converge to 1e-5 there), 79-97 %
-  // of the rounding's time. Measured on FAUST_r 043-065 without WKS, level 6 from one checkpoint
-  // (476 k free variables), 12 minutes side by side: 101 rounds against 48, 283 k free variables
-  // against 471 k, 13 143 fixings to 1 against 12 663, no more failed rounds (31 against 32) and
-  // none blaming earlier rounds (docs/results-log.md, seventy-fourth session). An infeasible LP
-  // pays the first iterations (1-2 s there) before its proof.
-  int64_t later_feasibility_skip_below = 512;
+  // others are pre-tested and their costed solve goes on from there. 0: off, every part pre-tested
+  // first. Why off: it skips the test where it is needed. Measured on FAUST_r 043-065 without WKS,
+  // level 6 from one checkpoint (476 k free variables), 12 minutes side by side: with 512, 101
+  // rounds against 48 and 283 k free variables against 471 k; but its round 89 took an LP as
+  // optimal in 64 iterations (relative residual 2.64e-3, under `tol` 3e-3) that the pre-test,
+  // run on the same state from its checkpoint, proved infeasible in 3 712 iterations, and the
+  // rounds after it fixed on from an infeasible LP (docs/results-log.md, seventy-fourth session).
+  int64_t later_feasibility_skip_below = 0;
   // … and only where that solve's relative primal residual is at most this (0: any optimal one).
-  // At `tol` 3e-3 a part can end optimal in 64 iterations from its warm start with 2.7e-3, and
-  // FAUST_r 043-065's run that skipped two such rounds' pre-tests had its LPs fail round after
-  // round soon after and released 372 fixings (not shown to be those rounds' doing). With 1e-3 the
-  // same 12 minutes from the same checkpoint went 34 rounds (452 k free variables) against 91
-  // (290 k), on the same path: in those 32 rounds no pre-test it let run proved anything
-  // (docs/results-log.md, seventy-fourth session). Hence 0.
-  double later_feasibility_skip_residual = 0.0;
+  // The LP above ended at 2.64e-3; from the same checkpoint 1e-3 kept the 512 run's path for 32
+  // rounds (no pre-test it let run proved anything there) at 34 rounds in 12 minutes against 91.
+  double later_feasibility_skip_residual = 1e-3;
   // The tolerance of the zero-cost solves: both pre-tests, and the re-proof of a part the costed
   // solve proved infeasible (0: the LP's own). At zero cost PDHG's "optimal" says only that the
   // relative residual is under it; at full resolution 3e-3 of 1 + |b| let parts through that had
