@@ -435,16 +435,18 @@ JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpS
     return own;
   };
   const bool first_order_pretest = pretest.iterations > 0 && solver.name().rfind("pdhg", 0) == 0;
-  // Part k's pre-test parameters, and its key in the pre-test's cache.
+  // Part k's pre-test parameters, and its key in the pre-test's cache (its fingerprint, a pass
+  // over the part's rows, taken once per part).
+  std::vector<std::optional<PretestCache::Key>> keys(parts.size());
   const auto pretest_of = [&](size_t k) {
     const LpProblem& plp = whole ? lp : parts[k].lp;
     SolverParams zp = pretest_params(params, pretest.iterations, pretest.tolerance);
     if (weighted) zp.initial_primal_weight = part_weight(*warm_weight, parts[k].cols);
-    PretestCache::Key key;
-    if (pretest.cache)
-      key = {constraint_fingerprint(plp), plp.rows(),      plp.cols(), plp.nonzeros(), zp.max_iterations,
-             zp.tolerance,                 zp.initial_primal_weight};
-    return std::pair{zp, key};
+    if (pretest.cache && !keys[k])
+      keys[k] = PretestCache::Key{constraint_fingerprint(plp), plp.rows(),    plp.cols(),
+                                  plp.nonzeros(),              zp.max_iterations, zp.tolerance,
+                                  zp.initial_primal_weight};
+    return std::pair{zp, keys[k].value_or(PretestCache::Key{})};
   };
   const auto in_cache = [&](const PretestCache::Key& key) {
     return std::find_if(pretest.cache->entries.begin(), pretest.cache->entries.end(),
