@@ -57,6 +57,7 @@ struct MatchArgs {
   double feasibility_tol = RoundingOptions{}.feasibility_tolerance;
   int64_t feasibility_skip_below = RoundingOptions{}.later_feasibility_skip_below;
   double feasibility_skip_residual = RoundingOptions{}.later_feasibility_skip_residual;
+  double feasibility_skip_row = RoundingOptions{}.later_feasibility_skip_row;
   int release_after_trims = RoundingOptions{}.release_after_trims;
   double tolerance = 1e-4;
   double coarse_tolerance = CoarseToFineOptions{}.coarse_tolerance;
@@ -273,6 +274,7 @@ int run_match(const MatchArgs& args) {
   ro.feasibility_tolerance = args.feasibility_tol;
   ro.later_feasibility_skip_below = args.feasibility_skip_below;
   ro.later_feasibility_skip_residual = args.feasibility_skip_residual;
+  ro.later_feasibility_skip_row = args.feasibility_skip_row;
   ro.release_after_trims = args.release_after_trims;
   ro.lp.tolerance = args.tolerance;
   ro.lp.time_limit = args.time_limit;
@@ -736,6 +738,11 @@ Action add_match_command(CLI::App& app) {
   app.add_option("--feasibility-skip-residual", a->feasibility_skip_residual,
                  "with --feasibility-skip-below: skip the zero-cost solve only where the costed one ended with its "
                  "relative primal residual at most this (0: any)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  app.add_option("--feasibility-skip-row", a->feasibility_skip_row,
+                 "with --feasibility-skip-below: skip the zero-cost solve only where the costed one ended with no "
+                 "row off by more than this (0: any)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   app.add_option("--feasibility-tol", a->feasibility_tol,

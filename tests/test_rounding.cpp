@@ -1774,6 +1774,20 @@ TEST_CASE("rounding: a later round's parts optimal within their first iterations
   CHECK(strict.cols == std::vector<int64_t>{4, 2, 2});
   CHECK(g.r.x == c.r.x);
   CHECK(g.pretest_seconds > 0.0);
+  // The same by the bound in a row alone (no relative bound): q's part, about 1e-7 off in its
+  // row, is pre-tested under 1e-12 and not under 1e-3.
+  ZeroCostNoting row_strict, row_loose;
+  const detail::JoinedSolve rs = detail::solve_in_parts(ok, params, row_strict, nullptr, 0, params, true, {}, nullptr,
+                                                       nullptr, {}, 10.0, {1000, 0.0, nullptr, 5000, 0.0, 1e-12});
+  const detail::JoinedSolve rl = detail::solve_in_parts(ok, params, row_loose, nullptr, 0, params, true, {}, nullptr,
+                                                       nullptr, {}, 10.0, {1000, 0.0, nullptr, 5000, 0.0, 1e-3});
+  REQUIRE(rs.r.status == LpStatus::Optimal);
+  REQUIRE(rl.r.status == LpStatus::Optimal);
+  CHECK(row_strict.zero == std::vector<bool>{false, false, true});
+  CHECK(row_strict.cols == std::vector<int64_t>{4, 2, 2});
+  CHECK(row_loose.zero == std::vector<bool>{false, false});
+  CHECK(rs.r.x == c.r.x);
+  CHECK(rl.r.x == c.r.x);
   // Neither part optimal in its first 8 iterations: both pre-tested, then each costed solve goes
   // on from its first iterations' point (warm) for the rest of the cap, to the same optimum.
   const detail::JoinedSolve e = joined(ok, tested, 8);

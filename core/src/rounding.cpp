@@ -466,8 +466,10 @@ JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpS
       if (q.max_iterations <= pretest.skip_below) continue;
       q.max_iterations = pretest.skip_below;
       quick[k] = solver.solve(plp, q);
-      spdlog::debug("rounding: a part of {} variables, its first {} iterations: {} ({:.2f} s)", plp.cols(),
-                    quick[k]->iterations, to_string(quick[k]->status), quick[k]->seconds);
+      spdlog::debug("rounding: a part of {} variables, its first {} iterations: {} ({:.2f} s; residual {:.3g} "
+                    "relative, {:.3g} in a row)",
+                    plp.cols(), quick[k]->iterations, to_string(quick[k]->status), quick[k]->seconds,
+                    quick[k]->primal_residual, quick[k]->row_residual);
     }
   if (first_order_pretest) {
     std::vector<PretestCache::Entry> fresh;  // this call's new verdicts short of a proof, for the next calls
@@ -476,8 +478,10 @@ JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpS
       if (exact && plp.cols() < below) continue;
       // Optimal in its first iterations (within the residual bound), or proved infeasible there
       // (its costed proof stands; proved again at zero cost below for the clash alone).
+      // (A row residual that is NaN, none computed, does not pass its bound.)
       if (quick[k] && ((quick[k]->status == LpStatus::Optimal &&
-                        (pretest.skip_residual <= 0.0 || quick[k]->primal_residual <= pretest.skip_residual)) ||
+                        (pretest.skip_residual <= 0.0 || quick[k]->primal_residual <= pretest.skip_residual) &&
+                        (pretest.skip_row <= 0.0 || quick[k]->row_residual <= pretest.skip_row)) ||
                        quick[k]->status == LpStatus::Infeasible))
         continue;
       auto [zp, key] = pretest_of(k);
@@ -1754,7 +1758,8 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
                               {options.exact_pivots_per_column, options.exact_part_seconds}, &exact_cache, &warm_weight, options.slow_part,
                               options.slow_part_seconds,
                               {options.later_feasibility_iterations, options.feasibility_tolerance, &pretest_cache,
-                               options.later_feasibility_skip_below, options.later_feasibility_skip_residual});
+                               options.later_feasibility_skip_below, options.later_feasibility_skip_residual,
+                               options.later_feasibility_skip_row});
     }
     const LpResult& r = joined.r;
     // Round 1's iterate over the whole LP, for first_iterate and (an optimum) for the alternatives.

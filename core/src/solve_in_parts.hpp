@@ -29,7 +29,7 @@ namespace shapematch::detail {
 // infeasible (even with the pre-test off); `pretest.cache` keeps its verdicts (PretestCache).
 // With `pretest.skip_below` > 0 each such part (with a larger cap, and not passed by the cache)
 // has its costed solve first, for at most that many iterations: a part optimal by then (within
-// `pretest.skip_residual` where > 0) or proved infeasible there is not pre-tested and that result
+// `pretest.skip_residual` and `pretest.skip_row` where > 0) or proved infeasible there is not pre-tested and that result
 // stands; one at that iteration limit is pre-tested and its costed solve goes on from there.
 struct JoinedSolve {
   LpResult r;
@@ -120,8 +120,11 @@ struct ZeroCostPretest {
   // > 0: each part's costed solve runs first for at most this many iterations; a part optimal by
   // then is not pre-tested (RoundingOptions::later_feasibility_skip_below).
   int64_t skip_below = 0;
-  // … and only where its relative primal residual is at most this (0: any optimal one).
+  // … and only where its relative primal residual is at most this (0: any optimal one)
   double skip_residual = 0.0;
+  // … and its largest violation of a row, ‖Ax−b‖∞, at most this (0: any; the skip's own bound,
+  // RoundingOptions::later_feasibility_skip_row).
+  double skip_row = 0.0;
 };
 
 // A fingerprint of an LP's constraints (sizes, rows of A, b): equal for equal constraints.
