@@ -701,7 +701,9 @@ Action add_match_command(CLI::App& app) {
                  "(0: the single largest)")
       ->check(CLI::Range(0.0, 1.0))
       ->capture_default_str();
-  app.add_option("--max-rounds", a->max_rounds, "rounding rounds before giving up")->capture_default_str();
+  app.add_option("--max-rounds", a->max_rounds,
+                 "rounding rounds that bring its free variables to no new low, before giving up (rounds that do "
+                 "are progress and not counted)")->capture_default_str();
   app.add_flag("--converged-first", a->converged_first,
                "in a later round whose LP stopped at its iteration cap in some parts, fix only from the parts that "
                "converged; the others go on from their iterate one round more");

@@ -1045,7 +1045,7 @@ TEST_CASE("coarse to fine: a stuck rounding widens around its failed parts and g
   // elsewhere, the widened LP then solved again for a certified bound. Off, running out of
   // rounds widens too, as an infeasible LP (not counted as stuck).
   CoarseToFineOptions o = slow_finest_rounding();
-  o.rounding.max_rounds = 3;
+  o.rounding.max_total_rounds = 3;
   // Measured with the whole batch fixed where no candidate stands away: with only an eighth of
   // it (the default since the fifty-second session) none of the stuck rounding's fixings to 1 lies
   // where the widened space keeps it (0 of 69 carried).
@@ -1108,7 +1108,7 @@ TEST_CASE("coarse to fine: a stuck rounding starts again from its fixings in the
   // Measured: it finishes one round after the restart, in the ring-0 space it was stuck in, at
   // energy 11.86 against 6.93 after the widening (which is why it is off by default).
   CoarseToFineOptions o = slow_finest_rounding();
-  o.rounding.max_rounds = 3;
+  o.rounding.max_total_rounds = 3;
   o.price_widenings = 0;
   o.stuck_after = 1e-12;
   o.rounding.alternative_thresholds = {};  // (with them a rounding is neither saved nor restarted)
@@ -1705,7 +1705,7 @@ TEST_CASE("coarse to fine: with lookahead_drop_stuck a chain stuck inside lookah
   });
   REQUIRE(saved.size() == 1);
   REQUIRE(saved[0].chains.size() == 2);
-  o.rounding.max_rounds = 1;
+  o.rounding.max_total_rounds = 1;
   const CoarseToFineMatcher once(dx, dy, o);
   const CoarseToFineResult plain = once.run({}, &saved[0]);
   REQUIRE(plain.levels.size() == 5);

@@ -459,7 +459,7 @@ TEST_CASE("rounding: where the first rounding fails after an optimal round 1, th
   o.first_iterate = [&](const std::vector<double>&, const std::vector<double>&, double) {
     throw SolverError("the first rounding gives up (test)");
   };
-  o.max_rounds = 1;
+  o.max_total_rounds = 1;
   try {
     (void)round_to_graph_surface(m.space, m.lp, m.energy, o);
     FAIL("expected the first rounding's error");
@@ -488,6 +488,27 @@ TEST_CASE("rounding: round 1 stops at its own cap, rounds from its iterate, and 
   // An unconverged dual still gives a valid (weaker) bound.
   CHECK(capped.lower_bound <= full.first_lp.objective * (1 + 1e-3));
   CHECK(capped.lower_bound <= capped.energy);
+}
+
+TEST_CASE("rounding: max_rounds counts the rounds that bring no new low of free variables, max_total_rounds all") {
+  const MatchingLp& m = dolphin_ball_60();
+  RoundingOptions o;
+  o.solver = "pdhg-cpu";
+  o.lp.tolerance = 1e-3;
+  o.alternative_thresholds = {};
+  const RoundingResult plain = round_to_graph_surface(m.space, m.lp, m.energy, o);
+  // Every round of this rounding leaves fewer free variables than any before it.
+  REQUIRE(plain.rounds.size() >= 3);
+  for (size_t i = 1; i < plain.rounds.size(); ++i) REQUIRE(plain.rounds[i].variables < plain.rounds[i - 1].variables);
+  // So one round without a new low is enough for it; two rounds in all are not.
+  o.max_rounds = 1;
+  const RoundingResult one = round_to_graph_surface(m.space, m.lp, m.energy, o);
+  CHECK(one.gamma == plain.gamma);
+  CHECK(one.rounds.size() == plain.rounds.size());
+  o.max_total_rounds = 2;
+  CHECK_THROWS_AS(round_to_graph_surface(m.space, m.lp, m.energy, o), InfeasibleError);
+  o.max_total_rounds = static_cast<int>(plain.rounds.size());
+  CHECK(round_to_graph_surface(m.space, m.lp, m.energy, o).gamma == plain.gamma);
 }
 
 TEST_CASE("rounding: limits end in an error, never a wrong answer") {

@@ -1595,18 +1595,27 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
       for (int64_t j : red.cols) w_full[j] = r.primal_weight;
     }
   };
-  for (int round = 1, forward = 0; fixer.state().unsatisfied > 0; ++round) {
+  // Rounds that went forward (fixed, or searched) and those after which the free variables stood at
+  // a new low: max_rounds counts the first without the second (RoundingOptions::max_rounds).
+  for (int round = 1, forward = 0, lows = 0; fixer.state().unsatisfied > 0; ++round) {
+    Stopwatch clock;
+    Reduced red = reduce(lp, fixer.state());  // (round 1's costs are set aside for its pre-test)
+    const bool new_low = red.lp.cols() < fewest_free;
+    if (new_low && round > 1) ++lows;
     // Out of rounds: no binary solution found in this space. An InfeasibleError with the open
     // rows lets coarse to fine widen there rather than give up the whole run.
-    if (forward >= options.max_rounds) {
-      const std::string what = "rounding did not reach a binary solution in " + std::to_string(options.max_rounds) +
-                               " rounds (raise --max-rounds or lower --threshold)";
+    const bool idle_out = forward - lows >= options.max_rounds;
+    if (idle_out || (options.max_total_rounds > 0 && forward >= options.max_total_rounds)) {
+      const std::string what =
+          idle_out ? "rounding did not reach a binary solution: " + std::to_string(options.max_rounds) +
+                         " of its rounds brought no new low of free variables (raise --max-rounds or lower "
+                         "--threshold)"
+                   : "rounding did not reach a binary solution in " + std::to_string(options.max_total_rounds) +
+                         " rounds";
       if (options.stuck_after > 0.0) throw stuck(what, fixer.unsatisfied_rows());
       throw InfeasibleError(what, fixer.unsatisfied_rows());
     }
-    Stopwatch clock;
-    Reduced red = reduce(lp, fixer.state());  // (round 1's costs are set aside for its pre-test)
-    if (red.lp.cols() < fewest_free) {
+    if (new_low) {
       fewest_free = red.lp.cols();
       stalled = 0;
       since_low.reset();
