@@ -1039,7 +1039,7 @@ TEST_CASE("coarse to fine: a run gone on from inside a level of lookahead goes o
 }
 
 TEST_CASE("coarse to fine: a stuck rounding widens around its failed parts and goes on from its fixings") {
-  // Measured: with max_rounds 3 and a wide greedy margin (few fixings per round), this pair's
+  // Measured: with max_total_rounds 3 and a wide greedy margin (few fixings per round), this pair's
   // finest rounding (ring 0) runs out of rounds with a few faces open. Stuck (stuck_after), it
   // widens there and solves the level again: afresh, or (stuck_carry) from the fixings to 1
   // elsewhere, the widened LP then solved again for a certified bound. Off, running out of

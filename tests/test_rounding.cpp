@@ -500,12 +500,12 @@ TEST_CASE("rounding: max_rounds counts the rounds that bring no new low of free 
   // Every round of this rounding leaves fewer free variables than any before it.
   REQUIRE(plain.rounds.size() >= 3);
   for (size_t i = 1; i < plain.rounds.size(); ++i) REQUIRE(plain.rounds[i].variables < plain.rounds[i - 1].variables);
-  // So one round without a new low is enough for it; two rounds in all are not.
+  // So one round without a new low is enough for it; one round fewer than it made, in all, is not.
   o.max_rounds = 1;
   const RoundingResult one = round_to_graph_surface(m.space, m.lp, m.energy, o);
   CHECK(one.gamma == plain.gamma);
   CHECK(one.rounds.size() == plain.rounds.size());
-  o.max_total_rounds = 2;
+  o.max_total_rounds = static_cast<int>(plain.rounds.size()) - 1;
   CHECK_THROWS_AS(round_to_graph_surface(m.space, m.lp, m.energy, o), InfeasibleError);
   o.max_total_rounds = static_cast<int>(plain.rounds.size());
   CHECK(round_to_graph_surface(m.space, m.lp, m.energy, o).gamma == plain.gamma);
@@ -695,6 +695,33 @@ TEST_CASE("rounding: an infeasible LP after a fixing undoes only the fixings its
   int infeasible = 0;
   for (const auto& k : r.rounds) infeasible += k.status == LpStatus::Infeasible;
   CHECK(infeasible == 1);
+}
+
+TEST_CASE("rounding: max_rounds runs out on the rounds after a trim, which bring no new low") {
+  // cycle_behind_a_fixing: round 2's LP is infeasible and trims round 1's fixing, so the rounds
+  // after it start with more free variables than round 2 had. At the start of each round the
+  // rounds that went forward before it (their LP not infeasible) less those that brought a new
+  // low (up to it, round 1 aside) are what max_rounds bounds: the rounding needs one more than
+  // their peak, and runs out at the peak itself.
+  const RoundingResult plain = round_cycle({});
+  int forward = 0, lows = 0, peak = 0;
+  int64_t fewest = std::numeric_limits<int64_t>::max();
+  for (size_t k = 0; k < plain.rounds.size(); ++k) {
+    const RoundingRound& round = plain.rounds[k];
+    REQUIRE(round.status != LpStatus::IterationLimit);  // (no round undone on a suspicion)
+    if (round.variables < fewest) {
+      fewest = round.variables;
+      lows += k > 0;
+    }
+    peak = std::max(peak, forward - lows);
+    forward += round.status != LpStatus::Infeasible;
+  }
+  REQUIRE(peak >= 1);  // rounds without a new low happened
+  RoundingOptions o;
+  o.max_rounds = peak + 1;
+  CHECK(round_cycle(o).gamma == plain.gamma);
+  o.max_rounds = peak;
+  CHECK_THROWS_AS(round_cycle(o), InfeasibleError);
 }
 
 TEST_CASE("rounding: a search right after a fixing whose LP has no solution leaves it to the LP round, not a release") {

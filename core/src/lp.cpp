@@ -106,7 +106,8 @@ void evaluate_solution(const LpProblem& p, LpResult& r) {
     for (int64_t i = 0; i < p.rows(); ++i) {
       res += (ax[i] - p.b[i]) * (ax[i] - p.b[i]);
       nb += p.b[i] * p.b[i];
-      worst = std::max(worst, std::abs(ax[i] - p.b[i]));
+      const double off = std::abs(ax[i] - p.b[i]);
+      if (!(off <= worst)) worst = off;  // a NaN stays (std::max would drop it and pass a bound)
     }
     for (int64_t j = 0; j < p.cols(); ++j) cx += p.c[j] * r.x[j];
     r.primal_residual = std::sqrt(res) / (1.0 + std::sqrt(nb));

@@ -1601,7 +1601,8 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
     Stopwatch clock;
     Reduced red = reduce(lp, fixer.state());  // (round 1's costs are set aside for its pre-test)
     const bool new_low = red.lp.cols() < fewest_free;
-    if (new_low && round > 1) ++lows;
+    // (Not the round after a release, whose "low" is only the reset: releases are bounded apart.)
+    if (new_low && round > 1 && fewest_free != std::numeric_limits<int64_t>::max()) ++lows;
     // Out of rounds: no binary solution found in this space. An InfeasibleError with the open
     // rows lets coarse to fine widen there rather than give up the whole run.
     const bool idle_out = forward - lows >= options.max_rounds;

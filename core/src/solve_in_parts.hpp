@@ -29,8 +29,9 @@ namespace shapematch::detail {
 // infeasible (even with the pre-test off); `pretest.cache` keeps its verdicts (PretestCache).
 // With `pretest.skip_below` > 0 each such part (with a larger cap, and not passed by the cache)
 // has its costed solve first, for at most that many iterations: a part optimal by then (within
-// `pretest.skip_residual` and `pretest.skip_row` where > 0) or proved infeasible there is not pre-tested and that result
-// stands; one at that iteration limit is pre-tested and its costed solve goes on from there.
+// `pretest.skip_residual` and `pretest.skip_row` where > 0) or proved infeasible there is not
+// pre-tested and that result stands; one at that iteration limit is pre-tested and its costed
+// solve goes on from there.
 struct JoinedSolve {
   LpResult r;
   std::vector<double> proof;

@@ -13,16 +13,18 @@ struct RoundingRound;
 
 struct RoundingOptions {
   double threshold = 0.5;      // fix every variable above this to 1
-  // Rounds that fix (or search) without bringing the free variables to a new low, at most; then
-  // fail (InfeasibleError, naming the open rows) rather than return a wrong answer. Rounds that
-  // do are progress and not counted: counted all, 200 ended a level-5 rounding of TOSCA_r
-  // cat2-cat9 (full resolution, cheap rounds with --feasibility-skip-below) in 3 minutes while it
+  // Rounds that go forward (fix, search, or wait on a part at its cap) without bringing the free
+  // variables to a new low, at most; then fail (InfeasibleError, naming the open rows) rather
+  // than return a wrong answer. Rounds that do are progress and not counted: counted all, 200
+  // ended a level-5 rounding of TOSCA_r cat2-cat9 (full resolution, cheap rounds with
+  // --feasibility-later and --feasibility-skip-below) in 2.5 minutes while it
   // went from 641 k free variables to 268 k one fixing a round, and coarse to fine widened to
   // 11.3 M variables; not counted, the level finished 239 rounds after (docs/results-log.md,
   // seventy-fifth session).
   int max_rounds = 50;
-  // Rounds that fix (or search) in all, at most, new lows or not; then fail as above (0: no limit).
-  // A budget for a bounded run, not a sign of being stuck.
+  // Rounds that go forward in all, at most, new lows or not; then fail as above (0: no limit). A
+  // budget for a bounded run (library callers and tests; no command-line flag), not a sign of
+  // being stuck.
   int max_total_rounds = 0;
   // Rounds after the first with fewer free variables than this use Clp's dual simplex: exact,
   // and a vertex, so most of it is already 0/1 (0: never). The first-order solver's approximate
@@ -208,21 +210,29 @@ struct RoundingOptions {
   // iterations, from the round's warm start (where its cap is larger, and the pre-test's cache
   // does not pass it anyway); a part optimal by then skips its pre-test (its result stands), the
   // others are pre-tested and their costed solve goes on from there. 0: off, every part pre-tested
-  // first. Why off: it skips the test where it is needed. Measured on FAUST_r 043-065 without WKS,
-  // level 6 from one checkpoint (476 k free variables), 12 minutes side by side: with 512, 101
-  // rounds against 48 and 283 k free variables against 471 k; but its round 89 took an LP as
-  // optimal in 64 iterations (relative residual 2.64e-3, under `tol` 3e-3) that the pre-test,
-  // run on the same state from its checkpoint, proved infeasible in 3 712 iterations, and the
-  // rounds after it fixed on from an infeasible LP (docs/results-log.md, seventy-fourth session).
-  int64_t later_feasibility_skip_below = 0;
+  // first. Measured on FAUST_r 043-065 without WKS, level 6 from one checkpoint (476 k free
+  // variables), 12 minutes side by side: with 512, 101 rounds against 48 and 283 k free variables
+  // against 471 k; but its round 89 took an LP as optimal in 64 iterations (relative residual
+  // 2.64e-3, under `tol` 3e-3) that the pre-test, run on the same state from its checkpoint,
+  // proved infeasible in 3 712 iterations (seventy-fourth session): hence the bound in a row
+  // below. With it, TOSCA_r cat2-cat9 (WKS, --feasibility-later 8192 --feasibility-tol 1e-5
+  // --exact-below 10000) from a checkpoint in level 5's rounding (641 k free variables; rounds of
+  // 12-19 s, 11-18 s of them the pre-tests): level 5 finished in 239
+  // rounds (2:43) and level 6 in 49 rounds after its first LPs, the pair's first full-resolution
+  // Γ, where every part pre-tested first was at 445 k free variables after 15 minutes
+  // (docs/results-log.md, seventy-fifth session).
+  int64_t later_feasibility_skip_below = 512;
   // … and only where that solve's relative primal residual is at most this (0: any optimal one).
   // The LP above ended at 2.64e-3; from the same checkpoint 1e-3 kept the 512 run's path for 32
-  // rounds (no pre-test it let run proved anything there) at 34 rounds in 12 minutes against 91.
-  double later_feasibility_skip_residual = 1e-3;
+  // rounds (no pre-test it let run proved anything there) at 34 rounds in 12 minutes against 91:
+  // 0, the bound in a row does that job.
+  double later_feasibility_skip_residual = 0.0;
   // … and only where that solve's largest violation of a row (‖Ax−b‖∞, LpResult::row_residual)
   // is at most this (0: any). The LP above ended 0.034 off in a row; rounding's costed solves of
   // feasible LPs at full resolution ended at most 0.018 off, most 0.002-0.006 (467 solves,
   // seventy-second session): a bound in a row tells what the relative one could not at 3e-3.
+  // On cat2-cat9 above, 554 first-iteration solves ended optimal, 4 of them 0.021-0.024 off (each
+  // pre-tested, none proved infeasible), the others at most 0.014.
   double later_feasibility_skip_row = 0.02;
   // The tolerance of the zero-cost solves: both pre-tests, and the re-proof of a part the costed
   // solve proved infeasible (0: the LP's own). At zero cost PDHG's "optimal" says only that the
@@ -240,7 +250,7 @@ struct RoundingOptions {
   // made so far, so that the caller can widen the space there and solve again, afresh or from
   // them (coarse to fine does). Measured, FAUST_r 020-021 at full resolution: trimming the last
   // fixing, and releasing the fixings around the failed part, both ran for 15+ minutes
-  // (docs/results-log.md). Running out of rounds (max_rounds) then ends in a StuckError too. 0: never
+  // (docs/results-log.md). Running out of rounds (max_rounds, max_total_rounds) then ends in a StuckError too. 0: never
   // (rounding goes on as before).
   double stuck_after = 0.0;
   int stuck_rounds = 4;
