@@ -1595,8 +1595,8 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
       for (int64_t j : red.cols) w_full[j] = r.primal_weight;
     }
   };
-  // Rounds that went forward (fixed, or searched) and those after which the free variables stood at
-  // a new low: max_rounds counts the first without the second (RoundingOptions::max_rounds).
+  // Rounds that went forward (fixed, searched or waited) and those after which the free variables
+  // stood at a new low: max_rounds counts the first without the second (RoundingOptions::max_rounds).
   for (int round = 1, forward = 0, lows = 0; fixer.state().unsatisfied > 0; ++round) {
     Stopwatch clock;
     Reduced red = reduce(lp, fixer.state());  // (round 1's costs are set aside for its pre-test)
