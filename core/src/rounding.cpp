@@ -471,19 +471,21 @@ JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpS
                     plp.cols(), quick[k]->iterations, to_string(quick[k]->status), quick[k]->seconds,
                     quick[k]->primal_residual, quick[k]->row_residual);
     }
+  // Optimal in its first iterations within the residual bounds (a NaN, none computed, passes
+  // none), or proved infeasible there (its costed proof stands; proved again at zero cost below
+  // for the clash alone).
+  const auto skips_pretest = [&](const LpResult& q) {
+    if (q.status == LpStatus::Infeasible) return true;
+    return q.status == LpStatus::Optimal &&
+           (pretest.skip_residual <= 0.0 || q.primal_residual <= pretest.skip_residual) &&
+           (pretest.skip_row <= 0.0 || q.row_residual <= pretest.skip_row);
+  };
   if (first_order_pretest) {
     std::vector<PretestCache::Entry> fresh;  // this call's new verdicts short of a proof, for the next calls
     for (size_t k = 0; k < parts.size(); ++k) {
       const LpProblem& plp = whole ? lp : parts[k].lp;
       if (exact && plp.cols() < below) continue;
-      // Optimal in its first iterations (within the residual bound), or proved infeasible there
-      // (its costed proof stands; proved again at zero cost below for the clash alone).
-      // (A row residual that is NaN, none computed, does not pass its bound.)
-      if (quick[k] && ((quick[k]->status == LpStatus::Optimal &&
-                        (pretest.skip_residual <= 0.0 || quick[k]->primal_residual <= pretest.skip_residual) &&
-                        (pretest.skip_row <= 0.0 || quick[k]->row_residual <= pretest.skip_row)) ||
-                       quick[k]->status == LpStatus::Infeasible))
-        continue;
+      if (quick[k] && skips_pretest(*quick[k])) continue;
       auto [zp, key] = pretest_of(k);
       if (pretest.cache) {
         auto it = in_cache(key);
