@@ -528,6 +528,15 @@ int run_match(const MatchArgs& args) {
                               .set("feasibility_first", args.feasibility_first)
                               .set("feasibility_later", args.feasibility_later)
                               .set("feasibility_tol", args.feasibility_tol)
+                              .set("feasibility_skip_below", args.feasibility_skip_below)
+                              .set("feasibility_skip_residual", args.feasibility_skip_residual)
+                              .set("feasibility_skip_row", args.feasibility_skip_row)
+                              // Since the seventy-fifth session --max-rounds counts only the
+                              // rounds without a new low of free variables; say so, so that
+                              // reports from before and after can be told apart.
+                              .set("max_rounds", args.max_rounds)
+                              .set("max_rounds_counts", "rounds without a new low")
+                              .set("time_limit", args.time_limit)
                               .set("release_after_trims", args.release_after_trims)
                               .set("split_parts", !args.whole_lp)
                               .set("tolerance", args.tolerance)
@@ -548,6 +557,7 @@ int run_match(const MatchArgs& args) {
                               .set("surface_parents", args.hierarchy.surface_parents)
                               .set("level_ratio", args.hierarchy.ratio)
                               .set("ring", args.ring)
+                              .set("max_ring", args.max_ring)
                               .set("coarse_ring", args.coarse_ring)
                               .set("coarse_ring_faces", args.coarse_ring_faces)
                               .set("neighbourhood", args.neighbourhood)

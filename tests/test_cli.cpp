@@ -299,6 +299,10 @@ TEST_CASE("cli: match writes a verified, complete output directory, or nothing")
   CHECK(json_number(report, "untangle_rings") == 24);  // the defaults reach the report
   CHECK(json_number(report, "untangle_max_shift") == doctest::Approx(1e-3));
   CHECK(json_number(report, "release_after_trims") == shapematch::RoundingOptions{}.release_after_trims);
+  CHECK(json_number(report, "max_rounds") == shapematch::RoundingOptions{}.max_rounds);
+  CHECK(report.find("\"max_rounds_counts\": \"rounds without a new low\"") != std::string::npos);
+  CHECK(json_number(report, "feasibility_skip_row") == shapematch::RoundingOptions{}.later_feasibility_skip_row);
+  CHECK(report.find("\"time_limit\": null") != std::string::npos);  // none
   // One level of 30 faces: rounded with 0.5, and again with the default alternative 0.7.
   CHECK(json_number(report, "roundings") == 2);
 
@@ -317,11 +321,18 @@ TEST_CASE("cli: match writes a verified, complete output directory, or nothing")
   // --close-pockets reaches the rounding and the report (no pocket at 30 faces; the repair
   // itself is tested in test_rounding).
   const fs::path closed = out.string() + "_pockets";
-  r = run("match --faces 30 --backend cpu --close-pockets -o " + closed.string());
+  r = run("match --faces 30 --backend cpu --close-pockets --max-rounds 9 --feasibility-skip-row 0.05 "
+          "--feasibility-skip-below 64 --max-ring 4 -o " +
+          closed.string());
   REQUIRE(r.code == 0);
   std::ifstream fc(closed / "report.json");
   const std::string with((std::istreambuf_iterator<char>(fc)), {});
   CHECK(with.find("\"close_pockets\": true") != std::string::npos);
+  // The rounding's and the widening's caps reach the report as given.
+  CHECK(json_number(with, "max_rounds") == 9);
+  CHECK(json_number(with, "feasibility_skip_row") == doctest::Approx(0.05));
+  CHECK(json_number(with, "feasibility_skip_below") == 64);
+  CHECK(json_number(with, "max_ring") == 4);
   CHECK(json_number(with, "pockets_closed") >= 0);
   CHECK(with.find("\"verified\": true") != std::string::npos);
   fs::remove_all(closed);

@@ -1769,9 +1769,12 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
                               options.exact_below, exact_params, options.split_parts,
                               {options.exact_pivots_per_column, options.exact_part_seconds}, &exact_cache, &warm_weight, options.slow_part,
                               options.slow_part_seconds,
-                              {options.later_feasibility_iterations, options.feasibility_tolerance, &pretest_cache,
-                               options.later_feasibility_skip_below, options.later_feasibility_skip_residual,
-                               options.later_feasibility_skip_row});
+                              {.iterations = options.later_feasibility_iterations,
+                               .tolerance = options.feasibility_tolerance,
+                               .cache = &pretest_cache,
+                               .skip_below = options.later_feasibility_skip_below,
+                               .skip_residual = options.later_feasibility_skip_residual,
+                               .skip_row = options.later_feasibility_skip_row});
     }
     const LpResult& r = joined.r;
     // Round 1's iterate over the whole LP, for first_iterate and (an optimum) for the alternatives.
