@@ -204,8 +204,12 @@ struct RoundingOptions {
   // (sixtieth session). Measured there with 2 048 (sixty-ninth session): three rounds proved in
   // 1 344-1 408 iterations (33-38 s against 40-140), one LP proved that the costed solve had left
   // at its cap; but parts within the tolerance of feasible at zero cost that the costed solve then
-  // proves infeasible pay both, and feasible rounds about 40 s. Hence 0: off.
-  int64_t later_feasibility_iterations = 0;
+  // proves infeasible pay both, and feasible rounds about 40 s. The skip below (a part whose
+  // costed solve ends optimal first is not pre-tested) took that cost away: with both, TOSCA_r
+  // cat2-cat9 and horse0-horse5 finished level 5's full-resolution rounding in 2-16 minutes, and at
+  // 3 000 faces three pairs ended within 0.7 % in energy and 0.0001 in mean error of the run
+  // without (docs/results-log.md, seventy-fifth and seventy-sixth sessions). Hence on: 8 192.
+  int64_t later_feasibility_iterations = 8192;
   // With later_feasibility_iterations: each part's costed solve runs first for at most this many
   // iterations, from the round's warm start (where its cap is larger, and the pre-test's cache
   // does not pass it anyway); a part optimal by then skips its pre-test (its result stands), the
@@ -242,8 +246,9 @@ struct RoundingOptions {
   // later_feasibility_iterations 8 192 and 1e-5, round 1's LP that every other setting had fixed
   // from was proved infeasible at zero cost (2 624 iterations), and the rounding went from 1.70 M
   // free variables to 50 k in 26 minutes where the others stayed at 1.4 M after 40; either alone
-  // did not. At 3 000 faces the same energies, 11 % slower. Not yet a default: one pair.
-  double feasibility_tolerance = 0.0;
+  // did not. At 3 000 faces the same energies, 11 % slower. The default since the
+  // seventy-sixth session, with later_feasibility_iterations (see there).
+  double feasibility_tolerance = 1e-5;
   // Where the LPs after fixings have failed (infeasible, or looking it at their cap) round after
   // round, at least stuck_rounds of them taking over this many times round 1's seconds in all,
   // give up with a StuckError naming the last failed parts' rows and carrying the fixings to 1
