@@ -35,7 +35,7 @@ struct MatchArgs {
   double threshold = 0.5;
   std::vector<double> alternative_thresholds = RoundingOptions{}.alternative_thresholds;
   int64_t alternatives_below = RoundingOptions{}.alternatives_below;
-  int max_rounds = 50;
+  int max_rounds = RoundingOptions{}.max_rounds;
   double later_round_iterations = RoundingOptions{}.later_round_iterations;
   bool carry_round_weights = RoundingOptions{}.carry_weights;
   double fractional_batch = RoundingOptions{}.fractional_batch;
@@ -557,7 +557,7 @@ int run_match(const MatchArgs& args) {
                               .set("surface_parents", args.hierarchy.surface_parents)
                               .set("level_ratio", args.hierarchy.ratio)
                               .set("ring", args.ring)
-                              .set("max_ring", args.max_ring)
+                              .set("max_ring", co.max_ring)  // as used: at least --ring
                               .set("coarse_ring", args.coarse_ring)
                               .set("coarse_ring_faces", args.coarse_ring_faces)
                               .set("neighbourhood", args.neighbourhood)

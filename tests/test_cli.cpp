@@ -303,6 +303,9 @@ TEST_CASE("cli: match writes a verified, complete output directory, or nothing")
   CHECK(report.find("\"max_rounds_counts\": \"rounds without a new low\"") != std::string::npos);
   CHECK(json_number(report, "feasibility_skip_row") == shapematch::RoundingOptions{}.later_feasibility_skip_row);
   CHECK(report.find("\"time_limit\": null") != std::string::npos);  // none
+  // The end game's zero-cost pre-test is on by default (seventy-sixth session), at its own tolerance.
+  CHECK(json_number(report, "feasibility_later") == 8192);
+  CHECK(json_number(report, "feasibility_tol") == doctest::Approx(1e-5));
   // One level of 30 faces: rounded with 0.5, and again with the default alternative 0.7.
   CHECK(json_number(report, "roundings") == 2);
 
