@@ -221,10 +221,10 @@ struct RoundingOptions {
   // proved infeasible in 3 712 iterations (seventy-fourth session): hence the bound in a row
   // below. With it, TOSCA_r cat2-cat9 (WKS, --feasibility-later 8192 --feasibility-tol 1e-5
   // --exact-below 10000) from a checkpoint in level 5's rounding (641 k free variables; rounds of
-  // 12-19 s, 11-18 s of them the pre-tests): level 5 finished in 239
-  // rounds (2:43) and level 6 in 49 rounds after its first LPs, the pair's first full-resolution
-  // Γ, where every part pre-tested first was at 445 k free variables after 15 minutes
-  // (docs/results-log.md, seventy-fifth session).
+  // 12-19 s, 11-18 s of them the pre-tests): level 5 finished in 239 rounds (2:43) and level 6 in
+  // 49 rounds after its first LPs, the pair's first full-resolution Γ, where every part
+  // pre-tested first was at 445 k free variables after 15 minutes (docs/results-log.md,
+  // seventy-fifth session).
   int64_t later_feasibility_skip_below = 512;
   // … and only where that solve's relative primal residual is at most this (0: any optimal one).
   // The LP above ended at 2.64e-3; from the same checkpoint 1e-3 kept the 512 run's path for 32
@@ -255,8 +255,8 @@ struct RoundingOptions {
   // made so far, so that the caller can widen the space there and solve again, afresh or from
   // them (coarse to fine does). Measured, FAUST_r 020-021 at full resolution: trimming the last
   // fixing, and releasing the fixings around the failed part, both ran for 15+ minutes
-  // (docs/results-log.md). Running out of rounds (max_rounds, max_total_rounds) then ends in a StuckError too. 0: never
-  // (rounding goes on as before).
+  // (docs/results-log.md). Running out of rounds (max_rounds, max_total_rounds) then ends in a
+  // StuckError too. 0: never (rounding goes on as before).
   double stuck_after = 0.0;
   int stuck_rounds = 4;
   // With stuck_after: stuck also where the free variables have reached no new low for this many
