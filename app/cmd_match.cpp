@@ -81,6 +81,7 @@ struct MatchArgs {
   bool watch_resolve = CoarseToFineOptions{}.watch_resolve;
   int max_suspected_widenings = CoarseToFineOptions{}.max_suspected_widenings;
   int suspicion_rings = CoarseToFineOptions{}.suspicion_rings;
+  int suspicion_margins = CoarseToFineOptions{}.suspicion_margins;
   int zero_cost_proof_rings = CoarseToFineOptions{}.zero_cost_proof_rings;
   double second_start_budget = CoarseToFineOptions{}.second_start_budget;
   bool warm_widening = CoarseToFineOptions{}.warm_widening;
@@ -208,6 +209,7 @@ int run_match(const MatchArgs& args) {
   co.watch_resolve = args.watch_resolve;
   co.max_suspected_widenings = args.max_suspected_widenings;
   co.suspicion_rings = args.suspicion_rings;
+  co.suspicion_margins = args.suspicion_margins;
   co.zero_cost_proof_rings = args.zero_cost_proof_rings;
   co.second_start_budget = args.second_start_budget;
   co.warm_widening = args.warm_widening;
@@ -572,6 +574,7 @@ int run_match(const MatchArgs& args) {
                               .set("watch_resolve", args.watch_resolve)
                               .set("max_suspected_widenings", args.max_suspected_widenings)
                               .set("suspicion_rings", args.suspicion_rings)
+                              .set("suspicion_margins", args.suspicion_margins)
                               .set("zero_cost_proof_rings", args.zero_cost_proof_rings)
                               .set("second_start_budget", args.second_start_budget)
                               .set("warm_widening", args.warm_widening)
@@ -943,6 +946,11 @@ Action add_match_command(CLI::App& app) {
                  "where --max-suspected-widenings ends the watch, every X face within this many fine rings of "
                  "the faces widened so far at the level gets one more ring first (0: off)")
       ->check(CLI::Range(0, 16))
+      ->capture_default_str();
+  app.add_option("--suspicion-margins", a->suspicion_margins,
+                 "at most this many --suspicion-rings margins per ring of a level (0: one at every suspicion "
+                 "that ends the watch's trust)")
+      ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   app.add_option("--zero-cost-proof-rings", a->zero_cost_proof_rings,
                  "where --feasibility-first proves a level's first LP infeasible for the first time at its ring, "

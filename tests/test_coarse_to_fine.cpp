@@ -1417,6 +1417,18 @@ TEST_CASE("coarse to fine: after N suspicions in a row the watch is off until a 
   CHECK(one.suspicion());  // and so again after a proof
   CHECK_FALSE(one.trusted());
   CHECK(CoarseToFineOptions{}.max_suspected_widenings == 1);
+}
+
+TEST_CASE("coarse to fine: the suspicion's margin at most suspicion_margins times per ring") {
+  using detail::margin_left;
+  const int limit = CoarseToFineOptions{}.suspicion_margins;
+  CHECK(limit == 1);  // the default: once per ring
+  CHECK(margin_left(0, limit));
+  CHECK_FALSE(margin_left(1, limit));
+  CHECK(margin_left(2, 3));
+  CHECK_FALSE(margin_left(3, 3));
+  CHECK(margin_left(0, 0));  // 0: no limit, a margin at every suspicion that ends the trust
+  CHECK(margin_left(100, 0));
 
   detail::SuspicionCount unlimited(0);
   for (int i = 0; i < 50; ++i) CHECK_FALSE(unlimited.suspicion());
@@ -1517,6 +1529,7 @@ TEST_CASE("coarse to fine: a run gone on from an attempt of a level in progress 
   CHECK(loaded.attempt.propagated == a.propagated);
   CHECK(loaded.attempt.report.widened_faces == a.report.widened_faces);
   CHECK(loaded.attempt.zero_cost_margin_given == a.zero_cost_margin_given);
+  CHECK(loaded.attempt.suspicion_margins == a.suspicion_margins);
   {  // (The margin's flag through a checkpoint, version 9, not through a version-8 one.)
     LevelCheckpoint given = last;
     given.attempt.zero_cost_margin_given = true;
@@ -1526,6 +1539,20 @@ TEST_CASE("coarse to fine: a run gone on from an attempt of a level in progress 
     CHECK(load_checkpoint(other).attempt.extra == a.extra);
     detail::save_checkpoint_as(other, given, 8);
     CHECK_FALSE(load_checkpoint(other).attempt.zero_cost_margin_given);
+    CHECK(load_checkpoint(other).attempt.extra == a.extra);
+  }
+  {  // (The suspicion margins given at the ring through a checkpoint, version 11, not version 10.)
+    LevelCheckpoint given = last;
+    given.attempt.suspicion_margins = 2;
+    given.attempt.zero_cost_margin_given = true;
+    const std::string other = (tmp.path / "margins.ckpt").string();
+    save_checkpoint(other, given);
+    CHECK(load_checkpoint(other).attempt.suspicion_margins == 2);
+    CHECK(load_checkpoint(other).attempt.zero_cost_margin_given);
+    CHECK(load_checkpoint(other).attempt.extra == a.extra);
+    detail::save_checkpoint_as(other, given, 10);
+    CHECK(load_checkpoint(other).attempt.suspicion_margins == 0);
+    CHECK(load_checkpoint(other).attempt.zero_cost_margin_given);
     CHECK(load_checkpoint(other).attempt.extra == a.extra);
   }
   int more = 0;

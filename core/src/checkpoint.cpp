@@ -18,8 +18,9 @@ constexpr char kMagic[] = "shapematch level checkpoint\n";
 // lookahead's chains (LevelCheckpoint::chains) follow. 6: each chain's attempt follows it. 7:
 // LevelReport::lookahead_other_bound and lookahead_other_stuck. 8: branch_roundings,
 // branch_energy and branch_kept. 9: LevelAttempt::zero_cost_margin_given follows `trusted`.
-// 10: LevelAttempt::Rounding::steps follows its ones. 1 to 9 are read too.
-constexpr uint32_t kVersion = 10;
+// 10: LevelAttempt::Rounding::steps follows its ones. 11: LevelAttempt::suspicion_margins
+// follows zero_cost_margin_given. 1 to 10 are read too.
+constexpr uint32_t kVersion = 11;
 
 // Every number of a report, in the file's order (the Γ follows on its own). A field added to
 // LevelReport goes here too, with kVersion one higher; the size check below is the reminder.
@@ -122,6 +123,7 @@ void write_attempt(Writer& w, const LevelAttempt& a, uint32_t version) {
   w(a.ring), w(a.local), w(a.propagated), w(a.priced), w(a.regional_done), w(a.around_done);
   w(a.suspicions), w(a.trusted);
   if (version >= 9) w(a.zero_cost_margin_given);
+  if (version >= 11) w(a.suspicion_margins);
   each_field(a.report, w, version);
   w.array(a.extra);
   if (version < 3) return;
@@ -140,6 +142,7 @@ void read_attempt(Reader& r, LevelAttempt& a, uint32_t version, const std::strin
   r(a.ring), r(a.local), r(a.propagated), r(a.priced), r(a.regional_done), r(a.around_done);
   r(a.suspicions), r(a.trusted);
   if (version >= 9) r(a.zero_cost_margin_given);
+  if (version >= 11) r(a.suspicion_margins);
   each_field(a.report, r, version);
   r.array(a.extra);
   LevelAttempt::Rounding& g = a.rounding;

@@ -1071,6 +1071,8 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
   int propagated = 0;
   // The margin after a zero-cost proof (zero_cost_proof_rings) was given at this ring.
   bool zero_cost_margin_given = false;
+  // The suspicion_rings margins given at this ring (at most suspicion_margins).
+  int suspicion_margins = 0;
   if (resume) {
     rep = resume->report;
     ring = resume->ring;
@@ -1081,6 +1083,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
     around_done = resume->around_done;
     suspicions.restore(resume->suspicions, resume->trusted);
     zero_cost_margin_given = resume->zero_cost_margin_given;
+    suspicion_margins = resume->suspicion_margins;
     spdlog::info("level {}: going on from its checkpointed attempt: ring {}, {} faces with extra rings{}", l + 1, ring,
                  std::count_if(extra.begin(), extra.end(), [](int e) { return e > 0; }),
                  resume->rounding.empty() ? std::string()
@@ -1230,6 +1233,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
     a.suspicions = suspicions.count();
     a.trusted = suspicions.trusted();
     a.zero_cost_margin_given = zero_cost_margin_given;
+    a.suspicion_margins = suspicion_margins;
     a.report = rep;
     a.report.gamma.clear();
     return a;
@@ -1603,11 +1607,16 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
                        suspicions.count() == 1 ? std::string("a widening")
                                                : fmt::format("{} widenings in a row", suspicions.count()));
           // A patiently watched LP costs what several quickly watched ones do: room around every
-          // suspicion first (CoarseToFineOptions::suspicion_rings says why).
-          if (options_.suspicion_rings > 0 &&
-              widen_around(options_.suspicion_rings, "probably infeasible around its widenings"))
-            spdlog::info("level {}: widened around all earlier local widenings ({} rings) before it", l + 1,
-                         options_.suspicion_rings);
+          // suspicion first (CoarseToFineOptions::suspicion_rings says why), a few times per ring.
+          if (options_.suspicion_rings > 0 && detail::margin_left(suspicion_margins, options_.suspicion_margins)) {
+            ++suspicion_margins;
+            if (widen_around(options_.suspicion_rings, "probably infeasible around its widenings"))
+              spdlog::info("level {}: widened around all earlier local widenings ({} rings) before it", l + 1,
+                           options_.suspicion_rings);
+          } else if (options_.suspicion_rings > 0) {
+            spdlog::info("level {}: no margin around its widenings before it ({} given at ring {})", l + 1,
+                         suspicion_margins, ring);
+          }
         }
         continue;
       }
@@ -1636,6 +1645,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
       ++ring;
       feasible_seen = false;
       zero_cost_margin_given = false;
+      suspicion_margins = 0;
       for (int& x : extra) x = std::max(0, std::min(x, options_.max_ring - ring));
     }
   }

@@ -70,4 +70,8 @@ private:
   bool trusted_ = true;
 };
 
+// Whether another margin may be given where `given` were given already and at most `limit` may
+// (0: no limit; CoarseToFineOptions::suspicion_margins).
+inline bool margin_left(int given, int limit) { return limit <= 0 || given < limit; }
+
 }  // namespace shapematch::detail

@@ -128,6 +128,15 @@ struct CoarseToFineOptions {
   // (11.2 M variables) was optimal in 4.4 minutes, and level 6 ended in 31 minutes, gap 1.12 %,
   // error 0.0221 (0.0317 at μ = 1). 0: off.
   int suspicion_rings = 2;
+  // At most this many suspicion_rings margins per ring of a level (0: one at every suspicion that
+  // ends the watch's trust, as before the seventy-seventh session). Each one widens around every
+  // widening so far, so a second one costs far more than the first: measured, TOSCA_r
+  // horse0-horse10 at full resolution, level 6: the first margin (3 593 faces) took the LP from
+  // 15.5 M to 22.0 M variables; after its proof (10 faces) and a second suspicion (28 faces) the
+  // second (4 717 faces) took it to 29.1 M, each first LP there 30-60 minutes on one core, while the
+  // places that the proof and the suspicion named were a few dozen faces (docs/results-log.md,
+  // seventy-sixth session). The measured cure (FAUST_r 029-063, above) was one margin.
+  int suspicion_margins = 1;
   // Where the zero-cost pre-test (RoundingOptions::feasibility_iterations) proves a level's first
   // LP infeasible for the first time at its ring, every X face within this many fine rings of the
   // faces widened so far gets one more ring too, as after the suspicion that the divergence watch
@@ -439,6 +448,8 @@ struct LevelAttempt {
   // The margin after a proof at zero cost (zero_cost_proof_rings) was given at this ring: once per
   // ring, also across a stop (version 9; before, a run gone on from here could give it again).
   bool zero_cost_margin_given = false;
+  // The suspicion_rings margins given at this ring (version 11; before, none counted).
+  int suspicion_margins = 0;
   LevelReport report;            // its counts so far (widenings, widened faces, …); no Γ
   // Where the attempt's rounding had got, saved after its rounds (at most every few seconds): a
   // run gone on from it builds the same LP, fixes `ones` before its round 1 and keeps round 1's
