@@ -1609,10 +1609,11 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
           // A patiently watched LP costs what several quickly watched ones do: room around every
           // suspicion first (CoarseToFineOptions::suspicion_rings says why), a few times per ring.
           if (options_.suspicion_rings > 0 && detail::margin_left(suspicion_margins, options_.suspicion_margins)) {
-            ++suspicion_margins;
-            if (widen_around(options_.suspicion_rings, "probably infeasible around its widenings"))
+            if (widen_around(options_.suspicion_rings, "probably infeasible around its widenings")) {
+              ++suspicion_margins;  // (one that widened nothing was not given)
               spdlog::info("level {}: widened around all earlier local widenings ({} rings) before it", l + 1,
                            options_.suspicion_rings);
+            }
           } else if (options_.suspicion_rings > 0) {
             spdlog::info("level {}: no margin around its widenings before it ({} given at ring {})", l + 1,
                          suspicion_margins, ring);
