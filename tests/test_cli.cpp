@@ -544,6 +544,7 @@ TEST_CASE("cli: checkpoint shows both chains of a run stopped inside lookahead")
   a.rounding.columns = 10;
   a.rounding.rows = 4;
   a.rounding.ones = {1, 7};
+  a.rounding.cap_scale = 4.0;
   const std::string inside_file = (tmp.path / "inside.ckpt").string();
   shapematch::save_checkpoint(inside_file, inside);
   const Run at = run("checkpoint " + inside_file);
@@ -556,6 +557,7 @@ TEST_CASE("cli: checkpoint shows both chains of a run stopped inside lookahead")
   const size_t top = at.out.rfind("\"attempt\"");  // the level in progress, after `lookahead`
   CHECK(json_number(at.out.substr(top), "level") == 3);
   CHECK(json_number(at.out.substr(top), "fixings_to_one") == 2);
+  CHECK(json_number(at.out.substr(top), "cap_scale") == 4);
   // Its first level alone: neither chain goes with it.
   const Run kept = run("checkpoint " + ckpt + " --keep-levels 1 --out " + ckpt);
   REQUIRE_MESSAGE(kept.code == 0, kept.err);

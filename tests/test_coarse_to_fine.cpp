@@ -1605,6 +1605,16 @@ TEST_CASE("coarse to fine: a run gone on from an attempt of a level in progress 
   save_checkpoint(file, stepped);
   CHECK(load_checkpoint(file).attempt.rounding.steps == stepped.attempt.rounding.steps);
   CHECK(load_checkpoint(file).attempt.rounding.step_count() == 2);
+  // The twelfth keeps the later rounds' cap multiple; the eleventh has none (1).
+  stepped.attempt.rounding.cap_scale = 4.0;
+  save_checkpoint(file, stepped);
+  CHECK(load_checkpoint(file).attempt.rounding.cap_scale == 4.0);
+  detail::save_checkpoint_as(file, stepped, 11);
+  CHECK(load_checkpoint(file).attempt.rounding.cap_scale == 1.0);
+  CHECK(load_checkpoint(file).attempt.rounding.steps == stepped.attempt.rounding.steps);
+  stepped.attempt.rounding.cap_scale = 0.5;  // no rounding's: refused
+  save_checkpoint(file, stepped);
+  CHECK_THROWS_AS(load_checkpoint(file), IoError);
   save_checkpoint(file, marked);
   std::string bytes;
   {
@@ -1612,8 +1622,8 @@ TEST_CASE("coarse to fine: a run gone on from an attempt of a level in progress 
     bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
   }
   const size_t at = std::string("shapematch level checkpoint\n").size();
-  REQUIRE(bytes[at] == 10);
-  bytes[at] = 11;  // a later version than this build's
+  REQUIRE(bytes[at] == 12);
+  bytes[at] = 13;  // a later version than this build's
   std::ofstream(file, std::ios::binary) << bytes;
   CHECK_THROWS_AS(load_checkpoint(file), IoError);
   detail::save_checkpoint_as(file, marked, 1);
@@ -1633,7 +1643,7 @@ TEST_CASE("coarse to fine: a run gone on from an attempt of a level in progress 
   CHECK(v3.attempt.report.widened_faces == a.report.widened_faces);
   CHECK(v3.attempt.report.stuck_restarts == 0);
   CHECK(v3.levels.back().gamma == last.levels.back().gamma);
-  CHECK_THROWS_AS(detail::save_checkpoint_as(file, marked, 11), InvalidInputError);
+  CHECK_THROWS_AS(detail::save_checkpoint_as(file, marked, 13), InvalidInputError);
 }
 
 TEST_CASE("coarse to fine: a run gone on from a checkpoint inside a rounding fixes its decisions and keeps its bound") {
@@ -1701,6 +1711,19 @@ TEST_CASE("coarse to fine: a run gone on from a checkpoint inside a rounding fix
   CHECK(check_graph_surface(r.finest.space, r.rounding.gamma).ok());
   CHECK(satisfies_exactly(r.finest.lp, r.rounding.gamma));
   for (int64_t j : g.ones) CHECK(std::binary_search(r.rounding.gamma.begin(), r.rounding.gamma.end(), j));
+  // The later rounds' cap multiple goes on where the saved rounding had got, and is saved again.
+  LevelCheckpoint scaled = loaded;
+  scaled.attempt.rounding.cap_scale = 4.0;
+  int scaled_saves = 0;
+  const CoarseToFineResult rs = matcher.run({}, &scaled, [&](const LevelCheckpoint& c) {
+    if (c.attempt.rounding.empty()) return;
+    ++scaled_saves;
+    CHECK(c.attempt.rounding.cap_scale >= 4.0);
+  });
+  CHECK(scaled_saves > 0);
+  REQUIRE_FALSE(rs.rounding.rounds.empty());
+  CHECK(rs.rounding.rounds.front().cap_scale >= 4.0);
+  CHECK(check_graph_surface(rs.finest.space, rs.rounding.gamma).ok());
 
   // A rounding of another LP (another build, say) is dropped: the attempt rounds afresh, as the
   // whole run's did.

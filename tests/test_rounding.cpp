@@ -247,6 +247,25 @@ TEST_CASE("rounding: later rounds stop at their iteration cap and still end exac
   int64_t longest = 0;
   for (size_t i = 1; i < u.rounds.size(); ++i) longest = std::max(longest, u.rounds[i].iterations);
   CHECK(longest > 16);
+  for (const RoundingRound& round : r.rounds) CHECK(round.cap_scale >= 1.0);  // reported, from 1
+
+  // Started at a multiple of the cap (a rounding gone on from a checkpoint): its later rounds
+  // stop at that multiple, and it is reported from round 1 on.
+  o.later_round_iterations = 1e-9;
+  o.start_cap_scale = 4.0;
+  const RoundingResult s = round_to_graph_surface(m.space, m.lp, m.energy, o);
+  REQUIRE(s.rounds.size() >= 2);
+  CHECK(s.rounds.front().cap_scale >= 4.0);
+  int64_t longest_scaled = 0;
+  for (size_t i = 1; i < s.rounds.size(); ++i) {
+    CAPTURE(i);
+    CHECK(s.rounds[i].iterations <= static_cast<int64_t>(16 * s.rounds[i - 1].cap_scale));
+    longest_scaled = std::max(longest_scaled, s.rounds[i].iterations);
+  }
+  CHECK(longest_scaled > 16);  // past the unscaled cap
+  CHECK(satisfies_exactly(m.lp, s.gamma));
+  o.start_cap_scale = 0.5;
+  CHECK_THROWS_AS(round_to_graph_surface(m.space, m.lp, m.energy, o), InvalidInputError);
 }
 
 TEST_CASE("rounding: a later LP solved in its independent parts has the optimum of the whole") {

@@ -4,6 +4,7 @@
 #include "shapematch/errors.hpp"
 #include "shapematch/files.hpp"
 
+#include <cmath>
 #include <cstring>
 #include <fstream>
 #include <iterator>
@@ -19,8 +20,9 @@ constexpr char kMagic[] = "shapematch level checkpoint\n";
 // LevelReport::lookahead_other_bound and lookahead_other_stuck. 8: branch_roundings,
 // branch_energy and branch_kept. 9: LevelAttempt::zero_cost_margin_given follows `trusted`.
 // 10: LevelAttempt::Rounding::steps follows its ones. 11: LevelAttempt::suspicion_margins
-// follows zero_cost_margin_given. 1 to 10 are read too.
-constexpr uint32_t kVersion = 11;
+// follows zero_cost_margin_given. 12: LevelAttempt::Rounding::cap_scale follows its steps. 1 to 11
+// are read too.
+constexpr uint32_t kVersion = 12;
 
 // Every number of a report, in the file's order (the Γ follows on its own). A field added to
 // LevelReport goes here too, with kVersion one higher; the size check below is the reminder.
@@ -133,6 +135,7 @@ void write_attempt(Writer& w, const LevelAttempt& a, uint32_t version) {
     w(g.columns), w(g.rows), w(g.iterations), w(g.lower_bound), w(g.reference_seconds), w(g.reference_iterations);
     w.array(g.ones);
     if (version >= 10) w.array(g.steps);
+    if (version >= 12) w(g.cap_scale);
   }
 }
 void read_attempt(Reader& r, LevelAttempt& a, uint32_t version, const std::string& path) {
@@ -152,6 +155,10 @@ void read_attempt(Reader& r, LevelAttempt& a, uint32_t version, const std::strin
     r(g.columns), r(g.rows), r(g.iterations), r(g.lower_bound), r(g.reference_seconds), r(g.reference_iterations);
     r.array(g.ones);
     if (version >= 10) r.array(g.steps);
+    if (version >= 12) r(g.cap_scale);
+    if (!(g.cap_scale >= 1.0) || !std::isfinite(g.cap_scale))
+      throw IoError(path + ": not a shapematch checkpoint (a rounding's cap scale of " + std::to_string(g.cap_scale) +
+                    ")");
   }
   if (a.ring < 0) throw IoError(path + ": not a shapematch checkpoint (an attempt at ring " + std::to_string(a.ring) + ")");
 }

@@ -1273,7 +1273,8 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
     rep.variables = m.lp.cols();
     rep.constraints = m.lp.rows();
     // This attempt's rounding where it has got, with these fixings to 1: for a checkpoint or a restart.
-    const auto rounding_now = [&](const std::vector<int64_t>& ones, const std::vector<int32_t>& steps) {
+    const auto rounding_now = [&](const std::vector<int64_t>& ones, const std::vector<int32_t>& steps,
+                                  double cap_scale = 1.0) {
       return LevelAttempt::Rounding{.columns = m.lp.cols(),
                                     .rows = m.lp.rows(),
                                     .ones = ones,
@@ -1282,7 +1283,8 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
                                     .iterations = iterations_so_far,
                                     .lower_bound = first_bound,
                                     .reference_seconds = reference_seconds,
-                                    .reference_iterations = reference_iterations};
+                                    .reference_iterations = reference_iterations,
+                                    .cap_scale = cap_scale};
     };
     if (going_on && (going_on->columns != m.lp.cols() || going_on->rows != m.lp.rows())) {
       spdlog::warn("level {}: the checkpointed rounding was of an LP of {} × {}, this one is {} × {}; rounding afresh",
@@ -1429,14 +1431,16 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
       if (going_on) {  // its round 1 solves what the checkpointed fixings leave
         ro.start_ones = going_on->ones;
         ro.start_steps = going_on->steps;
+        ro.start_cap_scale = going_on->cap_scale;
         // Unwatched, as a later round: where those fixings leave no solution, the last step's are
         // undone first (a diverging first LP would widen the space instead).
         ro.lp.stop_on_divergence = false;
         cold_seconds = reference_seconds = ro.reference_seconds = going_on->reference_seconds;
         cold_iterations = reference_iterations = first_iterations = ro.reference_iterations =
             going_on->reference_iterations;
-        spdlog::info("level {}: rounding goes on after round {} from its {} fixings to 1 (undo steps: {})", l + 1,
-                     going_on->rounds, going_on->ones.size(), going_on->step_count());
+        spdlog::info("level {}: rounding goes on after round {} from its {} fixings to 1 (undo steps: {}, "
+                     "later rounds' cap {}x)",
+                     l + 1, going_on->rounds, going_on->ones.size(), going_on->step_count(), going_on->cap_scale);
       }
       // Where the rounding has got, saved as it goes and kept for a restart (not where
       // alternatives would run: a run gone on from fixings runs none).
@@ -1454,7 +1458,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
           if (r.round == 1 && !going_on) first_bound = bound;
           if (!attempted || since_saved.seconds() < options_.rounding_checkpoint_seconds) return;
           LevelAttempt a = current_attempt();
-          a.rounding = rounding_now(ones, steps);
+          a.rounding = rounding_now(ones, steps, r.cap_scale);
           attempted(a);
           since_saved.reset();
         };

@@ -1311,9 +1311,12 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
   double first_seconds = 0.0;
   int64_t first_iterations = 0;
   // Multiplies the later rounds' iteration cap: doubled each time a fixing from a capped LP is
-  // undone whole (below), up to kMaxCapScale.
-  double cap_scale = 1.0;
+  // undone whole (below), up to kMaxCapScale; a rounding gone on from a checkpoint starts where
+  // the saved one had got (RoundingOptions::start_cap_scale).
   constexpr double kMaxCapScale = 16.0;
+  if (!(options.start_cap_scale >= 1.0) || !std::isfinite(options.start_cap_scale))
+    throw InvalidInputError("rounding: the start cap scale must be a finite number of at least 1");
+  double cap_scale = std::min(options.start_cap_scale, kMaxCapScale);
   // Undoes the last fixing and applies less of it; where nothing of it can go (a single variable
   // that can be neither 1 nor 0), undoes the fixing before it as well, and so on back. Measured:
   // FAUST 020-024 at 4000 faces got stuck this way in round 15 and lost its whole level. Gives up
@@ -1569,6 +1572,7 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
   };
   const auto record = [&](RoundingRound& info, const Stopwatch& clock) {
     info.seconds = clock.seconds() - info.feasibility_seconds;
+    info.cap_scale = cap_scale;
     if (info.round > 1) later_work += double(info.iterations) * double(info.variables);
     result.rounds.push_back(info);
     if (progress) progress(info);

@@ -468,6 +468,7 @@ struct LevelAttempt {
     double lower_bound = 0.0;        // certified by round 1
     double reference_seconds = 0.0;  // round 1's cold solve (RoundingOptions::reference_*)
     int64_t reference_iterations = 0;
+    double cap_scale = 1.0;          // RoundingOptions::start_cap_scale (version 12; before: 1)
     bool empty() const { return rounds == 0; }
     // How many steps its fixings form (one where `steps` is empty, none without fixings).
     int64_t step_count() const {

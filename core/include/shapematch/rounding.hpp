@@ -174,6 +174,13 @@ struct RoundingOptions {
   // rounding's own round 1.
   double reference_seconds = 0.0;
   int64_t reference_iterations = 0;
+  // The multiple of the later rounds' iteration cap to start from (at least 1; at most 16, where
+  // the doubling stops): a run gone on from a checkpoint (coarse to fine keeps it there) starts
+  // where the saved rounding had got, not at 1. Measured, TOSCA_r horse0-horse5 at full
+  // resolution (seventy-seventh session): gone on at 1 after the saved rounding had doubled it,
+  // its first round fixed from an iterate at the 1x cap again, the next LP was infeasible, and the
+  // fixing was undone whole and the cap doubled again: 13 minutes to get back where it had been.
+  double start_cap_scale = 1.0;
   // Round 1's iterations at most (0: lp.max_iterations alone). Coarse to fine caps a warm solve
   // after pricing at the cold solve's count: measured on the cat at full resolution, such a
   // re-solve crept to tolerance in 11 328 iterations (17 minutes) against 4 480 cold.
@@ -351,6 +358,7 @@ struct RoundingRound {
   // of its end game's seconds there (docs/results-log.md, seventy-third session).
   double later_pretest_seconds = 0.0;
   bool undone = false;         // the fixing made the LP infeasible and was replaced by a smaller one
+  double cap_scale = 1.0;      // the later rounds' iteration cap multiple after this round
   int64_t searched_parts = 0;  // parts finished by search (search_below); iterations: its nodes
   bool search = false;         // finished by search (search_below), not by an LP
   int64_t released = 0;        // fixings released around parts without a binary solution (search)
