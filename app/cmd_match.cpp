@@ -78,6 +78,7 @@ struct MatchArgs {
   int max_propagation_widenings = CoarseToFineOptions{}.max_propagation_widenings;
   int recurring_margin = CoarseToFineOptions{}.recurring_margin;
   double recurring_max_share = CoarseToFineOptions{}.recurring_max_share;
+  int recurring_beyond = CoarseToFineOptions{}.recurring_beyond;
   bool watch_resolve = CoarseToFineOptions{}.watch_resolve;
   int max_suspected_widenings = CoarseToFineOptions{}.max_suspected_widenings;
   int suspicion_rings = CoarseToFineOptions{}.suspicion_rings;
@@ -206,6 +207,7 @@ int run_match(const MatchArgs& args) {
   co.max_propagation_widenings = args.max_propagation_widenings;
   co.recurring_margin = args.recurring_margin;
   co.recurring_max_share = args.recurring_max_share;
+  co.recurring_beyond = args.recurring_beyond;
   co.watch_resolve = args.watch_resolve;
   co.max_suspected_widenings = args.max_suspected_widenings;
   co.suspicion_rings = args.suspicion_rings;
@@ -571,6 +573,7 @@ int run_match(const MatchArgs& args) {
                               .set("max_propagation_widenings", args.max_propagation_widenings)
                               .set("recurring_margin", args.recurring_margin)
                               .set("recurring_max_share", args.recurring_max_share)
+                              .set("recurring_beyond", args.recurring_beyond)
                               .set("watch_resolve", args.watch_resolve)
                               .set("max_suspected_widenings", args.max_suspected_widenings)
                               .set("suspicion_rings", args.suspicion_rings)
@@ -971,6 +974,10 @@ Action add_match_command(CLI::App& app) {
                  "with --recurring-margin: where that would widen more than this share of the X faces, widen at the "
                  "proof as for any contradiction instead (0: no limit)")
       ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str();
+  app.add_option("--recurring-beyond", a->recurring_beyond,
+                 "with --recurring-margin: such a return widens its faces to --max-ring plus this many rings")
+      ->check(CLI::Range(1, 3))
       ->capture_default_str();
   app.add_option("--second-start-budget", a->second_start_budget,
                  "beside a refined Γ, the second start's rounding gives up once its rounds after the first did this "

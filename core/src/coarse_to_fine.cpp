@@ -1311,7 +1311,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
         ProofPlace again(m);
         for (int64_t f : back) again.add(m, m.closedness_rows + f);
         const int margin = options_.widen_margin + options_.recurring_margin * returns;
-        const int cap = options_.max_ring + kMaxRingBeyond;
+        const int cap = options_.max_ring + std::clamp(options_.recurring_beyond, 1, kMaxRingBeyond);
         const std::vector<int> faces = faces_to_widen(m, again, margin, true);
         int64_t growing = 0;
         const bool too_many = detail::recurring_too_wide(faces, extra, ring, cap, options_.recurring_max_share,

@@ -103,6 +103,11 @@ struct CoarseToFineOptions {
   // took 432 faces to ring 6 (10.1 M -> 16.0 M variables), the next 3 179 (45.4 M), an LP
   // that one core cannot solve in an hour. 0: no limit.
   double recurring_max_share = 0.1;
+  // The ring such a return widens to: max_ring + this (1 to 3, where local widenings stop). Each
+  // return takes hundreds of faces there at once (TOSCA_r david0-david6 without WKS at full
+  // resolution, level 6: three returns of 639, 451 and 678 faces to ring 6, 10.6 M -> 28.9 M
+  // variables in two minutes of rebuilds, seventy-seventh session).
+  int recurring_beyond = 3;
   // Let the divergence watch stop the re-solve after pricing too (as before the twenty-sixth
   // session). Off: that re-solve starts at the optimum of a space it contains, and stops at the
   // cold first LP's iterations anyway (detail::watch_divergence says why).
