@@ -1914,6 +1914,14 @@ TEST_CASE("coarse to fine: a true map restricts the coarsest level, and there is
   CHECK_THROWS_WITH_AS(collapsed.run(), doctest::Contains("within 0 rings of the true map"), InfeasibleError);
   o.truth.pop_back();
   CHECK_THROWS_AS(CoarseToFineMatcher(m, m, o), InvalidInputError);
+  // (Options out of range are refused up front too: a recurring widening's ring past the cap.)
+  CoarseToFineOptions beyond;
+  for (int n : {0, 4}) {
+    beyond.recurring_beyond = n;
+    CHECK_THROWS_AS(CoarseToFineMatcher(m, m, beyond), InvalidInputError);
+  }
+  beyond.recurring_beyond = 1;
+  CHECK_NOTHROW(CoarseToFineMatcher(m, m, beyond));
 }
 
 TEST_CASE("image split: an LP half the identity and half a rotation splits the images the rotation moves") {

@@ -538,6 +538,8 @@ CoarseToFineMatcher::CoarseToFineMatcher(const Mesh& x, const Mesh& y, CoarseToF
   if (options_.branch_depth < 0 || options_.branch_rings < 0 || !(options_.branch_min_split >= 0.0) ||
       !(options_.branch_gap >= 0.0))
     throw InvalidInputError("coarse to fine: need a branch depth, rings, split and gap of 0 or more");
+  if (options_.recurring_beyond < 1 || options_.recurring_beyond > kMaxRingBeyond)
+    throw InvalidInputError("coarse to fine: need 1 ≤ --recurring-beyond ≤ " + std::to_string(kMaxRingBeyond));
   // Both shapes get the same number of levels (the larger shape's count), each its own face counts.
   HierarchyOptions ho = options_.hierarchy;
   if (ho.levels == 0)
@@ -874,7 +876,8 @@ void CoarseToFineMatcher::check(const LevelCheckpoint& c) const {
   if (!g.empty() && (a.empty() || g.columns <= 0 || g.rows <= 0 || g.iterations < 0 ||
                      std::any_of(g.ones.begin(), g.ones.end(), [&](int64_t j) { return j < 0 || j >= g.columns; }) ||
                      (!g.steps.empty() && g.steps.size() != g.ones.size()) ||
-                     std::any_of(g.steps.begin(), g.steps.end(), [](int32_t k) { return k < 0; })))
+                     std::any_of(g.steps.begin(), g.steps.end(), [](int32_t k) { return k < 0; }) ||
+                     !(g.cap_scale >= 1.0) || !std::isfinite(g.cap_scale)))
     throw InvalidInputError("the checkpoint's rounding of level " + std::to_string(done + 1) + " does not fit it");
 }
 
@@ -1311,7 +1314,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
         ProofPlace again(m);
         for (int64_t f : back) again.add(m, m.closedness_rows + f);
         const int margin = options_.widen_margin + options_.recurring_margin * returns;
-        const int cap = options_.max_ring + std::clamp(options_.recurring_beyond, 1, kMaxRingBeyond);
+        const int cap = options_.max_ring + options_.recurring_beyond;
         const std::vector<int> faces = faces_to_widen(m, again, margin, true);
         int64_t growing = 0;
         const bool too_many = detail::recurring_too_wide(faces, extra, ring, cap, options_.recurring_max_share,
@@ -1566,7 +1569,8 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
           std::isfinite(first_bound)) {
         ++restarts;
         ++rep.stuck_restarts;
-        restart = rounding_now(s->ones(), s->steps());
+        // (Its cap multiple afresh too, as the restarts were measured: --stuck-restarts.)
+        restart = rounding_now(s->ones(), s->steps(), 1.0);
         spdlog::warn("level {}: {}; starting its rounding again from its {} fixings to 1 ({} of {})", l + 1,
                      e.what(), s->ones().size(), restarts, options_.stuck_restarts);
         continue;

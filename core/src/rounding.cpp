@@ -1350,7 +1350,7 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
       const size_t blamed = step.batch.size() - away_from_proof.size();
       const bool few_blamed = !away_from_proof.empty() && 4 * blamed <= step.batch.size();
       if (first && step.capped && cap_scale < kMaxCapScale && !few_blamed) {
-        cap_scale *= 2.0;
+        cap_scale = std::min(2.0 * cap_scale, kMaxCapScale);
         spdlog::debug("rounding: undoing the {} fixings from a capped LP; the cap grows {}x", step.batch.size(),
                       cap_scale);
         history.pop_back();
@@ -1879,7 +1879,7 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
                                  fixer.assigned_since(history.back().mark), &touched);
       const bool proven = r.status == LpStatus::Infeasible;
       if (touched == 0 && !proven && cap_scale < kMaxCapScale) {
-        cap_scale *= 2.0;
+        cap_scale = std::min(2.0 * cap_scale, kMaxCapScale);
         spdlog::debug("round {}: a part at its cap looks infeasible, away from the last fixing: it goes on from its "
                       "iterate, the cap {}x",
                       round, cap_scale);
