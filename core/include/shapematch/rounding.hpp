@@ -179,7 +179,7 @@ struct RoundingOptions {
   // where the saved rounding had got, not at 1. Measured, TOSCA_r horse0-horse5 at full
   // resolution (seventy-seventh session): gone on at 1 after the saved rounding had doubled it,
   // its first round fixed from an iterate at the 1x cap again, the next LP was infeasible, and the
-  // fixing was undone whole and the cap doubled again: 13 minutes to get back where it had been.
+  // fixing was undone whole and the cap doubled again: 15 minutes to get back where it had been.
   double start_cap_scale = 1.0;
   // Round 1's iterations at most (0: lp.max_iterations alone). Coarse to fine caps a warm solve
   // after pricing at the cold solve's count: measured on the cat at full resolution, such a
