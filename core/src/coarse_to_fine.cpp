@@ -1277,7 +1277,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
     rep.constraints = m.lp.rows();
     // This attempt's rounding where it has got, with these fixings to 1: for a checkpoint or a restart.
     const auto rounding_now = [&](const std::vector<int64_t>& ones, const std::vector<int32_t>& steps,
-                                  double cap_scale = 1.0) {
+                                  double cap_scale) {
       return LevelAttempt::Rounding{.columns = m.lp.cols(),
                                     .rows = m.lp.rows(),
                                     .ones = ones,
