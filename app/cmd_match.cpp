@@ -83,6 +83,7 @@ struct MatchArgs {
   int max_suspected_widenings = CoarseToFineOptions{}.max_suspected_widenings;
   int suspicion_rings = CoarseToFineOptions{}.suspicion_rings;
   int suspicion_margins = CoarseToFineOptions{}.suspicion_margins;
+  std::string suspicion_margin_around = "widened";
   int zero_cost_proof_rings = CoarseToFineOptions{}.zero_cost_proof_rings;
   double second_start_budget = CoarseToFineOptions{}.second_start_budget;
   bool warm_widening = CoarseToFineOptions{}.warm_widening;
@@ -212,6 +213,8 @@ int run_match(const MatchArgs& args) {
   co.max_suspected_widenings = args.max_suspected_widenings;
   co.suspicion_rings = args.suspicion_rings;
   co.suspicion_margins = args.suspicion_margins;
+  co.suspicion_margin_scope = args.suspicion_margin_around == "named" ? CoarseToFineOptions::MarginScope::named
+                                                                      : CoarseToFineOptions::MarginScope::widened;
   co.zero_cost_proof_rings = args.zero_cost_proof_rings;
   co.second_start_budget = args.second_start_budget;
   co.warm_widening = args.warm_widening;
@@ -578,6 +581,7 @@ int run_match(const MatchArgs& args) {
                               .set("max_suspected_widenings", args.max_suspected_widenings)
                               .set("suspicion_rings", args.suspicion_rings)
                               .set("suspicion_margins", args.suspicion_margins)
+                              .set("suspicion_margin_around", args.suspicion_margin_around)
                               .set("zero_cost_proof_rings", args.zero_cost_proof_rings)
                               .set("second_start_budget", args.second_start_budget)
                               .set("warm_widening", args.warm_widening)
@@ -954,6 +958,11 @@ Action add_match_command(CLI::App& app) {
                  "at most this many --suspicion-rings margins per ring of a level (0: one at every suspicion "
                  "that ends the watch's trust)")
       ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  app.add_option("--suspicion-margin-around", a->suspicion_margin_around,
+                 "what a --suspicion-rings margin is drawn around: widened (every X face widened so far at the "
+                 "level) or named (only the X faces the suspicion itself named)")
+      ->check(CLI::IsMember({"widened", "named"}))
       ->capture_default_str();
   app.add_option("--zero-cost-proof-rings", a->zero_cost_proof_rings,
                  "where --feasibility-first proves a level's first LP infeasible for the first time at its ring, "

@@ -1,6 +1,7 @@
 #include "divergence_rule.hpp"
 #include "key_set.hpp"
 #include "recurring_conflicts.hpp"
+#include "suspicion_margin.hpp"
 #include "shapematch/coarse_to_fine.hpp"
 #include "shapematch/errors.hpp"
 #include "shapematch/evaluation.hpp"
@@ -1435,6 +1436,54 @@ TEST_CASE("coarse to fine: the suspicion's margin at most suspicion_margins time
   CHECK(margin_left(100, 0));
 }
 
+TEST_CASE("coarse to fine: the suspicion's margin around every widening or around the suspicion's places") {
+  using Scope = CoarseToFineOptions::MarginScope;
+  CHECK(CoarseToFineOptions{}.suspicion_margin_scope == Scope::widened);  // the default, as before
+  const Mesh x = shapes::icosphere(3);                                    // 1 280 faces
+  // Two widenings at opposite poles (the faces touching the vertex furthest up and down); the
+  // suspicion named the top one.
+  int top = 0, bottom = 0;
+  for (int v = 0; v < x.num_vertices(); ++v) {
+    if (x.vertices[v].z() > x.vertices[top].z()) top = v;
+    if (x.vertices[v].z() < x.vertices[bottom].z()) bottom = v;
+  }
+  std::vector<int> extra(x.num_faces(), 0), named;
+  for (int f = 0; f < x.num_faces(); ++f) {
+    const auto& t = x.faces[f];
+    const bool at_top = t[0] == top || t[1] == top || t[2] == top;
+    const bool at_bottom = t[0] == bottom || t[1] == bottom || t[2] == bottom;
+    if (at_top || at_bottom) extra[f] = 1;
+    if (at_top) named.push_back(f);
+  }
+  REQUIRE(named.size() >= 5);  // (a vertex star)
+  auto height = [&](int f) {
+    double z = 0.0;
+    for (int v : x.faces[f]) z += x.vertices[v].z() / 3.0;
+    return z;
+  };
+  const int rings = 2;
+  const std::vector<int> all = detail::suspicion_margin_faces(x, extra, named, Scope::widened, rings);
+  const std::vector<int> here = detail::suspicion_margin_faces(x, extra, named, Scope::named, rings);
+  // Every face within the rings of a widened face, at both poles; only the top's with `named`.
+  CHECK(all == detail::faces_near(x, [&] {
+          std::vector<int> w;
+          for (int f = 0; f < x.num_faces(); ++f)
+            if (extra[f] > 0) w.push_back(f);
+          return w;
+        }(), rings));
+  CHECK(here == detail::faces_near(x, named, rings));
+  CHECK(std::count_if(all.begin(), all.end(), [&](int f) { return height(f) < 0.0; }) > 0);
+  CHECK(std::count_if(here.begin(), here.end(), [&](int f) { return height(f) < 0.0; }) == 0);
+  CHECK(here.size() * 2 == all.size());  // (the icosphere is point-symmetric: the poles are alike)
+  for (int f : named) CHECK(std::find(here.begin(), here.end(), f) != here.end());
+  // Two rings out from a pole's star: the faces on its star's vertices and on theirs.
+  CHECK(here.size() > named.size());
+  CHECK(detail::faces_near(x, named, 0).size() < here.size());
+  // Nothing widened, nothing named: no margin (the caller then gives none).
+  CHECK(detail::suspicion_margin_faces(x, std::vector<int>(x.num_faces(), 0), named, Scope::widened, rings).empty());
+  CHECK(detail::suspicion_margin_faces(x, extra, {}, Scope::named, rings).empty());
+}
+
 TEST_CASE("coarse to fine: a run gone on from a level's checkpoint ends as the whole run") {
   CoarseToFineOptions o = small_levels();
   o.lookahead_levels = 0;  // (one chain throughout; inside lookahead: the test case above)
@@ -1922,6 +1971,9 @@ TEST_CASE("coarse to fine: a true map restricts the coarsest level, and there is
   }
   beyond.recurring_beyond = 1;
   CHECK_NOTHROW(CoarseToFineMatcher(m, m, beyond));
+  CoarseToFineOptions scope;
+  scope.suspicion_margin_scope = static_cast<CoarseToFineOptions::MarginScope>(7);
+  CHECK_THROWS_AS(CoarseToFineMatcher(m, m, scope), InvalidInputError);
 }
 
 TEST_CASE("image split: an LP half the identity and half a rotation splits the images the rotation moves") {

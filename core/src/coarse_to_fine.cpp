@@ -8,6 +8,7 @@
 #include "key_set.hpp"
 #include "parallel.hpp"
 #include "recurring_conflicts.hpp"
+#include "suspicion_margin.hpp"
 
 #include <spdlog/spdlog.h>
 
@@ -540,6 +541,9 @@ CoarseToFineMatcher::CoarseToFineMatcher(const Mesh& x, const Mesh& y, CoarseToF
     throw InvalidInputError("coarse to fine: need a branch depth, rings, split and gap of 0 or more");
   if (options_.recurring_beyond < 1 || options_.recurring_beyond > kMaxRingBeyond)
     throw InvalidInputError("coarse to fine: need 1 ≤ --recurring-beyond ≤ " + std::to_string(kMaxRingBeyond));
+  if (options_.suspicion_margin_scope != CoarseToFineOptions::MarginScope::widened &&
+      options_.suspicion_margin_scope != CoarseToFineOptions::MarginScope::named)
+    throw InvalidInputError("coarse to fine: unknown suspicion margin scope");
   // Both shapes get the same number of levels (the larger shape's count), each its own face counts.
   HierarchyOptions ho = options_.hierarchy;
   if (ho.levels == 0)
@@ -1158,17 +1162,14 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
   };
   // The X faces within `rings` fine rings of every face widened so far at this level.
   auto around_widened = [&](int rings) {
-    const Mesh& X = lx.mesh;
-    std::vector<char> near(X.num_vertices(), 0);
-    for (int f = 0; f < X.num_faces() && f < int(extra.size()); ++f)
-      if (extra[f] > 0)
-        for (int v : X.faces[f]) near[v] = 1;
-    return faces_on(X, near, rings);
+    return detail::suspicion_margin_faces(lx.mesh, extra, {}, CoarseToFineOptions::MarginScope::widened, rings);
   };
-  // One more ring on every X face within `rings` of those widened so far, past max_ring if need
-  // be (not counted against max_local_widenings; counted as a margin widening).
-  auto widen_around = [&](int rings, const char* why) {
-    if (!widen_locally(around_widened(rings), why, options_.max_ring + kMaxRingBeyond, true)) return false;
+  // One more ring on every X face within `rings` of those widened so far (or of `faces` where
+  // given), past max_ring if need be (not counted against max_local_widenings; counted as a margin
+  // widening).
+  auto widen_around = [&](int rings, const char* why, const std::vector<int>* faces = nullptr) {
+    if (!widen_locally(faces ? *faces : around_widened(rings), why, options_.max_ring + kMaxRingBeyond, true))
+      return false;
     ++rep.margin_widenings;
     return true;
   };
@@ -1617,10 +1618,17 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
           // A patiently watched LP costs what several quickly watched ones do: room around every
           // suspicion first (CoarseToFineOptions::suspicion_rings says why), a few times per ring.
           if (options_.suspicion_rings > 0 && detail::margin_left(suspicion_margins, options_.suspicion_margins)) {
-            if (widen_around(options_.suspicion_rings, "probably infeasible around its widenings")) {
+            // (named: around the X faces the suspicion's own widening found, suspicion_margin_scope)
+            const bool named = options_.suspicion_margin_scope == CoarseToFineOptions::MarginScope::named;
+            const std::vector<int> faces = detail::suspicion_margin_faces(
+                lx.mesh, extra, named ? faces_to_widen(m, proof, options_.widen_margin, false) : std::vector<int>{},
+                options_.suspicion_margin_scope, options_.suspicion_rings);
+            if (widen_around(options_.suspicion_rings,
+                             named ? "probably infeasible around its places" : "probably infeasible around its widenings",
+                             &faces)) {
               ++suspicion_margins;  // (one that widened nothing was not given)
-              spdlog::info("level {}: widened around all earlier local widenings ({} rings) before it", l + 1,
-                           options_.suspicion_rings);
+              spdlog::info("level {}: widened around {} ({} rings) before it", l + 1,
+                           named ? "the suspicion's places" : "all earlier local widenings", options_.suspicion_rings);
             }
           } else if (options_.suspicion_rings > 0) {
             spdlog::info("level {}: no margin around its widenings before it ({} given at ring {})", l + 1,

@@ -142,6 +142,14 @@ struct CoarseToFineOptions {
   // places that the proof and the suspicion named were a few dozen faces (docs/results-log.md,
   // seventy-sixth session). The measured cure (FAUST_r 029-063, above) was one margin.
   int suspicion_margins = 1;
+  // Which faces that margin is drawn around: every X face widened so far at the level (widened,
+  // as before the seventy-eighth session) or only those the suspicion itself named (named: the X
+  // faces its local widening found on the rows where PDHG diverged). At full resolution the first
+  // is the space's largest amplifier: TOSCA_r david0-david6 without WKS, level 6, the margin took
+  // 2 937 faces (29.0 M → 32.3 M variables) where the suspicion named 84 (docs/results-log.md,
+  // seventy-seventh session); the measured cure on FAUST_r 029-063 (above) was the first.
+  enum class MarginScope { widened, named };
+  MarginScope suspicion_margin_scope = MarginScope::widened;
   // Where the zero-cost pre-test (RoundingOptions::feasibility_iterations) proves a level's first
   // LP infeasible for the first time at its ring, every X face within this many fine rings of the
   // faces widened so far gets one more ring too, as after the suspicion that the divergence watch
