@@ -115,6 +115,8 @@ Action add_checkpoint_command(CLI::App& app) {
           .set("price_widenings", a.report.price_widenings)
           .set("stuck_widenings", a.report.stuck_widenings)
           .set("stuck_restarts", a.report.stuck_restarts)
+          // (its next LP the re-solve after a pricing, from the iterate kept with it)
+          .set("warm_resolve", !a.priced_from.empty())
           .set("rounding", std::move(rounding));
     };
     Json levels = reports(c.levels);

@@ -557,6 +557,9 @@ TEST_CASE("cli: checkpoint shows both chains of a run stopped inside lookahead")
   a.rounding.rows = 4;
   a.rounding.ones = {1, 7};
   a.rounding.cap_scale = 4.0;
+  a.priced_from = shapematch::CarriedIterate::from_parts(
+      {.keys = {1, 2}, .values = {0.5, 0.25}, .row_edge = {3}, .y = {0.1, 0.2}, .closedness_rows = 1, .scale = 1.0});
+  a.cold_iterations = 64;
   const std::string inside_file = (tmp.path / "inside.ckpt").string();
   shapematch::save_checkpoint(inside_file, inside);
   const Run at = run("checkpoint " + inside_file);
@@ -570,6 +573,8 @@ TEST_CASE("cli: checkpoint shows both chains of a run stopped inside lookahead")
   CHECK(json_number(at.out.substr(top), "level") == 3);
   CHECK(json_number(at.out.substr(top), "fixings_to_one") == 2);
   CHECK(json_number(at.out.substr(top), "cap_scale") == 4);
+  CHECK(at.out.find("\"warm_resolve\": true", top) != std::string::npos);  // a pricing's iterate kept with it
+  CHECK(r.out.find("\"warm_resolve\"") == std::string::npos);               // (no attempt there)
   // Its first level alone: neither chain goes with it.
   const Run kept = run("checkpoint " + ckpt + " --keep-levels 1 --out " + ckpt);
   REQUIRE_MESSAGE(kept.code == 0, kept.err);

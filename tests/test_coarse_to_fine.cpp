@@ -1671,8 +1671,8 @@ TEST_CASE("coarse to fine: a run gone on from an attempt of a level in progress 
     bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
   }
   const size_t at = std::string("shapematch level checkpoint\n").size();
-  REQUIRE(bytes[at] == 12);
-  bytes[at] = 13;  // a later version than this build's
+  REQUIRE(bytes[at] == 13);
+  bytes[at] = 14;  // a later version than this build's
   std::ofstream(file, std::ios::binary) << bytes;
   CHECK_THROWS_AS(load_checkpoint(file), IoError);
   detail::save_checkpoint_as(file, marked, 1);
@@ -1692,7 +1692,82 @@ TEST_CASE("coarse to fine: a run gone on from an attempt of a level in progress 
   CHECK(v3.attempt.report.widened_faces == a.report.widened_faces);
   CHECK(v3.attempt.report.stuck_restarts == 0);
   CHECK(v3.levels.back().gamma == last.levels.back().gamma);
-  CHECK_THROWS_AS(detail::save_checkpoint_as(file, marked, 13), InvalidInputError);
+  CHECK_THROWS_AS(detail::save_checkpoint_as(file, marked, 14), InvalidInputError);
+}
+
+TEST_CASE("coarse to fine: a run gone on from the attempt after a pricing starts its re-solve warm, as the whole run") {
+  // The attempt checkpointed right after a pricing widened the space keeps the priced LP's
+  // iterate (version 13): a run gone on from it re-solves warm, capped at the cold solve's
+  // iterations, exactly as the uninterrupted run did; from a version-12 file it solves cold.
+  CoarseToFineOptions o = small_levels();
+  o.lookahead_levels = 0;
+  o.ring = 0;  // (the finest level's ring-0 space prices below zero one ring out)
+  REQUIRE(o.price_widenings > 0);
+  const CoarseToFineMatcher matcher = finger_matcher(o);
+  std::vector<LevelCheckpoint> priced;
+  const CoarseToFineResult whole = matcher.run({}, nullptr, [&](const LevelCheckpoint& c) {
+    if (!c.attempt.empty() && !c.attempt.priced_from.empty()) priced.push_back(c);
+  });
+  REQUIRE_FALSE(priced.empty());
+  const LevelCheckpoint& after = priced.back();
+  const LevelAttempt& a = after.attempt;
+  CHECK(a.report.price_widenings > 0);
+  CHECK(a.cold_iterations > 0);
+  CHECK(a.rounding.empty());
+
+  test::TempDir tmp;
+  const std::string file = (tmp.path / "priced.ckpt").string();
+  save_checkpoint(file, after);
+  const LevelCheckpoint loaded = load_checkpoint(file);
+  REQUIRE_FALSE(loaded.attempt.priced_from.empty());
+  CHECK(loaded.attempt.cold_iterations == a.cold_iterations);
+  CHECK(loaded.attempt.cold_seconds == a.cold_seconds);
+  {  // the same iterate back, part by part
+    const CarriedIterate::Parts p = a.priced_from.parts(), q = loaded.attempt.priced_from.parts();
+    CHECK_FALSE(p.keys.empty());
+    CHECK(q.keys == p.keys);
+    CHECK(q.values == p.values);
+    CHECK(q.row_edge == p.row_edge);
+    CHECK(q.y == p.y);
+    CHECK(q.scale == p.scale);
+  }
+  const CoarseToFineResult r = matcher.run({}, &loaded);
+  REQUIRE(r.levels.size() == whole.levels.size());
+  const LevelReport& f = r.levels.back();
+  const LevelReport& w = whole.levels.back();
+  CHECK(f.variables == w.variables);
+  CHECK(f.price_widenings == w.price_widenings);
+  CHECK(f.iterations == w.iterations);  // the re-solve's as warm as it was
+  CHECK(f.rounds == w.rounds);
+  CHECK(f.energy == doctest::Approx(w.energy).epsilon(1e-12));
+  CHECK(f.gamma == w.gamma);
+  CHECK(check_graph_surface(r.finest.space, r.rounding.gamma).ok());
+
+  // Version 12 kept no iterate: the same attempt, its re-solve cold (another iteration count).
+  detail::save_checkpoint_as(file, after, 12);
+  const LevelCheckpoint v12 = load_checkpoint(file);
+  CHECK(v12.attempt.priced_from.empty());
+  CHECK(v12.attempt.extra == a.extra);
+  const CoarseToFineResult cold = matcher.run({}, &v12);
+  CHECK(cold.levels.back().variables == w.variables);
+  CHECK(cold.levels.back().iterations != w.iterations);
+  CHECK(check_graph_surface(cold.finest.space, cold.rounding.gamma).ok());
+
+  // Parts that do not fit together are refused, in memory and in a file.
+  CarriedIterate::Parts bad = a.priced_from.parts();
+  bad.values.pop_back();
+  CHECK_THROWS_AS(CarriedIterate::from_parts(bad), InvalidInputError);
+  bad = a.priced_from.parts();
+  bad.y.assign(bad.y.size(), std::numeric_limits<double>::quiet_NaN());
+  CHECK_THROWS_AS(CarriedIterate::from_parts(bad), InvalidInputError);
+  LevelCheckpoint broken = after;
+  bad = a.priced_from.parts();
+  std::swap(bad.row_edge.front(), bad.row_edge.back());
+  REQUIRE(bad.row_edge.front() != bad.row_edge.back());
+  CHECK_THROWS_AS(CarriedIterate::from_parts(bad), InvalidInputError);
+  broken.attempt.cold_iterations = 0;
+  save_checkpoint(file, broken);
+  CHECK_THROWS_AS(load_checkpoint(file), IoError);
 }
 
 TEST_CASE("coarse to fine: a run gone on from a checkpoint inside a rounding fixes its decisions and keeps its bound") {

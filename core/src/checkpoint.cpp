@@ -20,9 +20,10 @@ constexpr char kMagic[] = "shapematch level checkpoint\n";
 // LevelReport::lookahead_other_bound and lookahead_other_stuck. 8: branch_roundings,
 // branch_energy and branch_kept. 9: LevelAttempt::zero_cost_margin_given follows `trusted`.
 // 10: LevelAttempt::Rounding::steps follows its ones. 11: LevelAttempt::suspicion_margins
-// follows zero_cost_margin_given. 12: LevelAttempt::Rounding::cap_scale follows its steps. 1 to 11
-// are read too.
-constexpr uint32_t kVersion = 12;
+// follows zero_cost_margin_given. 12: LevelAttempt::Rounding::cap_scale follows its steps. 13:
+// LevelAttempt::priced_from (a flag, then its parts and the cold solve's iterations and seconds)
+// follows the rounding. 1 to 12 are read too.
+constexpr uint32_t kVersion = 13;
 
 // Every number of a report, in the file's order (the Γ follows on its own). A field added to
 // LevelReport goes here too, with kVersion one higher; the size check below is the reminder.
@@ -137,6 +138,13 @@ void write_attempt(Writer& w, const LevelAttempt& a, uint32_t version) {
     if (version >= 10) w.array(g.steps);
     if (version >= 12) w(g.cap_scale);
   }
+  if (version < 13) return;
+  w(!a.priced_from.empty());
+  if (a.priced_from.empty()) return;
+  const CarriedIterate::Parts p = a.priced_from.parts();
+  w.array(p.keys), w.array(p.values), w.array(p.row_edge), w.array(p.y);
+  w(p.closedness_rows), w(p.scale), w(p.primal_weight);
+  w(a.cold_iterations), w(a.cold_seconds);
 }
 void read_attempt(Reader& r, LevelAttempt& a, uint32_t version, const std::string& path) {
   bool held = false;
@@ -161,6 +169,22 @@ void read_attempt(Reader& r, LevelAttempt& a, uint32_t version, const std::strin
                     ")");
   }
   if (a.ring < 0) throw IoError(path + ": not a shapematch checkpoint (an attempt at ring " + std::to_string(a.ring) + ")");
+  if (version < 13) return;
+  bool priced = false;
+  r(priced);
+  if (!priced) return;
+  CarriedIterate::Parts p;
+  r.array(p.keys), r.array(p.values), r.array(p.row_edge), r.array(p.y);
+  r(p.closedness_rows), r(p.scale), r(p.primal_weight);
+  r(a.cold_iterations), r(a.cold_seconds);
+  try {
+    a.priced_from = CarriedIterate::from_parts(std::move(p));
+  } catch (const InvalidInputError& e) {
+    throw IoError(path + ": not a shapematch checkpoint (" + e.what() + ")");
+  }
+  if (a.cold_iterations <= 0 || !(a.cold_seconds >= 0.0) || !std::isfinite(a.cold_seconds))
+    throw IoError(path + ": not a shapematch checkpoint (a re-solve's cap of " + std::to_string(a.cold_iterations) +
+                  " iterations)");
 }
 
 }  // namespace

@@ -921,6 +921,44 @@ void CarriedIterate::keep(const MatchingLp& m, const std::vector<double>& x, con
   primal_weight_ = primal_weight > 0.0 && std::isfinite(primal_weight) ? primal_weight : 0.0;
 }
 
+CarriedIterate::Parts CarriedIterate::parts() const {
+  Parts p;
+  p.keys.reserve(x_.size());
+  p.values.reserve(x_.size());
+  for (const auto& [k, v] : x_) p.keys.push_back(k), p.values.push_back(v);
+  p.row_edge = row_edge_;
+  p.y = y_;
+  p.closedness_rows = closedness_rows_;
+  p.scale = scale_;
+  p.primal_weight = primal_weight_;
+  return p;
+}
+
+CarriedIterate CarriedIterate::from_parts(Parts p) {
+  auto bad = [](const std::string& what) { throw InvalidInputError("carried iterate: " + what); };
+  if (p.keys.size() != p.values.size()) bad("need one value per key");
+  if (!std::is_sorted(p.keys.begin(), p.keys.end()) || !std::is_sorted(p.row_edge.begin(), p.row_edge.end()))
+    bad("keys and rows out of order");
+  if (p.closedness_rows < 0 || p.closedness_rows != int64_t(p.row_edge.size()) ||
+      int64_t(p.y.size()) < p.closedness_rows)
+    bad("need one product edge per closedness row and a dual per row");
+  if (!(p.scale > 0.0) || !std::isfinite(p.scale) || !(p.primal_weight >= 0.0) || !std::isfinite(p.primal_weight))
+    bad("a scale or primal weight out of range");
+  for (double v : p.values)
+    if (!(v > 0.0) || !std::isfinite(v)) bad("a primal value out of range");
+  for (double v : p.y)
+    if (!std::isfinite(v)) bad("a dual value out of range");
+  CarriedIterate c;
+  c.x_.reserve(p.keys.size());
+  for (size_t i = 0; i < p.keys.size(); ++i) c.x_.emplace_back(p.keys[i], p.values[i]);
+  c.row_edge_ = std::move(p.row_edge);
+  c.y_ = std::move(p.y);
+  c.closedness_rows_ = p.closedness_rows;
+  c.scale_ = p.scale;
+  c.primal_weight_ = p.primal_weight;
+  return c;
+}
+
 namespace {
 // The y_i that maximises Σ_j min(0, s_j − a_ij y_i) over row i's entries (s_j: column j's reduced
 // cost without row i), the one nearest `current` where several do. The sum is concave and
@@ -1129,6 +1167,15 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
   // columns are new), so it is feasible too, and the zero-cost pre-test would only cost. (Not
   // after the ring grows: the extra rings beyond max_ring are cut back there.)
   bool feasible_seen = false;
+  if (resume && !resume->priced_from.empty() && resume->rounding.empty()) {  // its re-solve, warm as it would have been
+    priced_from = resume->priced_from;
+    price_warm = feasible_seen = true;
+    cold_iterations = resume->cold_iterations;
+    cold_seconds = resume->cold_seconds;
+    spdlog::info("level {}: its re-solve after pricing starts from the checkpointed iterate (the cold solve's "
+                 "{} iterations cap it)",
+                 l + 1, cold_iterations);
+  }
   bool propagating = false;
   detail::RecurringConflicts recurring;  // π rows where propagation failed, by face
   // One more fine ring on these faces (up to `cap` rings); false if none could grow. `last`: the
@@ -1238,6 +1285,11 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
     a.trusted = suspicions.trusted();
     a.zero_cost_margin_given = zero_cost_margin_given;
     a.suspicion_margins = suspicion_margins;
+    if (price_warm) {  // (the re-solve after a pricing, about to start)
+      a.priced_from = priced_from;
+      a.cold_iterations = cold_iterations;
+      a.cold_seconds = cold_seconds;
+    }
     a.report = rep;
     a.report.gamma.clear();
     return a;

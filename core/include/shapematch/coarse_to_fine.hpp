@@ -49,6 +49,20 @@ public:
   // only misplaces a warm-start value (or a carried fixing, which propagation then checks).
   static uint64_t key(const ProductTriangle& t);
 
+  // What it holds, for a checkpoint (LevelAttempt::priced_from): the nonzero primal values by key
+  // (keys sorted), the kept LP's closedness rows' product edges (sorted) and all its duals.
+  struct Parts {
+    std::vector<uint64_t> keys;
+    std::vector<double> values;
+    std::vector<int64_t> row_edge;
+    std::vector<double> y;
+    int64_t closedness_rows = 0;
+    double scale = 0.0, primal_weight = 0.0;
+  };
+  Parts parts() const;
+  // Throws InvalidInputError where the parts do not fit together (sizes, order, values).
+  static CarriedIterate from_parts(Parts p);
+
 private:
   std::vector<std::pair<uint64_t, double>> x_;  // sorted by key; only the nonzero values
   std::vector<int64_t> row_edge_;
@@ -463,6 +477,14 @@ struct LevelAttempt {
   bool zero_cost_margin_given = false;
   // The suspicion_rings margins given at this ring (version 11; before, none counted).
   int suspicion_margins = 0;
+  // Where the attempt is the re-solve after a pricing widened the space: the iterate it starts
+  // from (the priced LP's), and the cold first LP's iterations and seconds, which cap it and scale
+  // its rounding (version 13; before, a run gone on from here solved it cold: TOSCA_r
+  // david0-david6 without WKS at full resolution, level 6, 32.5 M variables, about an hour on one
+  // core against 704 iterations warm on the same level of the other run). Empty elsewhere.
+  CarriedIterate priced_from;
+  int64_t cold_iterations = 0;
+  double cold_seconds = 0.0;
   LevelReport report;            // its counts so far (widenings, widened faces, …); no Γ
   // Where the attempt's rounding had got, saved after its rounds (at most every few seconds): a
   // run gone on from it builds the same LP, fixes `ones` before its round 1 and keeps round 1's
