@@ -97,6 +97,7 @@ struct MatchArgs {
   bool stuck_carry = CoarseToFineOptions{}.stuck_carry;
   int stuck_restarts = CoarseToFineOptions{}.stuck_restarts;
   double rounding_checkpoint_seconds = CoarseToFineOptions{}.rounding_checkpoint_seconds;
+  double lp_checkpoint_seconds = CoarseToFineOptions{}.lp_checkpoint_seconds;
   int stuck_stalled = RoundingOptions{}.stuck_stalled;
   int price_widenings = CoarseToFineOptions{}.price_widenings;
   int lookahead_levels = CoarseToFineOptions{}.lookahead_levels;
@@ -233,6 +234,7 @@ int run_match(const MatchArgs& args) {
   co.stuck_carry = args.stuck_carry;
   co.stuck_restarts = args.stuck_restarts;
   co.rounding_checkpoint_seconds = args.rounding_checkpoint_seconds;
+  co.lp_checkpoint_seconds = args.lp_checkpoint_seconds;
   co.price_widenings = args.price_widenings;
   co.lookahead_levels = args.lookahead_levels;
   co.lookahead_drop_stuck = args.lookahead_drop_stuck;
@@ -321,6 +323,9 @@ int run_match(const MatchArgs& args) {
       else if (!a.rounding.empty())
         spdlog::info("checkpoint in level {}'s rounding{}, after round {} ({} fixings to 1): {}", c.done() + 1, chain,
                      a.rounding.rounds, a.rounding.ones.size(), args.checkpoint);
+      else if (!a.solving.empty())
+        spdlog::info("checkpoint in level {}{}'s {} at {} iterations: {}", c.done() + 1, chain,
+                     a.solving_resolve ? "re-solve after pricing" : "first LP", a.solving_iterations, args.checkpoint);
       else
         spdlog::info("checkpoint in level {}{}, before its next attempt (ring {}, {} faces with extra rings): {}",
                      c.done() + 1, chain, a.ring,
@@ -592,6 +597,7 @@ int run_match(const MatchArgs& args) {
                               .set("stuck_carry", args.stuck_carry)
                               .set("stuck_restarts", args.stuck_restarts)
                               .set("rounding_checkpoint_seconds", args.rounding_checkpoint_seconds)
+                              .set("lp_checkpoint_seconds", args.lp_checkpoint_seconds)
                               .set("stuck_stalled", args.stuck_stalled)
                               .set("price_widenings", args.price_widenings)
                               .set("price_threshold", args.price_threshold)
@@ -891,6 +897,11 @@ Action add_match_command(CLI::App& app) {
   app.add_option("--rounding-checkpoint-seconds", a->rounding_checkpoint_seconds,
                  "with --checkpoint: save where a level's rounding has got after its rounds, at most this often "
                  "(seconds)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  app.add_option("--lp-checkpoint-seconds", a->lp_checkpoint_seconds,
+                 "with --checkpoint: save a refined level's first LP's iterate with its attempt at most this often "
+                 "(seconds), so that a run gone on from it starts that LP there (0: never)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   auto* tr = app.add_option("--truth", a->truth,

@@ -442,6 +442,7 @@ TEST_CASE("cli: match --checkpoint goes on after the levels a stopped run finish
   CHECK(json_number(first, "suspicion_margins") == 1);              // the default
   CHECK(json_number(first, "recurring_beyond") == 3);               // the default
   CHECK(json_string(first, "suspicion_margin_around") == "widened");  // the default
+  CHECK(json_number(first, "lp_checkpoint_seconds") == 600);          // the default
   CHECK(json_number(first, "max_suspected_widenings") == 1);        // the default
   CHECK(first.find("\"stuck_restarts\": 1") != std::string::npos);
   CHECK(first.find("\"stuck_restarts\": 0") != std::string::npos);  // per level
@@ -455,6 +456,10 @@ TEST_CASE("cli: match --checkpoint goes on after the levels a stopped run finish
   r = run("match " + dolphin + " " + swimming + " --recurring-beyond 0 -o " + (tmp.path / "d").string());
   CHECK(r.code != 0);
   CHECK(r.err.find("--recurring-beyond") != std::string::npos);
+  CHECK_FALSE(fs::exists(tmp.path / "d"));
+  r = run("match " + dolphin + " " + swimming + " --lp-checkpoint-seconds -1 -o " + (tmp.path / "d").string());
+  CHECK(r.code != 0);
+  CHECK(r.err.find("--lp-checkpoint-seconds") != std::string::npos);
   CHECK_FALSE(fs::exists(tmp.path / "d"));
   r = run("match " + dolphin + " " + swimming + " --suspicion-margin-around all -o " + (tmp.path / "d").string());
   CHECK(r.code != 0);
@@ -574,6 +579,7 @@ TEST_CASE("cli: checkpoint shows both chains of a run stopped inside lookahead")
   CHECK(json_number(at.out.substr(top), "fixings_to_one") == 2);
   CHECK(json_number(at.out.substr(top), "cap_scale") == 4);
   CHECK(at.out.find("\"warm_resolve\": true", top) != std::string::npos);  // a pricing's iterate kept with it
+  CHECK(at.out.find("\"solving_iterations\": null", top) != std::string::npos);  // no LP under way kept
   CHECK(r.out.find("\"warm_resolve\"") == std::string::npos);               // (no attempt there)
   // Its first level alone: neither chain goes with it.
   const Run kept = run("checkpoint " + ckpt + " --keep-levels 1 --out " + ckpt);

@@ -1695,6 +1695,63 @@ TEST_CASE("coarse to fine: a run gone on from an attempt of a level in progress 
   CHECK_THROWS_AS(detail::save_checkpoint_as(file, marked, 14), InvalidInputError);
 }
 
+TEST_CASE("coarse to fine: a run gone on from inside a refined level's first LP starts that LP where it was") {
+  // lp_checkpoint_seconds: the attempt is saved with its first LP's iterate as it goes (here at
+  // every residual check); a run gone on from the last such save solves the rest of that LP, not
+  // all of it, and ends with a verified Γ of about the same energy.
+  CoarseToFineOptions o = small_levels();
+  o.lookahead_levels = 0;
+  o.price_widenings = 0;  // (one first LP at the finest level: the one saved)
+  o.lp_checkpoint_seconds = 1e-9;
+  REQUIRE(CoarseToFineOptions{}.lp_checkpoint_seconds > 0.0);  // on by default
+  const CoarseToFineMatcher matcher = finger_matcher(o);
+  const int finest = static_cast<int>(matcher.x_levels().size()) - 1;
+  std::vector<LevelCheckpoint> solving;
+  std::vector<int64_t> firsts;  // the finest level's round-1 iterations, attempt by attempt
+  auto at_finest = [&](std::vector<int64_t>& into) {
+    return [&, finest](const LevelReport& l, const RoundingRound& r) {
+      if (l.level == finest && r.round == 1) into.push_back(r.iterations);
+    };
+  };
+  const CoarseToFineResult whole = matcher.run(at_finest(firsts), nullptr, [&](const LevelCheckpoint& c) {
+    if (!c.attempt.empty() && !c.attempt.solving.empty() && c.attempt.report.level == finest) solving.push_back(c);
+  });
+  REQUIRE(firsts.size() == 1);
+  REQUIRE(solving.size() >= 3);
+  const LevelCheckpoint& late = solving.back();
+  const int64_t done = late.attempt.solving_iterations;
+  CHECK_FALSE(late.attempt.solving_resolve);
+  CHECK(done > 0);
+  CHECK(done <= firsts[0]);
+  CHECK(late.attempt.rounding.empty());
+  // Through a file, and on from it.
+  test::TempDir tmp;
+  const std::string file = (tmp.path / "solving.ckpt").string();
+  save_checkpoint(file, late);
+  const LevelCheckpoint loaded = load_checkpoint(file);
+  REQUIRE_FALSE(loaded.attempt.solving.empty());
+  CHECK(loaded.attempt.solving_iterations == done);
+  CHECK(loaded.attempt.solving.parts().y == late.attempt.solving.parts().y);
+  std::vector<int64_t> rest;
+  const CoarseToFineResult r = matcher.run(at_finest(rest), &loaded);  // (no checkpointing: no saves)
+  REQUIRE(rest.size() == 1);
+  MESSAGE("first LP: ", firsts[0], " iterations whole, ", done, " before the save and ", rest[0], " after it");
+  CHECK(rest[0] < firsts[0]);
+  CHECK(rest[0] <= firsts[0] - done / 2);  // (it goes on, not from zero)
+  const LevelReport& f = r.levels.back();
+  CHECK(f.iterations >= rest[0] + done);  // the report counts those before the save too
+  CHECK(check_graph_surface(r.finest.space, r.rounding.gamma).ok());
+  CHECK(f.energy == doctest::Approx(whole.levels.back().energy).epsilon(0.05));
+  // A version-12 file has no iterate: the same attempt from zero.
+  detail::save_checkpoint_as(file, late, 12);
+  CHECK(load_checkpoint(file).attempt.solving.empty());
+  // An LP under way at a negative count is refused.
+  LevelCheckpoint broken = late;
+  broken.attempt.solving_iterations = -1;
+  save_checkpoint(file, broken);
+  CHECK_THROWS_AS(load_checkpoint(file), IoError);
+}
+
 TEST_CASE("coarse to fine: a run gone on from the attempt after a pricing starts its re-solve warm, as the whole run") {
   // The attempt checkpointed right after a pricing widened the space keeps the priced LP's
   // iterate (version 13): a run gone on from it re-solves warm, capped at the cold solve's
@@ -1768,6 +1825,27 @@ TEST_CASE("coarse to fine: a run gone on from the attempt after a pricing starts
   broken.attempt.cold_iterations = 0;
   save_checkpoint(file, broken);
   CHECK_THROWS_AS(load_checkpoint(file), IoError);
+
+  // Saved inside that re-solve (lp_checkpoint_seconds), a run gone on from it goes on with the
+  // re-solve's rules: from that iterate, capped at what is left of the cold solve's iterations.
+  o.lp_checkpoint_seconds = 1e-9;
+  const CoarseToFineMatcher saving = finger_matcher(o);
+  std::vector<LevelCheckpoint> inside;
+  const CoarseToFineResult again = saving.run({}, nullptr, [&](const LevelCheckpoint& c) {
+    if (!c.attempt.empty() && c.attempt.solving_resolve) inside.push_back(c);
+  });
+  CHECK(again.levels.back().energy == doctest::Approx(w.energy).epsilon(1e-12));  // the saves change nothing
+  REQUIRE_FALSE(inside.empty());
+  const LevelAttempt& at = inside.back().attempt;
+  CHECK(at.cold_iterations > 0);
+  CHECK(at.priced_from.empty());  // (the re-solve had started from it)
+  save_checkpoint(file, inside.back());
+  const LevelCheckpoint inside_loaded = load_checkpoint(file);
+  CHECK(inside_loaded.attempt.solving_resolve);
+  const CoarseToFineResult on = saving.run({}, &inside_loaded);
+  CHECK(check_graph_surface(on.finest.space, on.rounding.gamma).ok());
+  CHECK(on.levels.back().energy == doctest::Approx(w.energy).epsilon(0.05));
+  CHECK(on.levels.back().iterations <= w.iterations + 64);  // (not the re-solve again from zero)
 }
 
 TEST_CASE("coarse to fine: a run gone on from a checkpoint inside a rounding fixes its decisions and keeps its bound") {

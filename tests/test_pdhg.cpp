@@ -260,6 +260,52 @@ TEST_CASE("pdhg-cpu: a warm start goes on with the primal weight its solve ended
   CHECK(carried.iterations < cold.iterations);
 }
 
+TEST_CASE("pdhg-cpu: a snapshot is a point the solve can start again from, near where it was") {
+  const Mesh x = shapes::octahedron();
+  const Mesh y = test::deformed(x, [](const Eigen::Vector3d& p) {
+    return Eigen::Vector3d(1.3 * p.x() + 0.1 * p.z(), p.y(), 0.8 * p.z() + 0.05 * p.x() * p.y());
+  });
+  const MatchingLp m = build_matching_lp(x, compute_geometry(x), y, compute_geometry(y));
+  SolverParams params = tight(1e-6);
+  struct Snapshot {
+    std::vector<double> x, y;
+    double omega = 0.0;
+    int64_t iterations = 0;
+  };
+  std::vector<Snapshot> seen;
+  params.snapshot_seconds = 1e-9;  // (at every residual check)
+  params.snapshot = [&](const std::vector<double>& sx, const std::vector<double>& sy, double w, int64_t it) {
+    seen.push_back({sx, sy, w, it});
+  };
+  const LpResult whole = solve_lp(m.lp, "pdhg-cpu", params);
+  REQUIRE(whole.status == LpStatus::Optimal);
+  REQUIRE(seen.size() >= 2);
+  for (const Snapshot& s : seen) {
+    CHECK(s.x.size() == size_t(m.lp.cols()));
+    CHECK(s.y.size() == size_t(m.lp.rows()));
+    CHECK(s.omega > 0.0);
+    CHECK(s.iterations <= whole.iterations);
+  }
+  CHECK(seen.back().iterations > seen.front().iterations);
+  // From the last one, with its ω: the rest of the solve, not all of it, to the same optimum.
+  const Snapshot& last = seen.back();
+  SolverParams again = tight(1e-6);
+  again.initial_x = last.x;
+  again.initial_y = last.y;
+  again.initial_primal_weight = last.omega;
+  const LpResult rest = solve_lp(m.lp, "pdhg-cpu", again);
+  REQUIRE(rest.status == LpStatus::Optimal);
+  MESSAGE("whole " << whole.iterations << " iterations, snapshot at " << last.iterations << ", the rest "
+                   << rest.iterations);
+  CHECK(rest.iterations <= whole.iterations - last.iterations + 64);
+  CHECK(std::abs(rest.objective - whole.objective) <= 1e-5 * (1.0 + std::abs(whole.objective)));
+  // Unset or at 0 seconds: never called.
+  params.snapshot_seconds = 0.0;
+  seen.clear();
+  solve_lp(m.lp, "pdhg-cpu", params);
+  CHECK(seen.empty());
+}
+
 TEST_CASE("pdhg-cpu: the cold primal weight starts cold solves only; an explicit ω wins") {
   const Mesh x = shapes::octahedron();
   const Mesh y = test::deformed(x, [](const Eigen::Vector3d& p) { return Eigen::Vector3d(1.2 * p.x(), p.y(), 0.9 * p.z()); });

@@ -21,8 +21,8 @@ constexpr char kMagic[] = "shapematch level checkpoint\n";
 // branch_energy and branch_kept. 9: LevelAttempt::zero_cost_margin_given follows `trusted`.
 // 10: LevelAttempt::Rounding::steps follows its ones. 11: LevelAttempt::suspicion_margins
 // follows zero_cost_margin_given. 12: LevelAttempt::Rounding::cap_scale follows its steps. 13:
-// LevelAttempt::priced_from (a flag, then its parts and the cold solve's iterations and seconds)
-// follows the rounding. 1 to 12 are read too.
+// LevelAttempt::priced_from and solving (each a flag, then its parts; solving's iterations and
+// flag; where either, the cold solve's iterations and seconds) follow the rounding. 1 to 12 are read too.
 constexpr uint32_t kVersion = 13;
 
 // Every number of a report, in the file's order (the Γ follows on its own). A field added to
@@ -119,6 +119,23 @@ void read_levels(Reader& r, std::vector<LevelReport>& levels, uint64_t count, ui
   }
 }
 
+// A warm start kept with an attempt (version >= 13): CarriedIterate::Parts.
+void write_iterate(Writer& w, const CarriedIterate& c) {
+  const CarriedIterate::Parts p = c.parts();
+  w.array(p.keys), w.array(p.values), w.array(p.row_edge), w.array(p.y);
+  w(p.closedness_rows), w(p.scale), w(p.primal_weight);
+}
+CarriedIterate read_iterate(Reader& r, const std::string& path) {
+  CarriedIterate::Parts p;
+  r.array(p.keys), r.array(p.values), r.array(p.row_edge), r.array(p.y);
+  r(p.closedness_rows), r(p.scale), r(p.primal_weight);
+  try {
+    return CarriedIterate::from_parts(std::move(p));
+  } catch (const InvalidInputError& e) {
+    throw IoError(path + ": not a shapematch checkpoint (" + e.what() + ")");
+  }
+}
+
 // A flag, then (where set) the attempt (version >= 2).
 void write_attempt(Writer& w, const LevelAttempt& a, uint32_t version) {
   w(!a.empty());
@@ -140,11 +157,13 @@ void write_attempt(Writer& w, const LevelAttempt& a, uint32_t version) {
   }
   if (version < 13) return;
   w(!a.priced_from.empty());
-  if (a.priced_from.empty()) return;
-  const CarriedIterate::Parts p = a.priced_from.parts();
-  w.array(p.keys), w.array(p.values), w.array(p.row_edge), w.array(p.y);
-  w(p.closedness_rows), w(p.scale), w(p.primal_weight);
-  w(a.cold_iterations), w(a.cold_seconds);
+  if (!a.priced_from.empty()) write_iterate(w, a.priced_from);
+  w(!a.solving.empty());
+  if (!a.solving.empty()) {
+    write_iterate(w, a.solving);
+    w(a.solving_iterations), w(a.solving_resolve);
+  }
+  if (!a.priced_from.empty() || !a.solving.empty()) w(a.cold_iterations), w(a.cold_seconds);
 }
 void read_attempt(Reader& r, LevelAttempt& a, uint32_t version, const std::string& path) {
   bool held = false;
@@ -170,19 +189,21 @@ void read_attempt(Reader& r, LevelAttempt& a, uint32_t version, const std::strin
   }
   if (a.ring < 0) throw IoError(path + ": not a shapematch checkpoint (an attempt at ring " + std::to_string(a.ring) + ")");
   if (version < 13) return;
-  bool priced = false;
+  bool priced = false, solving = false;
   r(priced);
-  if (!priced) return;
-  CarriedIterate::Parts p;
-  r.array(p.keys), r.array(p.values), r.array(p.row_edge), r.array(p.y);
-  r(p.closedness_rows), r(p.scale), r(p.primal_weight);
-  r(a.cold_iterations), r(a.cold_seconds);
-  try {
-    a.priced_from = CarriedIterate::from_parts(std::move(p));
-  } catch (const InvalidInputError& e) {
-    throw IoError(path + ": not a shapematch checkpoint (" + e.what() + ")");
+  if (priced) a.priced_from = read_iterate(r, path);
+  r(solving);
+  if (solving) {
+    a.solving = read_iterate(r, path);
+    r(a.solving_iterations), r(a.solving_resolve);
+    if (a.solving_iterations < 0)
+      throw IoError(path + ": not a shapematch checkpoint (an LP under way at " + std::to_string(a.solving_iterations) +
+                    " iterations)");
   }
-  if (a.cold_iterations <= 0 || !(a.cold_seconds >= 0.0) || !std::isfinite(a.cold_seconds))
+  if (priced || solving) r(a.cold_iterations), r(a.cold_seconds);
+  // (A re-solve is capped at the cold solve's iterations: it needs them.)
+  if ((priced || a.solving_resolve) &&
+      (a.cold_iterations <= 0 || !(a.cold_seconds >= 0.0) || !std::isfinite(a.cold_seconds)))
     throw IoError(path + ": not a shapematch checkpoint (a re-solve's cap of " + std::to_string(a.cold_iterations) +
                   " iterations)");
 }

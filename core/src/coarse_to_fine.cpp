@@ -1167,8 +1167,22 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
   // columns are new), so it is feasible too, and the zero-cost pre-test would only cost. (Not
   // after the ring grows: the extra rings beyond max_ring are cut back there.)
   bool feasible_seen = false;
-  if (resume && !resume->priced_from.empty() && resume->rounding.empty()) {  // its re-solve, warm as it would have been
-    priced_from = resume->priced_from;
+  // A checkpointed attempt's first LP under way (LevelAttempt::solving): the first attempt here
+  // starts it where it was, `solving_done` iterations in.
+  CarriedIterate solving_from;
+  int64_t solving_done = 0;
+  bool solving_resolve = false;
+  if (resume && resume->rounding.empty() && !resume->solving.empty()) {
+    solving_from = resume->solving;
+    solving_done = resume->solving_iterations;
+    solving_resolve = resume->solving_resolve;
+    feasible_seen = feasible_seen || solving_resolve;  // (the re-solve's space held an optimum)
+    cold_iterations = resume->cold_iterations;
+    cold_seconds = resume->cold_seconds;
+    spdlog::info("level {}: its {} goes on from the checkpointed iterate after {} iterations", l + 1,
+                 solving_resolve ? "re-solve after pricing" : "first LP", solving_done);
+  } else if (resume && resume->rounding.empty() && !resume->priced_from.empty()) {
+    priced_from = resume->priced_from;  // its re-solve, warm as it would have been
     price_warm = feasible_seen = true;
     cold_iterations = resume->cold_iterations;
     cold_seconds = resume->cold_seconds;
@@ -1397,7 +1411,9 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
     try {
       RoundingOptions ro = rounding_for(l);
       const bool carrying = l > 0 && !carried_ones.empty();
-      const bool warm_resolve = price_warm && !carrying;
+      // The first attempt of a run gone on from inside its first LP starts that LP where it was.
+      const bool from_solving = first_attempt && !solving_from.empty() && !carrying && !going_on;
+      const bool warm_resolve = (price_warm || (from_solving && solving_resolve)) && !carrying;
       const detail::FirstLpState first_state{.refined = l > 0,
                                              .widenings_left =
                                                  options_.local_widening && local < options_.max_local_widenings,
@@ -1415,21 +1431,29 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
       // 1 920-2 624), except where its tail creeps (the cat: 11 328 against 4 480). It stops at the
       // cold count; rounding goes on from its iterate and its bound stays valid.
       if (warm_resolve) {
-        priced_from.apply(m, ro.lp);
-        if (options_.price_dual_sweeps > 0) {
-          const double at_zero = certified_lower_bound(m.lp, ro.lp.initial_y);
-          const int64_t fresh = priced_from.ascend_new_rows(m, ro.lp.initial_y, options_.price_dual_sweeps);
-          spdlog::info("level {}: duals of {} new rows by {} sweeps of coordinate ascent: the warm start's bound {:.6g} "
-                       "(at 0: {:.6g})",
-                       l + 1, fresh, options_.price_dual_sweeps, certified_lower_bound(m.lp, ro.lp.initial_y), at_zero);
+        if (from_solving) {
+          solving_from.apply(m, ro.lp);
+        } else {
+          priced_from.apply(m, ro.lp);
+          if (options_.price_dual_sweeps > 0) {
+            const double at_zero = certified_lower_bound(m.lp, ro.lp.initial_y);
+            const int64_t fresh = priced_from.ascend_new_rows(m, ro.lp.initial_y, options_.price_dual_sweeps);
+            spdlog::info("level {}: duals of {} new rows by {} sweeps of coordinate ascent: the warm start's bound "
+                         "{:.6g} (at 0: {:.6g})",
+                         l + 1, fresh, options_.price_dual_sweeps, certified_lower_bound(m.lp, ro.lp.initial_y),
+                         at_zero);
+          }
         }
-        ro.first_max_iterations = cold_iterations;
+        ro.first_max_iterations = std::max<int64_t>(cold_iterations - (from_solving ? solving_done : 0), 1);
         // The later rounds' caps and the stuck rules scale with what a solve of this level costs,
         // which the warm re-solve understates: FAUST_r 024-043 at full resolution, level 6 (thirtieth
         // session), 704 iterations and 114 s against 2 944 and 418 s cold. Its rounding's later
         // rounds then sat at the 2 000-iteration floor and the stall rule gave up 319 s after the low.
         ro.reference_seconds = cold_seconds;
         ro.reference_iterations = cold_iterations;
+      } else if (from_solving) {
+        solving_from.apply(m, ro.lp);
+        ro.feasibility_iterations = 0;  // (it had passed its pre-test)
       }
       price_warm = false;
       if (feasible_seen) ro.feasibility_iterations = 0;  // (a start from fixings has none: rounding)
@@ -1534,6 +1558,20 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
           };
         }
       }
+      // The first LP's iterate saved with the attempt as it goes (lp_checkpoint_seconds says why).
+      if (attempted && l > 0 && options_.lp_checkpoint_seconds > 0.0 && !carrying && !going_on) {
+        ro.snapshot_seconds = options_.lp_checkpoint_seconds;
+        ro.first_snapshot = [&, resolve = warm_resolve, before = from_solving ? solving_done : 0](
+                                const std::vector<double>& x, const std::vector<double>& y, double w, int64_t it) {
+          LevelAttempt a = current_attempt();
+          a.solving.keep(m, x, y, w);
+          a.solving_iterations = before + it;
+          a.solving_resolve = resolve;
+          a.cold_iterations = cold_iterations;
+          a.cold_seconds = cold_seconds;
+          attempted(a);
+        };
+      }
       // Where rounding gets stuck, widen around it (as for an infeasible LP) and solve again.
       if (l > 0 && options_.local_widening && local < options_.max_local_widenings)
         ro.stuck_after = options_.stuck_after;
@@ -1541,10 +1579,14 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
                                                  [&](const RoundingRound& r) {
                                                    if (r.round == 1 && !carrying && !going_on) {
                                                      if (r.status == LpStatus::Optimal) feasible_seen = true;
-                                                     first_iterations = r.iterations;
+                                                     // (gone on from inside it: with those before)
+                                                     first_iterations = r.iterations + (from_solving ? solving_done : 0);
                                                      if (!warm_resolve) {
-                                                       cold_iterations = r.iterations;
-                                                       cold_seconds = r.seconds;
+                                                       cold_iterations = first_iterations;
+                                                       cold_seconds = r.iterations > 0 ? r.seconds *
+                                                                                             double(first_iterations) /
+                                                                                             double(r.iterations)
+                                                                                       : r.seconds;
                                                      }
                                                      reference_iterations = cold_iterations;
                                                      reference_seconds = cold_seconds;
@@ -1589,6 +1631,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
         rep.rounds += going_on->rounds;
         rep.iterations += going_on->iterations;
       }
+      if (from_solving) rep.iterations += solving_done;
       if (l + 1 == hx_.size()) {
         result.finest = std::move(m);
         result.rounding = std::move(rr);

@@ -164,6 +164,7 @@ LpResult PdhgSolver::solve(const LpProblem& problem, const SolverParams& params)
   int64_t window_end = detail::DivergenceWatch::kWindow;
   std::vector<double> window_y;
   int restarts = 0;
+  Stopwatch since_snapshot;
   result.status = LpStatus::IterationLimit;
   while (true) {
     if (total >= params.max_iterations) {
@@ -255,6 +256,17 @@ LpResult PdhgSolver::solve(const LpProblem& problem, const SolverParams& params)
       }
       window_y = std::move(yh);
       window_end = total + detail::DivergenceWatch::kWindow;
+    }
+
+    // A point to start this solve again from, for the caller's checkpoint (SolverParams::snapshot).
+    if (params.snapshot && params.snapshot_seconds > 0.0 && since_snapshot.seconds() >= params.snapshot_seconds) {
+      std::vector<double> xh, yh;
+      backend->read(xh, yh);
+      std::vector<double> x(n), y(m);
+      for (int64_t j = 0; j < n; ++j) x[j] = d[j] * xh[j];
+      for (int64_t i = 0; i < m; ++i) y[i] = r[i] * yh[i];
+      params.snapshot(x, y, omega, total);
+      since_snapshot.reset();
     }
 
     // Restarts on the fixed-point residual (cuPDLPx): sufficient decay, necessary decay without

@@ -339,6 +339,7 @@ SolverParams pretest_params(const SolverParams& params, int64_t cap, double tole
   if (tolerance > 0.0) zp.tolerance = tolerance;
   zp.stop_on_divergence = false;
   zp.patient_divergence_watch = false;
+  zp.snapshot = {};  // (not the solve a checkpoint would go on from)
   return zp;
 }
 
@@ -1714,6 +1715,16 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
     if (!after_fixing) {
       round_one_weight = params.initial_primal_weight;
       if (options.first_lp) options.first_lp(red.lp);
+      // Round 1's solve (not its pre-test) over the whole LP, for a checkpoint (first_snapshot).
+      int64_t snapshot_offset = 0;  // (after a probe: its iterations)
+      if (options.first_snapshot && options.snapshot_seconds > 0.0) {
+        params.snapshot_seconds = options.snapshot_seconds;
+        params.snapshot = [&](const std::vector<double>& x, const std::vector<double>& y, double w, int64_t it) {
+          std::vector<double> full_y(lp.rows(), 0.0);
+          for (size_t i = 0; i < red.rows.size() && i < y.size(); ++i) full_y[red.rows[i]] = y[i];
+          options.first_snapshot(full_x(x), full_y, w, snapshot_offset + it);
+        };
+      }
       if (options.feasibility_iterations > 0 && options.solver.rfind("pdhg", 0) == 0) {
         // Without costs there are no ordinary duals to converge first: PDHG proves an infeasible
         // LP in a fraction of the iterations (and names only the clash); a feasible one's point
@@ -1753,6 +1764,7 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
           if (std::isfinite(p.primal_weight) && p.primal_weight > 0.0) params.initial_primal_weight = p.primal_weight;
           params.max_iterations = std::max<int64_t>(params.max_iterations - p.iterations, 1);
           params.time_limit -= p.seconds;
+          snapshot_offset = p.iterations;
           joined.r = solver->solve(red.lp, params);
           joined.r.iterations += p.iterations;
           joined.r.seconds += p.seconds;
@@ -2071,6 +2083,7 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
     alt.first_iterate = {};
     alt.probe = {};
     alt.probe_tolerance = 0.0;
+    alt.first_snapshot = {};
     alt.first_max_iterations = 0;
     alt.feasibility_iterations = 0;  // (round 1 was optimal)
     alt.lp.initial_x = first.x;  // round 1 starts at its optimum: it only confirms it

@@ -355,6 +355,14 @@ struct CoarseToFineOptions {
   // rounds at most this often (LevelAttempt::rounding): each save writes every level's Γ, a few
   // hundred kB at full resolution, and the last rounds take hundredths of a second each.
   double rounding_checkpoint_seconds = 10.0;
+  // With a checkpoint, a refined level's first LP (the attempt's, or the re-solve after a pricing)
+  // saves its iterate with the attempt at most this often (LevelAttempt::solving), so that a run
+  // gone on from it starts that LP there rather than from zero. At full resolution on one core such
+  // an LP runs 30-60 minutes (TOSCA_r david0-david6 without WKS, level 6: 7 296 iterations in
+  // 3 731 s, seventy-seventh session), and every stop inside it lost all of it. Each save writes
+  // the iterate (about 16 bytes per nonzero primal value and per closedness row: some hundred MB
+  // at 30 M variables, a few seconds). 0: never.
+  double lp_checkpoint_seconds = 600.0;
 };
 
 // Pricing: the reduced costs c_j − A_jᵀy of `other`'s columns, in energy units, against a dual
@@ -485,6 +493,13 @@ struct LevelAttempt {
   CarriedIterate priced_from;
   int64_t cold_iterations = 0;
   double cold_seconds = 0.0;
+  // Where the attempt's first LP (or that re-solve, `solving_resolve`) was under way: its iterate
+  // after `solving_iterations` iterations (CoarseToFineOptions::lp_checkpoint_seconds), which a
+  // run gone on from here starts it from, without the zero-cost pre-test it had passed (version
+  // 13; before, a run gone on from here solved it from zero). Empty elsewhere.
+  CarriedIterate solving;
+  int64_t solving_iterations = 0;
+  bool solving_resolve = false;
   LevelReport report;            // its counts so far (widenings, widened faces, …); no Γ
   // Where the attempt's rounding had got, saved after its rounds (at most every few seconds): a
   // run gone on from it builds the same LP, fixes `ones` before its round 1 and keeps round 1's

@@ -6,6 +6,7 @@
 
 #include <limits>
 #include <memory>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -70,6 +71,14 @@ struct SolverParams {
   // FAUST_r pairs at 2 000 faces, -10 to -26 % of PDHG's work; FAUST_r 021-024 at full resolution
   // took another path to a harder finest LP and more work. Hence not the default.
   double cold_restart_artificial = 0.0;
+  // PDHG: called every snapshot_seconds at most (at a residual check) with the point a restart
+  // would start from, in the problem's units, its ω and the iterations so far, so that a long
+  // solve can be checkpointed and started again near where it was (coarse to fine:
+  // CoarseToFineOptions::lp_checkpoint_seconds). Other solvers do not call it. 0 or unset: never.
+  std::function<void(const std::vector<double>& x, const std::vector<double>& y, double primal_weight,
+                     int64_t iterations)>
+      snapshot;
+  double snapshot_seconds = 0.0;
 };
 
 struct LpResult {
