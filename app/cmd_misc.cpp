@@ -116,7 +116,7 @@ Action add_checkpoint_command(CLI::App& app) {
           .set("stuck_widenings", a.report.stuck_widenings)
           .set("stuck_restarts", a.report.stuck_restarts)
           // (its next LP the re-solve after a pricing, from the iterate kept with it)
-          .set("warm_resolve", !a.priced_from.empty())
+          .set("warm_resolve", !a.priced_from.empty() || (!a.solving.empty() && a.solving_resolve))
           // (its first LP under way, from the iterate kept with it: after how many iterations; null: none)
           .set("solving_iterations", a.solving.empty() ? Json() : Json(a.solving_iterations))
           .set("rounding", std::move(rounding));

@@ -267,32 +267,27 @@ TEST_CASE("pdhg-cpu: a snapshot is a point the solve can start again from, near 
   });
   const MatchingLp m = build_matching_lp(x, compute_geometry(x), y, compute_geometry(y));
   SolverParams params = tight(1e-6);
-  struct Snapshot {
-    std::vector<double> x, y;
-    double omega = 0.0;
-    int64_t iterations = 0;
-  };
-  std::vector<Snapshot> seen;
+  std::vector<SolveSnapshot> seen;
   params.snapshot_seconds = 1e-9;  // (at every residual check)
-  params.snapshot = [&](const std::vector<double>& sx, const std::vector<double>& sy, double w, int64_t it) {
-    seen.push_back({sx, sy, w, it});
-  };
+  params.snapshot = [&](const SolveSnapshot& s) { seen.push_back(s); };
   const LpResult whole = solve_lp(m.lp, "pdhg-cpu", params);
   REQUIRE(whole.status == LpStatus::Optimal);
   REQUIRE(seen.size() >= 2);
-  for (const Snapshot& s : seen) {
+  for (const SolveSnapshot& s : seen) {
     CHECK(s.x.size() == size_t(m.lp.cols()));
     CHECK(s.y.size() == size_t(m.lp.rows()));
-    CHECK(s.omega > 0.0);
+    CHECK(s.primal_weight > 0.0);
     CHECK(s.iterations <= whole.iterations);
+    CHECK(s.seconds <= whole.seconds);
   }
+  CHECK(seen.back().seconds > seen.front().seconds);
   CHECK(seen.back().iterations > seen.front().iterations);
   // From the last one, with its ω: the rest of the solve, not all of it, to the same optimum.
-  const Snapshot& last = seen.back();
+  const SolveSnapshot& last = seen.back();
   SolverParams again = tight(1e-6);
   again.initial_x = last.x;
   again.initial_y = last.y;
-  again.initial_primal_weight = last.omega;
+  again.initial_primal_weight = last.primal_weight;
   const LpResult rest = solve_lp(m.lp, "pdhg-cpu", again);
   REQUIRE(rest.status == LpStatus::Optimal);
   MESSAGE("whole " << whole.iterations << " iterations, snapshot at " << last.iterations << ", the rest "

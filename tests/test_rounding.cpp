@@ -223,6 +223,43 @@ TEST_CASE("rounding: a rounding gone on from decisions with their steps keeps th
   CHECK_THROWS_AS(round_to_graph_surface(m.space, m.lp, m.energy, wrong), InvalidInputError);
 }
 
+TEST_CASE("rounding: round 1's first-order solve alone is snapshot, over the whole LP, resumed counts included") {
+  // Threshold 0 on the dolphins at 60 faces: several rounds, each on PDHG, and a pre-test.
+  const MatchingLp& m = dolphins_60();
+  RoundingOptions o;
+  o.solver = "pdhg-cpu";
+  o.exact_below = 0;
+  o.threshold = 0.0;
+  o.feasibility_iterations = 256;  // a pre-test, which is not snapshot
+  std::vector<SolveSnapshot> seen;
+  std::vector<bool> watched;
+  int rounds_seen = 0, before_round_one = 0;
+  o.snapshot_seconds = 1e-9;  // (at every residual check)
+  o.first_snapshot = [&](const SolveSnapshot& s, bool w) {
+    seen.push_back(s);
+    watched.push_back(w);
+    if (rounds_seen == 0) ++before_round_one;
+  };
+  const RoundingResult r =
+      round_to_graph_surface(m.space, m.lp, m.energy, o, [&](const RoundingRound&) { ++rounds_seen; });
+  REQUIRE(r.rounds.size() >= 2);
+  REQUIRE_FALSE(seen.empty());
+  CHECK(before_round_one == int(seen.size()));  // none from a later round
+  for (const SolveSnapshot& s : seen) {
+    CHECK(s.x.size() == size_t(m.lp.cols()));  // over the whole LP
+    CHECK(s.y.size() == size_t(m.lp.rows()));
+    CHECK(s.iterations <= r.rounds.front().iterations);  // round 1's own, not its pre-test's
+  }
+  // Gone on from a snapshot: its iterations and seconds count on.
+  o.resumed_iterations = 1000;
+  o.resumed_seconds = 50.0;
+  seen.clear();
+  round_to_graph_surface(m.space, m.lp, m.energy, o);
+  REQUIRE_FALSE(seen.empty());
+  CHECK(seen.front().iterations > 1000);
+  CHECK(seen.front().seconds > 50.0);
+}
+
 TEST_CASE("rounding: later rounds stop at their iteration cap and still end exact") {
   // Threshold 0 on the dolphins at 60 faces: several rounds (see the clashing-candidates test).
   const MatchingLp& m = dolphins_60();

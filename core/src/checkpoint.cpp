@@ -21,9 +21,12 @@ constexpr char kMagic[] = "shapematch level checkpoint\n";
 // branch_energy and branch_kept. 9: LevelAttempt::zero_cost_margin_given follows `trusted`.
 // 10: LevelAttempt::Rounding::steps follows its ones. 11: LevelAttempt::suspicion_margins
 // follows zero_cost_margin_given. 12: LevelAttempt::Rounding::cap_scale follows its steps. 13:
-// LevelAttempt::priced_from and solving (each a flag, then its parts; solving's iterations and
-// flag; where either, the cold solve's iterations and seconds) follow the rounding. 1 to 12 are read too.
+// LevelAttempt::priced_from and solving (each a flag, then its parts; solving's iterations,
+// seconds and two flags; where either, the cold solve's iterations and seconds) follow the
+// rounding. 1 to 12 are read too.
 constexpr uint32_t kVersion = 13;
+// More LP iterations than any solve makes (a count past it is a corrupt file, and would overflow).
+constexpr int64_t kMaxIterations = int64_t(1) << 40;
 
 // Every number of a report, in the file's order (the Γ follows on its own). A field added to
 // LevelReport goes here too, with kVersion one higher; the size check below is the reminder.
@@ -121,9 +124,13 @@ void read_levels(Reader& r, std::vector<LevelReport>& levels, uint64_t count, ui
 
 // A warm start kept with an attempt (version >= 13): CarriedIterate::Parts.
 void write_iterate(Writer& w, const CarriedIterate& c) {
-  const CarriedIterate::Parts p = c.parts();
-  w.array(p.keys), w.array(p.values), w.array(p.row_edge), w.array(p.y);
-  w(p.closedness_rows), w(p.scale), w(p.primal_weight);
+  const auto& x = c.values_by_key();  // (as Parts: keys, then values; no copy of either)
+  w(uint64_t(x.size()));
+  for (const auto& kv : x) w(kv.first);
+  w(uint64_t(x.size()));
+  for (const auto& kv : x) w(kv.second);
+  w.array(c.row_edges()), w.array(c.duals());
+  w(c.closedness_rows()), w(c.scale()), w(c.primal_weight());
 }
 CarriedIterate read_iterate(Reader& r, const std::string& path) {
   CarriedIterate::Parts p;
@@ -161,7 +168,7 @@ void write_attempt(Writer& w, const LevelAttempt& a, uint32_t version) {
   w(!a.solving.empty());
   if (!a.solving.empty()) {
     write_iterate(w, a.solving);
-    w(a.solving_iterations), w(a.solving_resolve);
+    w(a.solving_iterations), w(a.solving_seconds), w(a.solving_resolve), w(a.solving_watched);
   }
   if (!a.priced_from.empty() || !a.solving.empty()) w(a.cold_iterations), w(a.cold_seconds);
 }
@@ -195,12 +202,16 @@ void read_attempt(Reader& r, LevelAttempt& a, uint32_t version, const std::strin
   r(solving);
   if (solving) {
     a.solving = read_iterate(r, path);
-    r(a.solving_iterations), r(a.solving_resolve);
-    if (a.solving_iterations < 0)
+    r(a.solving_iterations), r(a.solving_seconds), r(a.solving_resolve), r(a.solving_watched);
+    if (a.solving_iterations < 0 || a.solving_iterations > kMaxIterations || !(a.solving_seconds >= 0.0) ||
+        !std::isfinite(a.solving_seconds))
       throw IoError(path + ": not a shapematch checkpoint (an LP under way at " + std::to_string(a.solving_iterations) +
                     " iterations)");
   }
   if (priced || solving) r(a.cold_iterations), r(a.cold_seconds);
+  if (a.cold_iterations < 0 || a.cold_iterations > kMaxIterations)
+    throw IoError(path + ": not a shapematch checkpoint (a cold solve of " + std::to_string(a.cold_iterations) +
+                  " iterations)");
   // (A re-solve is capped at the cold solve's iterations: it needs them.)
   if ((priced || a.solving_resolve) &&
       (a.cold_iterations <= 0 || !(a.cold_seconds >= 0.0) || !std::isfinite(a.cold_seconds)))

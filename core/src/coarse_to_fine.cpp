@@ -615,10 +615,10 @@ CoarseToFineResult CoarseToFineMatcher::run(const Progress& progress, const Leve
   int decide_at = -1;
   int start = 0;
   // A checkpoint of the two lookahead chains, `at` (if one) with the attempt `a` of its level.
-  auto save_chains = [&](const Chain& first, const Chain& second, const Chain* at, const LevelAttempt& a) {
+  auto save_chains = [&](const Chain& first, const Chain& second, const Chain* at, LevelAttempt&& a) {
     LevelCheckpoint both{fingerprint(), result.levels};
     for (const Chain* c : {&first, &second})
-      both.chains.push_back({c->pending, c->widened, c->leading, c == at ? a : LevelAttempt{}});
+      both.chains.push_back({c->pending, c->widened, c->leading, c == at ? std::move(a) : LevelAttempt{}});
     checkpoint(both);
   };
   // After level l: two chains that reached the same Γ go on as one, two at decide_at are
@@ -712,15 +712,15 @@ CoarseToFineResult CoarseToFineMatcher::run(const Progress& progress, const Leve
       // lookahead of both chains, those before this one having done the level. A chain alone at
       // the level saves itself as the only chain, its levels since the split as levels (a run
       // gone on from that has no other chain to fall back on).
-      std::function<void(const LevelAttempt&)> attempted;
+      std::function<void(LevelAttempt&&)> attempted;
       if (checkpoint)
-        attempted = [&, i, alone](const LevelAttempt& a) {
+        attempted = [&, i, alone](LevelAttempt&& a) {
           if (chains.size() == 1 || alone) {
-            LevelCheckpoint single{fingerprint(), result.levels, c.widened, a};
+            LevelCheckpoint single{fingerprint(), result.levels, c.widened, std::move(a)};
             single.levels.insert(single.levels.end(), c.pending.begin(), c.pending.end());
             return checkpoint(single);
           }
-          save_chains(i == 0 ? chains[0] : next[0], chains[1], &c, a);
+          save_chains(i == 0 ? chains[0] : next[0], chains[1], &c, std::move(a));
         };
       const LevelAttempt* attempt = l == start && !c.resume.empty() ? &c.resume : nullptr;
       LevelReport rep = header;
@@ -1084,7 +1084,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
                                         std::vector<ProductTriangle>& gamma, CoarseToFineResult& result,
                                         const Progress& progress, std::vector<int>& widened,
                                         const LevelAttempt* resume,
-                                        const std::function<void(const LevelAttempt&)>& attempted,
+                                        const std::function<void(LevelAttempt&&)>& attempted,
                                         const ChainRules& rules) const {
   const MeshLevel& lx = hx_.levels[l];
   const MeshLevel& ly = hy_.levels[l];
@@ -1171,11 +1171,14 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
   // starts it where it was, `solving_done` iterations in.
   CarriedIterate solving_from;
   int64_t solving_done = 0;
-  bool solving_resolve = false;
+  double solving_seconds = 0.0;
+  bool solving_resolve = false, solving_watched = true;
   if (resume && resume->rounding.empty() && !resume->solving.empty()) {
     solving_from = resume->solving;
     solving_done = resume->solving_iterations;
+    solving_seconds = resume->solving_seconds;
     solving_resolve = resume->solving_resolve;
+    solving_watched = resume->solving_watched;
     feasible_seen = feasible_seen || solving_resolve;  // (the re-solve's space held an optimum)
     cold_iterations = resume->cold_iterations;
     cold_seconds = resume->cold_seconds;
@@ -1314,7 +1317,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
     if (!first_attempt && attempted && l > 0) {
       LevelAttempt a = current_attempt();
       if (restarted) a.rounding = *restarted;
-      attempted(a);
+      attempted(std::move(a));
     }
     // The rounding this attempt goes on from where it builds the same LP: a stuck one's, or the
     // checkpointed attempt's.
@@ -1430,10 +1433,18 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
       // fraction of the cold solve's iterations (FAUST_r at full resolution: 512-1 088 against
       // 1 920-2 624), except where its tail creeps (the cat: 11 328 against 4 480). It stops at the
       // cold count; rounding goes on from its iterate and its bound stays valid.
+      if (from_solving) {  // (the rest of it: its iterations, seconds and watch as they were)
+        solving_from.apply(m, ro.lp);
+        solving_from = {};
+        ro.resumed_iterations = solving_done;
+        ro.resumed_seconds = solving_seconds;
+        ro.lp.max_iterations = std::max<int64_t>(ro.lp.max_iterations - solving_done, 1);
+        ro.lp.time_limit -= solving_seconds;
+        ro.feasibility_iterations = 0;  // (it had passed its pre-test)
+        if (!solving_watched) ro.lp.stop_on_divergence = ro.lp.patient_divergence_watch = false;
+      }
       if (warm_resolve) {
-        if (from_solving) {
-          solving_from.apply(m, ro.lp);
-        } else {
+        if (!from_solving) {
           priced_from.apply(m, ro.lp);
           if (options_.price_dual_sweeps > 0) {
             const double at_zero = certified_lower_bound(m.lp, ro.lp.initial_y);
@@ -1443,6 +1454,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
                          l + 1, fresh, options_.price_dual_sweeps, certified_lower_bound(m.lp, ro.lp.initial_y),
                          at_zero);
           }
+          priced_from = {};  // (no longer needed: this LP starts from it)
         }
         ro.first_max_iterations = std::max<int64_t>(cold_iterations - (from_solving ? solving_done : 0), 1);
         // The later rounds' caps and the stuck rules scale with what a solve of this level costs,
@@ -1451,9 +1463,6 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
         // rounds then sat at the 2 000-iteration floor and the stall rule gave up 319 s after the low.
         ro.reference_seconds = cold_seconds;
         ro.reference_iterations = cold_iterations;
-      } else if (from_solving) {
-        solving_from.apply(m, ro.lp);
-        ro.feasibility_iterations = 0;  // (it had passed its pre-test)
       }
       price_warm = false;
       if (feasible_seen) ro.feasibility_iterations = 0;  // (a start from fixings has none: rounding)
@@ -1528,7 +1537,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
                             (ro.alternative_thresholds.empty() || m.lp.cols() > ro.alternatives_below);
       first_bound = going_on ? going_on->lower_bound : std::numeric_limits<double>::quiet_NaN();
       rounds_so_far = tracking && going_on ? going_on->rounds : 0;  // (0: nothing to restart from)
-      iterations_so_far = going_on ? going_on->iterations : 0;
+      iterations_so_far = going_on ? going_on->iterations : from_solving ? solving_done : 0;
       Stopwatch since_saved;
       if (tracking)
         ro.decided = [&](const RoundingRound& r, const std::vector<int64_t>& ones, const std::vector<int32_t>& steps,
@@ -1539,7 +1548,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
           if (!attempted || since_saved.seconds() < options_.rounding_checkpoint_seconds) return;
           LevelAttempt a = current_attempt();
           a.rounding = rounding_now(ones, steps, r.cap_scale);
-          attempted(a);
+          attempted(std::move(a));
           since_saved.reset();
         };
       // A lookahead chain that cannot win: out after the first LP (once pricing has not widened).
@@ -1561,15 +1570,20 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
       // The first LP's iterate saved with the attempt as it goes (lp_checkpoint_seconds says why).
       if (attempted && l > 0 && options_.lp_checkpoint_seconds > 0.0 && !carrying && !going_on) {
         ro.snapshot_seconds = options_.lp_checkpoint_seconds;
-        ro.first_snapshot = [&, resolve = warm_resolve, before = from_solving ? solving_done : 0](
-                                const std::vector<double>& x, const std::vector<double>& y, double w, int64_t it) {
+        ro.first_snapshot = [&, resolve = warm_resolve](const SolveSnapshot& s, bool watched) {
           LevelAttempt a = current_attempt();
-          a.solving.keep(m, x, y, w);
-          a.solving_iterations = before + it;
+          a.solving.keep(m, s.x, s.y, s.primal_weight);
+          a.solving_iterations = s.iterations;  // (a run gone on from one: with those before, resumed_*)
+          a.solving_seconds = s.seconds;
           a.solving_resolve = resolve;
+          a.solving_watched = watched;
           a.cold_iterations = cold_iterations;
           a.cold_seconds = cold_seconds;
-          attempted(a);
+          try {
+            attempted(std::move(a));
+          } catch (const IoError& e) {  // (the solve goes on; the last checkpoint stands)
+            spdlog::warn("level {}: its first LP's checkpoint was not saved: {}", l + 1, e.what());
+          }
         };
       }
       // Where rounding gets stuck, widen around it (as for an infeasible LP) and solve again.
@@ -1583,10 +1597,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
                                                      first_iterations = r.iterations + (from_solving ? solving_done : 0);
                                                      if (!warm_resolve) {
                                                        cold_iterations = first_iterations;
-                                                       cold_seconds = r.iterations > 0 ? r.seconds *
-                                                                                             double(first_iterations) /
-                                                                                             double(r.iterations)
-                                                                                       : r.seconds;
+                                                       cold_seconds = r.seconds + (from_solving ? solving_seconds : 0.0);
                                                      }
                                                      reference_iterations = cold_iterations;
                                                      reference_seconds = cold_seconds;

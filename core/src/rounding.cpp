@@ -1716,15 +1716,19 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
       round_one_weight = params.initial_primal_weight;
       if (options.first_lp) options.first_lp(red.lp);
       // Round 1's solve (not its pre-test) over the whole LP, for a checkpoint (first_snapshot).
-      int64_t snapshot_offset = 0;  // (after a probe: its iterations)
-      if (options.first_snapshot && options.snapshot_seconds > 0.0) {
-        params.snapshot_seconds = options.snapshot_seconds;
-        params.snapshot = [&](const std::vector<double>& x, const std::vector<double>& y, double w, int64_t it) {
-          std::vector<double> full_y(lp.rows(), 0.0);
-          for (size_t i = 0; i < red.rows.size() && i < y.size(); ++i) full_y[red.rows[i]] = y[i];
-          options.first_snapshot(full_x(x), full_y, w, snapshot_offset + it);
-        };
-      }
+      // (Set below, after the pre-test's parameters are taken; reset after the solve.)
+      int64_t snapshot_iterations = options.resumed_iterations;  // (after a probe: its iterations too)
+      double snapshot_seconds = options.resumed_seconds;
+      auto snapshot = [&](const SolveSnapshot& s) {
+        SolveSnapshot whole;
+        whole.x = full_x(s.x);
+        whole.y.assign(lp.rows(), 0.0);
+        for (size_t i = 0; i < red.rows.size() && i < s.y.size(); ++i) whole.y[red.rows[i]] = s.y[i];
+        whole.primal_weight = s.primal_weight;
+        whole.iterations = snapshot_iterations + s.iterations;
+        whole.seconds = snapshot_seconds + s.seconds;
+        options.first_snapshot(whole, params.stop_on_divergence);
+      };
       if (options.feasibility_iterations > 0 && options.solver.rfind("pdhg", 0) == 0) {
         // Without costs there are no ordinary duals to converge first: PDHG proves an infeasible
         // LP in a fraction of the iterations (and names only the clash); a feasible one's point
@@ -1751,6 +1755,10 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
           params.patient_divergence_watch = false;
         }
       }
+      if (options.first_snapshot && options.snapshot_seconds > 0.0) {
+        params.snapshot_seconds = options.snapshot_seconds;
+        params.snapshot = snapshot;
+      }
       if (options.probe && options.probe_tolerance > params.tolerance) {
         SolverParams loose = params;
         loose.tolerance = options.probe_tolerance;
@@ -1764,7 +1772,8 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
           if (std::isfinite(p.primal_weight) && p.primal_weight > 0.0) params.initial_primal_weight = p.primal_weight;
           params.max_iterations = std::max<int64_t>(params.max_iterations - p.iterations, 1);
           params.time_limit -= p.seconds;
-          snapshot_offset = p.iterations;
+          snapshot_iterations += p.iterations;
+          snapshot_seconds += p.seconds;
           joined.r = solver->solve(red.lp, params);
           joined.r.iterations += p.iterations;
           joined.r.seconds += p.seconds;
@@ -1775,6 +1784,7 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
         joined.r = solver->solve(red.lp, params);
       }
       if (joined.r.status == LpStatus::Infeasible) joined.proof = joined.r.y;
+      params.snapshot = {};  // (it refers to this block)
     } else {
       std::vector<double> warm_weight;
       if (!w_full.empty()) {
@@ -1840,8 +1850,10 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
     info.feasibility_seconds = pretest_seconds;
     info.later_pretest_seconds = joined.pretest_seconds;
     if (round == 1) {  // in the units of the full LP: add what propagation fixed to 1 before it
-      first_seconds = options.reference_seconds > 0.0 ? options.reference_seconds : clock.seconds() - pretest_seconds;
-      first_iterations = options.reference_iterations > 0 ? options.reference_iterations : r.iterations;
+      first_seconds = options.reference_seconds > 0.0 ? options.reference_seconds
+                                                      : clock.seconds() - pretest_seconds + options.resumed_seconds;
+      first_iterations =
+          options.reference_iterations > 0 ? options.reference_iterations : r.iterations + options.resumed_iterations;
       first_work = double(first_iterations) * double(red.lp.cols());
       result.first_lp = r;
       result.first_lp.objective += lp.objective_scale * red.fixed_cost;
@@ -2084,6 +2096,8 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
     alt.probe = {};
     alt.probe_tolerance = 0.0;
     alt.first_snapshot = {};
+    alt.resumed_iterations = 0;  // (its round 1 is that optimum's)
+    alt.resumed_seconds = 0.0;
     alt.first_max_iterations = 0;
     alt.feasibility_iterations = 0;  // (round 1 was optimal)
     alt.lp.initial_x = first.x;  // round 1 starts at its optimum: it only confirms it

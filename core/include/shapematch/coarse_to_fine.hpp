@@ -60,6 +60,14 @@ public:
     double scale = 0.0, primal_weight = 0.0;
   };
   Parts parts() const;
+  // The same parts without copies, for writing one out (a checkpoint's at 30 M variables: some
+  // hundred MB each): the nonzero primal values by key (sorted), and the rest as in Parts.
+  const std::vector<std::pair<uint64_t, double>>& values_by_key() const { return x_; }
+  const std::vector<int64_t>& row_edges() const { return row_edge_; }
+  const std::vector<double>& duals() const { return y_; }
+  int64_t closedness_rows() const { return closedness_rows_; }
+  double scale() const { return scale_; }
+  double primal_weight() const { return primal_weight_; }
   // Throws InvalidInputError where the parts do not fit together (sizes, order, values).
   static CarriedIterate from_parts(Parts p);
 
@@ -494,12 +502,17 @@ struct LevelAttempt {
   int64_t cold_iterations = 0;
   double cold_seconds = 0.0;
   // Where the attempt's first LP (or that re-solve, `solving_resolve`) was under way: its iterate
-  // after `solving_iterations` iterations (CoarseToFineOptions::lp_checkpoint_seconds), which a
-  // run gone on from here starts it from, without the zero-cost pre-test it had passed (version
-  // 13; before, a run gone on from here solved it from zero). Empty elsewhere.
+  // after `solving_iterations` iterations and `solving_seconds` (CoarseToFineOptions::
+  // lp_checkpoint_seconds), which a run gone on from here starts it from, without the zero-cost
+  // pre-test it had passed, its divergence watch on only where it was (`solving_watched`: the
+  // pre-test turns it off where it finds a point), counting those iterations and seconds where
+  // the rounding scales with them (version 13; before, a run gone on from here solved it from
+  // zero). Empty elsewhere.
   CarriedIterate solving;
   int64_t solving_iterations = 0;
+  double solving_seconds = 0.0;
   bool solving_resolve = false;
+  bool solving_watched = true;
   LevelReport report;            // its counts so far (widenings, widened faces, …); no Γ
   // Where the attempt's rounding had got, saved after its rounds (at most every few seconds): a
   // run gone on from it builds the same LP, fixes `ones` before its round 1 and keeps round 1's
@@ -632,7 +645,7 @@ private:
   // every attempt after the first, with the state it starts from. `rules`: a lookahead chain's.
   void solve_refined(int l, const EnergyModel& model, LevelReport& rep, std::vector<ProductTriangle>& gamma,
                      CoarseToFineResult& result, const Progress& progress, std::vector<int>& widened,
-                     const LevelAttempt* resume, const std::function<void(const LevelAttempt&)>& attempted,
+                     const LevelAttempt* resume, const std::function<void(LevelAttempt&&)>& attempted,
                      const ChainRules& rules) const;
   // The second start at level l: the full product space, rounded. Fills `rep` (a copy of the
   // level's, with the second start's numbers), `gamma`, and at the finest level `finest`'s LP

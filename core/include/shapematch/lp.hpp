@@ -39,6 +39,14 @@ enum class LpStatus {
 };
 const char* to_string(LpStatus status);
 
+// A point a first-order solve could start again from (SolverParams::snapshot).
+struct SolveSnapshot {
+  std::vector<double> x, y;   // in the problem's units
+  double primal_weight = 0.0;  // PDHG's ω there
+  int64_t iterations = 0;      // so far
+  double seconds = 0.0;        // so far, its set-up included
+};
+
 struct SolverParams {
   double tolerance = 1e-4;        // relative primal residual and gap (first-order methods)
   int64_t max_iterations = 1'000'000;
@@ -72,12 +80,10 @@ struct SolverParams {
   // took another path to a harder finest LP and more work. Hence not the default.
   double cold_restart_artificial = 0.0;
   // PDHG: called every snapshot_seconds at most (at a residual check) with the point a restart
-  // would start from, in the problem's units, its ω and the iterations so far, so that a long
-  // solve can be checkpointed and started again near where it was (coarse to fine:
-  // CoarseToFineOptions::lp_checkpoint_seconds). Other solvers do not call it. 0 or unset: never.
-  std::function<void(const std::vector<double>& x, const std::vector<double>& y, double primal_weight,
-                     int64_t iterations)>
-      snapshot;
+  // would start from, so that a long solve can be checkpointed and started again near where it
+  // was (coarse to fine: CoarseToFineOptions::lp_checkpoint_seconds). Other solvers do not call
+  // it. 0 or unset: never.
+  std::function<void(const SolveSnapshot&)> snapshot;
   double snapshot_seconds = 0.0;
 };
 

@@ -316,12 +316,16 @@ struct RoundingOptions {
   std::function<void(const std::vector<double>& x, const std::vector<double>& y, double primal_weight)> probe;
   // Where set and snapshot_seconds > 0: called every snapshot_seconds at most during round 1's
   // first-order solve (not its pre-test, not later rounds) with the point it would restart from,
-  // over the whole LP as first_iterate's, its ω and the iterations so far (a probe's included),
-  // for a checkpoint that a later run starts that LP from (SolverParams::snapshot).
-  std::function<void(const std::vector<double>& x, const std::vector<double>& y, double primal_weight,
-                     int64_t iterations)>
-      first_snapshot;
+  // over the whole LP as first_iterate's, its iterations and seconds so far (a probe's included,
+  // and resumed_*), and whether that solve had the divergence watch on (the pre-test can turn it
+  // off), for a checkpoint that a later run starts that LP from (SolverParams::snapshot).
+  std::function<void(const SolveSnapshot& whole, bool watched)> first_snapshot;
   double snapshot_seconds = 0.0;
+  // Round 1's LP goes on from such a snapshot (its warm start in `lp`) after these: they count in
+  // round 1's iterations and seconds wherever those scale the later rounds (where reference_*
+  // are not given) and in its snapshots.
+  int64_t resumed_iterations = 0;
+  double resumed_seconds = 0.0;
   // Where the LP has at most alternatives_below columns, the rounding runs again from round 1's
   // iterate with each of these thresholds (round 1 then only confirms that optimum), and the Γ of
   // least energy is returned, with the threshold that found it. Fixing by a threshold is greedy,
