@@ -166,7 +166,8 @@ struct CoarseToFineOptions {
   int suspicion_margins = 1;
   // Which faces that margin is drawn around: every X face widened so far at the level (widened,
   // as before the seventy-eighth session) or only those the suspicion itself named (named: the X
-  // faces its local widening found on the rows where PDHG diverged). At full resolution the first
+  // faces on the rows where PDHG diverged, its local widening's first choice, whether or not that
+  // widening went on to the Y side or past max_ring). At full resolution the first
   // is the space's largest amplifier: TOSCA_r david0-david6 without WKS, level 6, the margin took
   // 2 937 faces (29.0 M → 32.3 M variables) where the suspicion named 84 (docs/results-log.md,
   // seventy-seventh session); the measured cure on FAUST_r 029-063 (above) was the first.
