@@ -73,6 +73,15 @@ SolverParams tight(double tol = 1e-5) {
   return p;
 }
 
+// The matching LP of an octahedron and a sheared, bent copy of it (small, not the identity).
+MatchingLp sheared_octahedron_lp() {
+  const Mesh x = shapes::octahedron();
+  const Mesh y = test::deformed(x, [](const Eigen::Vector3d& p) {
+    return Eigen::Vector3d(1.3 * p.x() + 0.1 * p.z(), p.y(), 0.8 * p.z() + 0.05 * p.x() * p.y());
+  });
+  return build_matching_lp(x, compute_geometry(x), y, compute_geometry(y));
+}
+
 }  // namespace
 
 TEST_CASE("scaled norm: Lanczos meets the exact largest singular value from below, in few steps") {
@@ -225,11 +234,7 @@ TEST_CASE("pdhg-cpu: matching LPs agree with Clp within 1e-4 relative") {
 }
 
 TEST_CASE("pdhg-cpu: a warm start goes on with the primal weight its solve ended with") {
-  const Mesh x = shapes::octahedron();
-  const Mesh y = test::deformed(x, [](const Eigen::Vector3d& p) {
-    return Eigen::Vector3d(1.3 * p.x() + 0.1 * p.z(), p.y(), 0.8 * p.z() + 0.05 * p.x() * p.y());
-  });
-  const MatchingLp m = build_matching_lp(x, compute_geometry(x), y, compute_geometry(y));
+  const MatchingLp m = sheared_octahedron_lp();
   SolverParams params = tight(1e-5);
   const LpResult r = solve_lp(m.lp, "pdhg-cpu", params);
   REQUIRE(r.status == LpStatus::Optimal);
@@ -261,11 +266,7 @@ TEST_CASE("pdhg-cpu: a warm start goes on with the primal weight its solve ended
 }
 
 TEST_CASE("pdhg-cpu: a snapshot is a point the solve can start again from, near where it was") {
-  const Mesh x = shapes::octahedron();
-  const Mesh y = test::deformed(x, [](const Eigen::Vector3d& p) {
-    return Eigen::Vector3d(1.3 * p.x() + 0.1 * p.z(), p.y(), 0.8 * p.z() + 0.05 * p.x() * p.y());
-  });
-  const MatchingLp m = build_matching_lp(x, compute_geometry(x), y, compute_geometry(y));
+  const MatchingLp m = sheared_octahedron_lp();
   SolverParams params = tight(1e-6);
   std::vector<SolveSnapshot> seen;
   params.snapshot_seconds = 1e-9;  // (at every residual check)
