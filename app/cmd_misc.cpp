@@ -101,6 +101,7 @@ Action add_checkpoint_command(CLI::App& app) {
                        .set("fixings_to_one", static_cast<int64_t>(g.ones.size()))
                        .set("fixing_steps", g.step_count())
                        .set("cap_scale", g.cap_scale)
+                       .set("warm_start", !g.warm.empty())
                        .set("iterations", g.iterations)
                        .set("lower_bound", g.lower_bound)
                        .set("variables", g.columns)

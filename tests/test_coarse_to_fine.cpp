@@ -1904,6 +1904,9 @@ TEST_CASE("coarse to fine: a run gone on from a checkpoint inside a rounding fix
   CHECK(g.iterations == last.front().attempt.rounding.iterations);
   CHECK(g.reference_iterations == last.front().attempt.rounding.reference_iterations);
   REQUIRE_FALSE(g.ones.empty());
+  // The next round's warm start goes with it (lp_checkpoint_seconds, on by default).
+  REQUIRE_FALSE(g.warm.empty());
+  CHECK(g.warm.parts().y == last.front().attempt.rounding.warm.parts().y);
   int saved_again = 0;
   const CoarseToFineResult r = matcher.run({}, &loaded, [&](const LevelCheckpoint& c) {
     if (!c.attempt.rounding.empty()) {
@@ -1923,6 +1926,24 @@ TEST_CASE("coarse to fine: a run gone on from a checkpoint inside a rounding fix
   CHECK(check_graph_surface(r.finest.space, r.rounding.gamma).ok());
   CHECK(satisfies_exactly(r.finest.lp, r.rounding.gamma));
   for (int64_t j : g.ones) CHECK(std::binary_search(r.rounding.gamma.begin(), r.rounding.gamma.end(), j));
+  {  // Without the warm start (a version-12 file) its round 1 starts cold: no fewer iterations.
+    detail::save_checkpoint_as(file, last.front(), 12);
+    const LevelCheckpoint v12 = load_checkpoint(file);
+    CHECK(v12.attempt.rounding.warm.empty());
+    CHECK(v12.attempt.rounding.ones == g.ones);
+    // (Every part on PDHG, whose iterations a warm start saves; the LP is the same.)
+    CoarseToFineOptions first_order = o;
+    first_order.rounding.exact_below = 0;
+    const CoarseToFineMatcher pdhg(fine_fingers().first, fine_fingers().second, first_order);
+    const CoarseToFineResult cold = pdhg.run({}, &v12), warm = pdhg.run({}, &loaded);
+    REQUIRE_FALSE(cold.rounding.rounds.empty());
+    REQUIRE_FALSE(warm.rounding.rounds.empty());
+    MESSAGE("gone on from round 1: its first round ", cold.rounding.rounds.front().iterations, " iterations cold, ",
+            warm.rounding.rounds.front().iterations, " warm");
+    CHECK(warm.rounding.rounds.front().iterations < cold.rounding.rounds.front().iterations);
+    CHECK(check_graph_surface(cold.finest.space, cold.rounding.gamma).ok());
+    CHECK(check_graph_surface(warm.finest.space, warm.rounding.gamma).ok());
+  }
   // The later rounds' cap multiple goes on where the saved rounding had got, and is saved again.
   LevelCheckpoint scaled = loaded;
   scaled.attempt.rounding.cap_scale = 4.0;

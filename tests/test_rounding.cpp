@@ -138,10 +138,13 @@ TEST_CASE("rounding: after each round it hands out its decisions, and a rounding
     std::vector<int64_t> ones;
     std::vector<int32_t> steps;
     double bound;
+    std::vector<double> x, y;
   };
   std::vector<Call> calls;
   o.decided = [&](const RoundingRound& r, const std::vector<int64_t>& ones, const std::vector<int32_t>& steps,
-                  double bound) { calls.push_back({r.round, ones, steps, bound}); };
+                  double bound, const std::vector<double>& x, const std::vector<double>& y) {
+    calls.push_back({r.round, ones, steps, bound, x, y});
+  };
   const RoundingResult r = round_to_graph_surface(m.space, m.lp, m.energy, o);
   REQUIRE(r.rounds.size() >= 2);
   REQUIRE(calls.size() == r.rounds.size());
@@ -153,7 +156,10 @@ TEST_CASE("rounding: after each round it hands out its decisions, and a rounding
     CHECK(calls[k].steps.size() == calls[k].ones.size());
     for (int32_t step : calls[k].steps) CHECK((step >= 0 && step <= int(k)));  // a step per round at most
     CHECK(calls[k].bound == r.first_lp.lower_bound);
+    CHECK(calls[k].x.size() == size_t(m.lp.cols()));  // the next round's warm start, over the whole LP
+    CHECK(calls[k].y.size() == size_t(m.lp.rows()));
   }
+  CHECK(std::any_of(calls.front().x.begin(), calls.front().x.end(), [](double v) { return v > 0.0; }));
   REQUIRE_FALSE(calls.front().ones.empty());
   for (int64_t j : calls.back().ones) CHECK(std::binary_search(r.gamma.begin(), r.gamma.end(), j));
   // Gone on from round 1's decisions: an exact graph surface that keeps every one of them.
@@ -164,6 +170,17 @@ TEST_CASE("rounding: after each round it hands out its decisions, and a rounding
   CHECK(satisfies_exactly(m.lp, g.gamma));
   CHECK(check_graph_surface(m.space, g.gamma).ok());
   for (int64_t j : calls.front().ones) CHECK(std::binary_search(g.gamma.begin(), g.gamma.end(), j));
+  // … and from them with round 1's iterate as its warm start (what a checkpoint keeps with them):
+  // the same guarantees, its first LP no longer than the cold one.
+  from.lp.initial_x = calls.front().x;
+  from.lp.initial_y = calls.front().y;
+  const RoundingResult w = round_to_graph_surface(m.space, m.lp, m.energy, from);
+  CHECK(satisfies_exactly(m.lp, w.gamma));
+  CHECK(check_graph_surface(m.space, w.gamma).ok());
+  for (int64_t j : calls.front().ones) CHECK(std::binary_search(w.gamma.begin(), w.gamma.end(), j));
+  MESSAGE("gone on from round 1's decisions: its first round ", g.rounds.front().iterations, " iterations cold, ",
+          w.rounds.front().iterations, " warm");
+  CHECK(w.rounds.front().iterations <= g.rounds.front().iterations);
 }
 
 TEST_CASE("rounding: a rounding gone on from decisions with their steps keeps the steps apart") {
@@ -176,9 +193,8 @@ TEST_CASE("rounding: a rounding gone on from decisions with their steps keeps th
   o.solver = "pdhg-cpu";
   o.lp.tolerance = 1e-3;
   std::vector<std::pair<std::vector<int64_t>, std::vector<int32_t>>> calls;
-  o.decided = [&](const RoundingRound&, const std::vector<int64_t>& ones, const std::vector<int32_t>& steps, double) {
-    calls.push_back({ones, steps});
-  };
+  o.decided = [&](const RoundingRound&, const std::vector<int64_t>& ones, const std::vector<int32_t>& steps, double,
+                  const std::vector<double>&, const std::vector<double>&) { calls.push_back({ones, steps}); };
   const RoundingResult plain = round_to_graph_surface(m.space, m.lp, m.energy, o);
   REQUIRE(calls.size() > 2);
   REQUIRE(calls.size() == plain.rounds.size());
@@ -191,9 +207,8 @@ TEST_CASE("rounding: a rounding gone on from decisions with their steps keeps th
     from.start_ones = ones;
     from.start_steps = with_steps ? steps : std::vector<int32_t>{};
     std::vector<std::pair<std::vector<int64_t>, std::vector<int32_t>>> after;
-    from.decided = [&](const RoundingRound&, const std::vector<int64_t>& a, const std::vector<int32_t>& s, double) {
-      after.push_back({a, s});
-    };
+    from.decided = [&](const RoundingRound&, const std::vector<int64_t>& a, const std::vector<int32_t>& s, double,
+                       const std::vector<double>&, const std::vector<double>&) { after.push_back({a, s}); };
     const RoundingResult g = round_to_graph_surface(m.space, m.lp, m.energy, from);
     CHECK(satisfies_exactly(m.lp, g.gamma));
     REQUIRE_FALSE(after.empty());

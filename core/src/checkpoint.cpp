@@ -21,6 +21,7 @@ constexpr char kMagic[] = "shapematch level checkpoint\n";
 // branch_energy and branch_kept. 9: LevelAttempt::zero_cost_margin_given follows `trusted`.
 // 10: LevelAttempt::Rounding::steps follows its ones. 11: LevelAttempt::suspicion_margins
 // follows zero_cost_margin_given. 12: LevelAttempt::Rounding::cap_scale follows its steps. 13:
+// LevelAttempt::Rounding::warm (a flag, then its parts) follows its cap_scale;
 // LevelAttempt::priced_from and solving (each a flag, then its parts; solving's iterations,
 // seconds and two flags; where either, the cold solve's iterations and seconds) follow the
 // rounding. 1 to 12 are read too.
@@ -161,6 +162,10 @@ void write_attempt(Writer& w, const LevelAttempt& a, uint32_t version) {
     w.array(g.ones);
     if (version >= 10) w.array(g.steps);
     if (version >= 12) w(g.cap_scale);
+    if (version >= 13) {
+      w(!g.warm.empty());
+      if (!g.warm.empty()) write_iterate(w, g.warm);
+    }
   }
   if (version < 13) return;
   w(!a.priced_from.empty());
@@ -190,6 +195,9 @@ void read_attempt(Reader& r, LevelAttempt& a, uint32_t version, const std::strin
     r.array(g.ones);
     if (version >= 10) r.array(g.steps);
     if (version >= 12) r(g.cap_scale);
+    bool warm = false;
+    if (version >= 13) r(warm);
+    if (warm) g.warm = read_iterate(r, path);
     if (!(g.cap_scale >= 1.0) || !std::isfinite(g.cap_scale))
       throw IoError(path + ": not a shapematch checkpoint (a rounding's cap scale of " + std::to_string(g.cap_scale) +
                     ")");

@@ -1518,6 +1518,11 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
                      ro.start_ones.size(), carried_ones.size());
       }
       if (going_on) {  // its round 1 solves what the checkpointed fixings leave
+        // From the iterate saved with them (version 13), as the next round would have: a part
+        // whose costed solve is optimal at once then skips its zero-cost pre-test (measured,
+        // TOSCA_r david0-david6 at full resolution: gone on cold, a 14.4 M-variable part's pre-test
+        // alone ran over 40 minutes on one core).
+        if (!going_on->warm.empty()) going_on->warm.apply(m, ro.lp);
         ro.start_ones = going_on->ones;
         ro.start_steps = going_on->steps;
         ro.start_cap_scale = going_on->cap_scale;
@@ -1541,13 +1546,15 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
       Stopwatch since_saved;
       if (tracking)
         ro.decided = [&](const RoundingRound& r, const std::vector<int64_t>& ones, const std::vector<int32_t>& steps,
-                         double bound) {
+                         double bound, const std::vector<double>& x, const std::vector<double>& y) {
           iterations_so_far += r.iterations;
           rounds_so_far = (going_on ? going_on->rounds : 0) + r.round;
           if (r.round == 1 && !going_on) first_bound = bound;
           if (!attempted || since_saved.seconds() < options_.rounding_checkpoint_seconds) return;
           LevelAttempt a = current_attempt();
           a.rounding = rounding_now(ones, steps, r.cap_scale);
+          // (its next round's warm start too: lp_checkpoint_seconds turns the LP's saves on)
+          if (options_.lp_checkpoint_seconds > 0.0) a.rounding.warm.keep(m, x, y);
           attempted(std::move(a));
           since_saved.reset();
         };
@@ -1558,12 +1565,11 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
         if (going_on) {
           if (going_on->lower_bound >= rules.beat) throw Outmatched{going_on->lower_bound};
         } else {
-          ro.decided = [inner = std::move(ro.decided), beat = rules.beat](const RoundingRound& r,
-                                                                          const std::vector<int64_t>& ones,
-                                                                          const std::vector<int32_t>& steps,
-                                                                          double bound) {
+          ro.decided = [inner = std::move(ro.decided), beat = rules.beat](
+                           const RoundingRound& r, const std::vector<int64_t>& ones, const std::vector<int32_t>& steps,
+                           double bound, const std::vector<double>& x, const std::vector<double>& y) {
             if (r.round == 1 && bound >= beat) throw Outmatched{bound};  // (before a checkpoint of it)
-            if (inner) inner(r, ones, steps, bound);
+            if (inner) inner(r, ones, steps, bound, x, y);
           };
         }
       }
@@ -1816,7 +1822,8 @@ void CoarseToFineMatcher::branch_coarsest(MatchingLp& m, RoundingResult& rr, con
       // No Γ of a side whose LP's bound reaches the best energy, or the other side's (a tie
       // keeps the first), can win or be the side to go on from: not rounded.
       const double beat = lower ? std::min(best_energy, lower->rr.energy) : best_energy;
-      ro.decided = [&](const RoundingRound& r, const std::vector<int64_t>&, const std::vector<int32_t>&, double b) {
+      ro.decided = [&](const RoundingRound& r, const std::vector<int64_t>&, const std::vector<int32_t>&, double b,
+                       const std::vector<double>&, const std::vector<double>&) {
         if (r.round == 1 && b >= beat) throw Pruned{b};
       };
       const char* which = place == &s.first ? "first" : "second";

@@ -1580,7 +1580,7 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
     if (options.decided) {
       std::vector<int32_t> steps;
       const std::vector<int64_t> ones = decisions(steps);
-      options.decided(info, ones, steps, result.first_lp.lower_bound);
+      options.decided(info, ones, steps, result.first_lp.lower_bound, x_full, y_full);
     }
   };
   // Giving up where the caller can widen (stuck_after): the fixings to 1 so far and the iterate go with it.

@@ -533,6 +533,9 @@ struct LevelAttempt {
     double reference_seconds = 0.0;  // round 1's cold solve (RoundingOptions::reference_*)
     int64_t reference_iterations = 0;
     double cap_scale = 1.0;          // RoundingOptions::start_cap_scale (version 12; before: 1)
+    // The next round's warm start (RoundingOptions::decided), which the run gone on from here
+    // starts its round 1 from (version 13, where lp_checkpoint_seconds > 0; empty: cold).
+    CarriedIterate warm;
     bool empty() const { return rounds == 0; }
     // How many steps its fixings form (one where `steps` is empty, none without fixings).
     int64_t step_count() const {

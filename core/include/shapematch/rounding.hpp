@@ -302,9 +302,10 @@ struct RoundingOptions {
   // rounding chose (sorted; not what propagation forced, which follows from them), the step of
   // its undo history each belongs to (0 the oldest; parallel to them), and round 1's certified
   // bound: where the rounding has got, for a checkpoint (coarse to fine) that a later run goes on
-  // from with start_ones and start_steps.
+  // from with start_ones and start_steps; and the next round's warm start over the whole LP (the
+  // last iterate kept), which such a run can start its round 1 from (`lp`'s initial_x/y).
   std::function<void(const RoundingRound& round, const std::vector<int64_t>& ones, const std::vector<int32_t>& steps,
-                     double first_bound)>
+                     double first_bound, const std::vector<double>& x, const std::vector<double>& y)>
       decided;
   // Where probe_tolerance is above lp.tolerance and `probe` is set, round 1's LP is solved first
   // to probe_tolerance and `probe` gets that iterate (over the whole LP, as first_iterate's) if it
