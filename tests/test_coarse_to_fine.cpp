@@ -1904,8 +1904,10 @@ TEST_CASE("coarse to fine: a run gone on from a checkpoint inside a rounding fix
   CHECK(g.iterations == last.front().attempt.rounding.iterations);
   CHECK(g.reference_iterations == last.front().attempt.rounding.reference_iterations);
   REQUIRE_FALSE(g.ones.empty());
-  // The next round's warm start goes with it (lp_checkpoint_seconds, on by default).
+  // The next round's warm start goes with it (lp_checkpoint_seconds, on by default): the first
+  // time; after these rounds of milliseconds, not again within those seconds.
   REQUIRE_FALSE(g.warm.empty());
+  CHECK(last.back().attempt.rounding.warm.empty());
   CHECK(g.warm.parts().y == last.front().attempt.rounding.warm.parts().y);
   int saved_again = 0;
   const CoarseToFineResult r = matcher.run({}, &loaded, [&](const LevelCheckpoint& c) {

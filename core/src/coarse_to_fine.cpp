@@ -1544,6 +1544,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
       rounds_so_far = tracking && going_on ? going_on->rounds : 0;  // (0: nothing to restart from)
       iterations_so_far = going_on ? going_on->iterations : from_solving ? solving_done : 0;
       Stopwatch since_saved;
+      std::optional<Stopwatch> since_warm;  // since a rounding checkpoint kept its warm start
       if (tracking)
         ro.decided = [&](const RoundingRound& r, const std::vector<int64_t>& ones, const std::vector<int32_t>& steps,
                          double bound, const std::vector<double>& x, const std::vector<double>& y) {
@@ -1553,8 +1554,15 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
           if (!attempted || since_saved.seconds() < options_.rounding_checkpoint_seconds) return;
           LevelAttempt a = current_attempt();
           a.rounding = rounding_now(ones, steps, r.cap_scale);
-          // (its next round's warm start too: lp_checkpoint_seconds turns the LP's saves on)
-          if (options_.lp_checkpoint_seconds > 0.0) a.rounding.warm.keep(m, x, y);
+          // Its next round's warm start too (lp_checkpoint_seconds turns the LP's saves on), where
+          // a cold start would cost: the first time, after a round of a tenth of that or more,
+          // and that often (some hundred MB at full resolution, where the end game's rounds take
+          // seconds and the saves come every rounding_checkpoint_seconds).
+          const double every = options_.lp_checkpoint_seconds;
+          if (every > 0.0 && (!since_warm || since_warm->seconds() >= every || r.seconds >= 0.1 * every)) {
+            a.rounding.warm.keep(m, x, y);
+            since_warm.emplace();
+          }
           attempted(std::move(a));
           since_saved.reset();
         };
