@@ -1671,8 +1671,8 @@ TEST_CASE("coarse to fine: a run gone on from an attempt of a level in progress 
     bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
   }
   const size_t at = std::string("shapematch level checkpoint\n").size();
-  REQUIRE(bytes[at] == 13);
-  bytes[at] = 14;  // a later version than this build's
+  REQUIRE(bytes[at] == 14);
+  bytes[at] = 15;  // a later version than this build's
   std::ofstream(file, std::ios::binary) << bytes;
   CHECK_THROWS_AS(load_checkpoint(file), IoError);
   detail::save_checkpoint_as(file, marked, 1);
@@ -1692,7 +1692,7 @@ TEST_CASE("coarse to fine: a run gone on from an attempt of a level in progress 
   CHECK(v3.attempt.report.widened_faces == a.report.widened_faces);
   CHECK(v3.attempt.report.stuck_restarts == 0);
   CHECK(v3.levels.back().gamma == last.levels.back().gamma);
-  CHECK_THROWS_AS(detail::save_checkpoint_as(file, marked, 14), InvalidInputError);
+  CHECK_THROWS_AS(detail::save_checkpoint_as(file, marked, 15), InvalidInputError);
 }
 
 TEST_CASE("coarse to fine: a run gone on from inside a refined level's first LP starts that LP where it was") {
@@ -1753,7 +1753,12 @@ TEST_CASE("coarse to fine: a run gone on from inside a refined level's first LP 
   CHECK(f.iterations >= rest[0] + done);  // the report counts those before the save too
   CHECK(check_graph_surface(r.finest.space, r.rounding.gamma).ok());
   CHECK(f.energy == doctest::Approx(whole.levels.back().energy).epsilon(0.05));
-  // A version-12 file has no iterate: the same attempt from zero.
+  // Version 13 kept the iterate but neither its seconds nor its watch flag; 12 no iterate: the
+  // same attempt from zero.
+  detail::save_checkpoint_as(file, late, 13);
+  CHECK(load_checkpoint(file).attempt.solving_iterations == done);
+  CHECK(load_checkpoint(file).attempt.solving_seconds == 0.0);
+  CHECK(load_checkpoint(file).attempt.solving_watched);
   detail::save_checkpoint_as(file, late, 12);
   CHECK(load_checkpoint(file).attempt.solving.empty());
   // An LP under way at a negative count is refused.
@@ -1904,11 +1909,23 @@ TEST_CASE("coarse to fine: a run gone on from a checkpoint inside a rounding fix
   CHECK(g.iterations == last.front().attempt.rounding.iterations);
   CHECK(g.reference_iterations == last.front().attempt.rounding.reference_iterations);
   REQUIRE_FALSE(g.ones.empty());
-  // The next round's warm start goes with it (lp_checkpoint_seconds, on by default): the first
-  // time; after these rounds of milliseconds, not again within those seconds.
+  // The next round's warm start goes with it (lp_checkpoint_seconds, on by default), every time.
   REQUIRE_FALSE(g.warm.empty());
-  CHECK(last.back().attempt.rounding.warm.empty());
-  CHECK(g.warm.parts().y == last.front().attempt.rounding.warm.parts().y);
+  for (const LevelCheckpoint& c : last) CHECK_FALSE(c.attempt.rounding.warm.empty());
+  {
+    const CarriedIterate::Parts p = last.front().attempt.rounding.warm.parts(), q = g.warm.parts();
+    CHECK(q.keys == p.keys);
+    CHECK(q.values == p.values);
+    CHECK(q.row_edge == p.row_edge);
+    CHECK(q.y == p.y);
+  }
+  {  // (Version 13 had none; nor the LP under way's seconds and watch flag.)
+    detail::save_checkpoint_as(file, last.front(), 13);
+    const LevelCheckpoint v13 = load_checkpoint(file);
+    CHECK(v13.attempt.rounding.warm.empty());
+    CHECK(v13.attempt.rounding.ones == g.ones);
+    save_checkpoint(file, last.front());
+  }
   int saved_again = 0;
   const CoarseToFineResult r = matcher.run({}, &loaded, [&](const LevelCheckpoint& c) {
     if (!c.attempt.rounding.empty()) {
@@ -1940,6 +1957,21 @@ TEST_CASE("coarse to fine: a run gone on from a checkpoint inside a rounding fix
     const CoarseToFineResult cold = pdhg.run({}, &v12), warm = pdhg.run({}, &loaded);
     REQUIRE_FALSE(cold.rounding.rounds.empty());
     REQUIRE_FALSE(warm.rounding.rounds.empty());
+    {  // The warm start is the one the next round had: gone on from this run's own checkpoint after
+       // round 1, its round 1 does what the uninterrupted run's round 2 did.
+      std::vector<LevelCheckpoint> own;
+      const CoarseToFineResult whole_pdhg = pdhg.run({}, nullptr, [&](const LevelCheckpoint& c) {
+        if (!c.attempt.rounding.empty() && int(c.levels.size()) == levels - 1) own.push_back(c);
+      });
+      REQUIRE(whole_pdhg.rounding.rounds.size() >= 2);
+      REQUIRE_FALSE(own.empty());
+      REQUIRE(own.front().attempt.rounding.rounds == 1);
+      REQUIRE(own.front().attempt.widenings() == own.back().attempt.widenings());  // (the attempt that finished)
+      const CoarseToFineResult on_pdhg = pdhg.run({}, &own.front());
+      REQUIRE_FALSE(on_pdhg.rounding.rounds.empty());
+      CHECK(on_pdhg.rounding.rounds.front().iterations == whole_pdhg.rounding.rounds[1].iterations);
+      CHECK(on_pdhg.rounding.rounds.front().fixed_to_one == whole_pdhg.rounding.rounds[1].fixed_to_one);
+    }
     MESSAGE("gone on from round 1: its first round ", cold.rounding.rounds.front().iterations, " iterations cold, ",
             warm.rounding.rounds.front().iterations, " warm");
     CHECK(warm.rounding.rounds.front().iterations < cold.rounding.rounds.front().iterations);

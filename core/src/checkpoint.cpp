@@ -21,11 +21,12 @@ constexpr char kMagic[] = "shapematch level checkpoint\n";
 // branch_energy and branch_kept. 9: LevelAttempt::zero_cost_margin_given follows `trusted`.
 // 10: LevelAttempt::Rounding::steps follows its ones. 11: LevelAttempt::suspicion_margins
 // follows zero_cost_margin_given. 12: LevelAttempt::Rounding::cap_scale follows its steps. 13:
-// LevelAttempt::Rounding::warm (a flag, then its parts) follows its cap_scale;
-// LevelAttempt::priced_from and solving (each a flag, then its parts; solving's iterations,
-// seconds and two flags; where either, the cold solve's iterations and seconds) follow the
-// rounding. 1 to 12 are read too.
-constexpr uint32_t kVersion = 13;
+// LevelAttempt::priced_from and solving (each a flag, then its parts; solving's iterations and
+// re-solve flag; where either, the cold solve's iterations and seconds) follow the rounding.
+// 14: LevelAttempt::Rounding::warm (a flag, then its parts) follows its cap_scale, and the LP
+// under way's seconds and watch flag follow its iterations and re-solve flag (13, without them,
+// was written by the seventy-eighth session's binaries before it). 1 to 13 are read too.
+constexpr uint32_t kVersion = 14;
 // More LP iterations than any solve makes (a count past it is a corrupt file, and would overflow).
 constexpr int64_t kMaxIterations = int64_t(1) << 40;
 
@@ -162,7 +163,7 @@ void write_attempt(Writer& w, const LevelAttempt& a, uint32_t version) {
     w.array(g.ones);
     if (version >= 10) w.array(g.steps);
     if (version >= 12) w(g.cap_scale);
-    if (version >= 13) {
+    if (version >= 14) {
       w(!g.warm.empty());
       if (!g.warm.empty()) write_iterate(w, g.warm);
     }
@@ -173,7 +174,10 @@ void write_attempt(Writer& w, const LevelAttempt& a, uint32_t version) {
   w(!a.solving.empty());
   if (!a.solving.empty()) {
     write_iterate(w, a.solving);
-    w(a.solving_iterations), w(a.solving_seconds), w(a.solving_resolve), w(a.solving_watched);
+    w(a.solving_iterations);
+    if (version >= 14) w(a.solving_seconds);
+    w(a.solving_resolve);
+    if (version >= 14) w(a.solving_watched);
   }
   if (!a.priced_from.empty() || !a.solving.empty()) w(a.cold_iterations), w(a.cold_seconds);
 }
@@ -196,7 +200,7 @@ void read_attempt(Reader& r, LevelAttempt& a, uint32_t version, const std::strin
     if (version >= 10) r.array(g.steps);
     if (version >= 12) r(g.cap_scale);
     bool warm = false;
-    if (version >= 13) r(warm);
+    if (version >= 14) r(warm);
     if (warm) g.warm = read_iterate(r, path);
     if (!(g.cap_scale >= 1.0) || !std::isfinite(g.cap_scale))
       throw IoError(path + ": not a shapematch checkpoint (a rounding's cap scale of " + std::to_string(g.cap_scale) +
@@ -210,7 +214,10 @@ void read_attempt(Reader& r, LevelAttempt& a, uint32_t version, const std::strin
   r(solving);
   if (solving) {
     a.solving = read_iterate(r, path);
-    r(a.solving_iterations), r(a.solving_seconds), r(a.solving_resolve), r(a.solving_watched);
+    r(a.solving_iterations);
+    if (version >= 14) r(a.solving_seconds);
+    r(a.solving_resolve);
+    if (version >= 14) r(a.solving_watched);
     if (a.solving_iterations < 0 || a.solving_iterations > kMaxIterations || !(a.solving_seconds >= 0.0) ||
         !std::isfinite(a.solving_seconds))
       throw IoError(path + ": not a shapematch checkpoint (an LP under way at " + std::to_string(a.solving_iterations) +

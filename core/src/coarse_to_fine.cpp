@@ -1438,8 +1438,6 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
         solving_from = {};
         ro.resumed_iterations = solving_done;
         ro.resumed_seconds = solving_seconds;
-        ro.lp.max_iterations = std::max<int64_t>(ro.lp.max_iterations - solving_done, 1);
-        ro.lp.time_limit -= solving_seconds;
         ro.feasibility_iterations = 0;  // (it had passed its pre-test)
         if (!solving_watched) ro.lp.stop_on_divergence = ro.lp.patient_divergence_watch = false;
       }
@@ -1544,26 +1542,28 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
       rounds_so_far = tracking && going_on ? going_on->rounds : 0;  // (0: nothing to restart from)
       iterations_so_far = going_on ? going_on->iterations : from_solving ? solving_done : 0;
       Stopwatch since_saved;
-      std::optional<Stopwatch> since_warm;  // since a rounding checkpoint kept its warm start
+      double last_save_seconds = 0.0;  // how long the last rounding checkpoint took
       if (tracking)
         ro.decided = [&](const RoundingRound& r, const std::vector<int64_t>& ones, const std::vector<int32_t>& steps,
                          double bound, const std::vector<double>& x, const std::vector<double>& y) {
           iterations_so_far += r.iterations;
           rounds_so_far = (going_on ? going_on->rounds : 0) + r.round;
           if (r.round == 1 && !going_on) first_bound = bound;
-          if (!attempted || since_saved.seconds() < options_.rounding_checkpoint_seconds) return;
+          // At most every rounding_checkpoint_seconds, and (where that is not 0) at most a twentieth
+          // of the time on saves: with the warm start below one takes seconds at full resolution
+          // (181 MB in 3 s at 29 M variables), where the end game's rounds take seconds each.
+          const double gap = options_.rounding_checkpoint_seconds > 0.0
+                                 ? std::max(options_.rounding_checkpoint_seconds, 20.0 * last_save_seconds)
+                                 : 0.0;
+          if (!attempted || since_saved.seconds() < gap) return;
+          Stopwatch saving;
           LevelAttempt a = current_attempt();
           a.rounding = rounding_now(ones, steps, r.cap_scale);
-          // Its next round's warm start too (lp_checkpoint_seconds turns the LP's saves on), where
-          // a cold start would cost: the first time, after a round of a tenth of that or more,
-          // and that often (some hundred MB at full resolution, where the end game's rounds take
-          // seconds and the saves come every rounding_checkpoint_seconds).
-          const double every = options_.lp_checkpoint_seconds;
-          if (every > 0.0 && (!since_warm || since_warm->seconds() >= every || r.seconds >= 0.1 * every)) {
-            a.rounding.warm.keep(m, x, y);
-            since_warm.emplace();
-          }
+          // Its next round's warm start too (lp_checkpoint_seconds turns the LP's saves on): a run
+          // gone on from it starts its round 1 there, not cold.
+          if (options_.lp_checkpoint_seconds > 0.0) a.rounding.warm.keep(m, x, y);
           attempted(std::move(a));
+          last_save_seconds = saving.seconds();
           since_saved.reset();
         };
       // A lookahead chain that cannot win: out after the first LP (once pricing has not widened).

@@ -1266,7 +1266,12 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
   if (!fixer.propagate_all())
     throw InfeasibleError("rounding: the matching LP is infeasible (found before any fixing)", {fixer.failed_row()});
 
-  std::vector<double> x_full(lp.cols(), 0.0), y_full(lp.rows(), 0.0);
+  // The next round's warm start over the whole LP: round 1's given one (a run gone on from a
+  // checkpoint: where its round 1 is undone, round 2 starts there too), then each round's iterate.
+  const bool given_start =
+      options.lp.initial_x.size() == size_t(lp.cols()) && options.lp.initial_y.size() == size_t(lp.rows());
+  std::vector<double> x_full = given_start ? options.lp.initial_x : std::vector<double>(lp.cols(), 0.0);
+  std::vector<double> y_full = given_start ? options.lp.initial_y : std::vector<double>(lp.rows(), 0.0);
   // Per column, the primal weight of the last first-order solve that had it (0: none yet), for
   // the next round's parts (carry_weights).
   std::vector<double> w_full(options.carry_weights ? lp.cols() : 0, 0.0);
@@ -1701,6 +1706,10 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
     }
     if (!after_fixing && options.first_max_iterations > 0)
       params.max_iterations = std::min(params.max_iterations, options.first_max_iterations);
+    if (!after_fixing && round == 1) {  // (gone on from a snapshot: what is left of round 1's limits)
+      params.max_iterations = std::max<int64_t>(params.max_iterations - options.resumed_iterations, 1);
+      params.time_limit -= options.resumed_seconds;
+    }
     // An iterate of red.lp over the whole LP: fixed variables at their values.
     auto full_x = [&](const std::vector<double>& reduced) {
       std::vector<double> x(lp.cols());
@@ -1818,8 +1827,8 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
         keep->x = x;
         keep->y = y;
         keep->primal_weight = std::isfinite(r.primal_weight) ? r.primal_weight : 0.0;
-        keep->seconds = clock.seconds() - pretest_seconds;
-        keep->iterations = r.iterations;
+        keep->seconds = clock.seconds() - pretest_seconds + options.resumed_seconds;
+        keep->iterations = r.iterations + options.resumed_iterations;
         // As result.first_lp below (which a failing first_iterate never reaches), without vectors.
         keep->result = r;
         keep->result.x = {};
