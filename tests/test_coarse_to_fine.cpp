@@ -1761,6 +1761,15 @@ TEST_CASE("coarse to fine: a run gone on from inside a refined level's first LP 
   CHECK(load_checkpoint(file).attempt.solving_watched);
   detail::save_checkpoint_as(file, late, 12);
   CHECK(load_checkpoint(file).attempt.solving.empty());
+  // Cut short inside the iterate, or with a flag byte that is no flag: an error naming the file.
+  save_checkpoint(file, late);
+  {
+    std::ifstream in(file, std::ios::binary);
+    std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    in.close();
+    std::ofstream(file, std::ios::binary | std::ios::trunc) << bytes.substr(0, bytes.size() - 64);
+    CHECK_THROWS_WITH_AS(load_checkpoint(file), doctest::Contains(file.c_str()), IoError);
+  }
   // An LP under way at a negative count is refused.
   LevelCheckpoint broken = late;
   broken.attempt.solving_iterations = -1;
