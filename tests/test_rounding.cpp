@@ -49,6 +49,15 @@ const MatchingLp& dolphin_ball_60() {
   return m;
 }
 
+// Threshold 0 (several rounds on the dolphins above), every round's LP on PDHG (none exact).
+RoundingOptions every_round_on_pdhg() {
+  RoundingOptions o;
+  o.solver = "pdhg-cpu";
+  o.exact_below = 0;
+  o.threshold = 0.0;
+  return o;
+}
+
 // max |A x − b| over the whole LP.
 double max_residual(const LpProblem& lp, const std::vector<double>& x) {
   std::vector<double> ax(lp.rows(), 0.0);
@@ -127,10 +136,7 @@ TEST_CASE("rounding: a deformed pair rounds to a verified graph surface within t
 TEST_CASE("rounding: after each round it hands out its decisions, and a rounding from them keeps them") {
   // Threshold 0 on the dolphins at 60 faces: several rounds (see the clashing-candidates test).
   const MatchingLp& m = dolphins_60();
-  RoundingOptions o;
-  o.solver = "pdhg-cpu";
-  o.exact_below = 0;
-  o.threshold = 0.0;
+  RoundingOptions o = every_round_on_pdhg();
   o.alternative_thresholds = {};  // one rounding
   o.close_pockets = false;        // (which may replace decided triangles)
   struct Call {
@@ -241,10 +247,7 @@ TEST_CASE("rounding: a rounding gone on from decisions with their steps keeps th
 TEST_CASE("rounding: round 1's first-order solve alone is snapshot, over the whole LP, resumed counts included") {
   // Threshold 0 on the dolphins at 60 faces: several rounds, each on PDHG, and a pre-test.
   const MatchingLp& m = dolphins_60();
-  RoundingOptions o;
-  o.solver = "pdhg-cpu";
-  o.exact_below = 0;
-  o.threshold = 0.0;
+  RoundingOptions o = every_round_on_pdhg();
   o.feasibility_iterations = 256;  // a pre-test, which is not snapshot
   std::vector<SolveSnapshot> seen;
   std::vector<bool> watched;
@@ -2103,10 +2106,7 @@ TEST_CASE("rounding: a later round's parts start from the primal weight their co
 TEST_CASE("rounding: later rounds carrying their parts' primal weights end in a verified graph surface") {
   // Every round on PDHG (as in the capped-rounds test), its parts started from the carried ω.
   const MatchingLp& m = dolphins_60();
-  RoundingOptions o;
-  o.solver = "pdhg-cpu";
-  o.exact_below = 0;
-  o.threshold = 0.0;
+  RoundingOptions o = every_round_on_pdhg();
   o.carry_weights = true;
   const RoundingResult r = round_to_graph_surface(m.space, m.lp, m.energy, o);
   REQUIRE(r.rounds.size() >= 2);
