@@ -1516,10 +1516,11 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
                      ro.start_ones.size(), carried_ones.size());
       }
       if (going_on) {  // its round 1 solves what the checkpointed fixings leave
-        // From the iterate saved with them (version 13), as the next round would have: a part
+        // From the iterate saved with them (version 14), as the next round would have: a part
         // whose costed solve is optimal at once then skips its zero-cost pre-test (measured,
-        // TOSCA_r david0-david6 at full resolution: gone on cold, a 14.4 M-variable part's pre-test
-        // alone ran over 40 minutes on one core).
+        // TOSCA_r david0-david6 without WKS at full resolution: gone on cold, a 14.4 M-variable
+        // part's costed solve was at 0.051 after 512 iterations and its pre-test then took 6 144
+        // iterations, about 50 minutes on one core; docs/results-log.md, seventy-eighth session).
         if (!going_on->warm.empty()) going_on->warm.apply(m, ro.lp);
         ro.start_ones = going_on->ones;
         ro.start_steps = going_on->steps;

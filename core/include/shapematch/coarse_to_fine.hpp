@@ -507,8 +507,8 @@ struct LevelAttempt {
   // lp_checkpoint_seconds), which a run gone on from here starts it from, without the zero-cost
   // pre-test it had passed, its divergence watch on only where it was (`solving_watched`: the
   // pre-test turns it off where it finds a point), counting those iterations and seconds where
-  // the rounding scales with them (version 13; before, a run gone on from here solved it from
-  // zero). Empty elsewhere.
+  // the rounding scales with them (version 13; its seconds and watch flag 14; before, a run gone
+  // on from here solved it from zero). Empty elsewhere.
   CarriedIterate solving;
   int64_t solving_iterations = 0;
   double solving_seconds = 0.0;
@@ -534,7 +534,7 @@ struct LevelAttempt {
     int64_t reference_iterations = 0;
     double cap_scale = 1.0;          // RoundingOptions::start_cap_scale (version 12; before: 1)
     // The next round's warm start (RoundingOptions::decided), which the run gone on from here
-    // starts its round 1 from (version 13, where lp_checkpoint_seconds > 0; empty: cold).
+    // starts its round 1 from (version 14, where lp_checkpoint_seconds > 0; empty: cold).
     CarriedIterate warm;
     bool empty() const { return rounds == 0; }
     // How many steps its fixings form (one where `steps` is empty, none without fixings).
