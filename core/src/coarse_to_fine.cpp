@@ -1473,7 +1473,9 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
         first_omega = options_.carry_primal_weight ? omega : 0.0;
       };
       // Price at a looser tolerance first (price_tolerance); the LP goes on to its own after.
-      const bool probing = pricing && options_.price_tolerance > ro.lp.tolerance;
+      // (Not in a run gone on from inside the LP: its probe may have priced already, and a probe
+      // from that iterate would price again at once; it prices once, after the LP, instead.)
+      const bool probing = pricing && !from_solving && options_.price_tolerance > ro.lp.tolerance;
       if (probing) {
         ro.probe_tolerance = options_.price_tolerance;
         ro.probe = [&](const std::vector<double>& x, const std::vector<double>& y, double omega) {
