@@ -267,3 +267,29 @@ TEST_CASE("pdhg-vulkan: both backends converge to the same objective") {
   // The same algorithm in fp32 with sums in another order: the paths stay close.
   CHECK(std::abs(double(gpu.iterations - cpu.iterations)) <= 0.25 * double(cpu.iterations));
 }
+
+TEST_CASE("pdhg-vulkan: a snapshot read from the device starts the solve again near where it was") {
+  if (!test::vulkan_wanted()) return;
+  const LpProblem lp = matching_lp();
+  SolverParams params = tight();
+  std::vector<SolveSnapshot> seen;
+  params.snapshot_seconds = 1e-9;  // (at every residual check)
+  params.snapshot = [&](const SolveSnapshot& s) { seen.push_back(s); };
+  const LpResult whole = solve_lp(lp, "pdhg-vulkan", params);
+  REQUIRE(whole.status == LpStatus::Optimal);
+  REQUIRE(seen.size() >= 2);
+  const SolveSnapshot& last = seen.back();
+  CHECK(last.x.size() == size_t(lp.cols()));
+  CHECK(last.y.size() == size_t(lp.rows()));
+  CHECK(last.iterations < whole.iterations);
+  SolverParams again = tight();
+  again.initial_x = last.x;
+  again.initial_y = last.y;
+  again.initial_primal_weight = last.primal_weight;
+  const LpResult rest = solve_lp(lp, "pdhg-vulkan", again);
+  REQUIRE(rest.status == LpStatus::Optimal);
+  CAPTURE(whole.iterations);
+  CAPTURE(last.iterations);
+  CHECK(rest.iterations <= whole.iterations - last.iterations + 64);
+  CHECK(std::abs(rest.objective - whole.objective) <= 1e-4 * std::abs(whole.objective));
+}
