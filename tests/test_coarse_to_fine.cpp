@@ -1742,6 +1742,13 @@ TEST_CASE("coarse to fine: a run gone on from inside a refined level's first LP 
   CHECK(loaded.attempt.solving_seconds == late.attempt.solving_seconds);
   CHECK(loaded.attempt.solving_seconds > 0.0);
   CHECK(loaded.attempt.solving_watched == late.attempt.solving_watched);
+  {  // (the watch flag both ways)
+    LevelCheckpoint unwatched = late;
+    unwatched.attempt.solving_watched = !late.attempt.solving_watched;
+    const std::string other = (tmp.path / "unwatched.ckpt").string();
+    save_checkpoint(other, unwatched);
+    CHECK(load_checkpoint(other).attempt.solving_watched == !late.attempt.solving_watched);
+  }
   CHECK(loaded.attempt.solving.parts().y == late.attempt.solving.parts().y);
   std::vector<int64_t> rest;
   const CoarseToFineResult r = matcher.run(at_finest(rest), &loaded);  // (no checkpointing: no saves)
@@ -1761,7 +1768,7 @@ TEST_CASE("coarse to fine: a run gone on from inside a refined level's first LP 
   CHECK(load_checkpoint(file).attempt.solving_watched);
   detail::save_checkpoint_as(file, late, 12);
   CHECK(load_checkpoint(file).attempt.solving.empty());
-  // Cut short inside the iterate, or with a flag byte that is no flag: an error naming the file.
+  // Cut short inside the iterate: an error naming the file.
   save_checkpoint(file, late);
   {
     std::ifstream in(file, std::ios::binary);

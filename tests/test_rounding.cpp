@@ -276,6 +276,14 @@ TEST_CASE("rounding: round 1's first-order solve alone is snapshot, over the who
   REQUIRE_FALSE(seen.empty());
   CHECK(seen.front().iterations > 1000);
   CHECK(seen.front().seconds > 50.0);
+  // … and round 1's cap is what is left of it: first_max_iterations less those before.
+  REQUIRE(r.rounds.front().iterations > 50);  // (uncapped, it takes more)
+  o.first_snapshot = {};
+  o.feasibility_iterations = 0;
+  o.first_max_iterations = 200;
+  o.resumed_iterations = 150;
+  const RoundingResult capped = round_to_graph_surface(m.space, m.lp, m.energy, o);
+  CHECK(capped.rounds.front().iterations == 50);
 }
 
 TEST_CASE("rounding: later rounds stop at their iteration cap and still end exact") {

@@ -24,8 +24,9 @@ constexpr char kMagic[] = "shapematch level checkpoint\n";
 // LevelAttempt::priced_from and solving (each a flag, then its parts; solving's iterations and
 // re-solve flag; where either, the cold solve's iterations and seconds) follow the rounding.
 // 14: LevelAttempt::Rounding::warm (a flag, then its parts) follows its cap_scale, and the LP
-// under way's seconds and watch flag follow its iterations and re-solve flag (13, without them,
-// was written by the seventy-eighth session's binaries before it). 1 to 13 are read too.
+// under way's seconds and watch flag follow its iterations and re-solve flag. 1 to 13 are read
+// too (13 as written by the seventy-eighth session's binaries of 4512e6d-a25eb65; its other
+// intermediate layouts of 13 are refused as cut short or malformed).
 constexpr uint32_t kVersion = 14;
 // More LP iterations than any solve makes (a count past it is a corrupt file, and would overflow).
 constexpr int64_t kMaxIterations = int64_t(1) << 40;

@@ -1454,7 +1454,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
           }
           priced_from = {};  // (no longer needed: this LP starts from it)
         }
-        ro.first_max_iterations = std::max<int64_t>(cold_iterations - (from_solving ? solving_done : 0), 1);
+        ro.first_max_iterations = cold_iterations;  // (the rounding takes resumed_iterations off it)
         // The later rounds' caps and the stuck rules scale with what a solve of this level costs,
         // which the warm re-solve understates: FAUST_r 024-043 at full resolution, level 6 (thirtieth
         // session), 704 iterations and 114 s against 2 944 and 418 s cold. Its rounding's later
@@ -1565,7 +1565,11 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
           // Its next round's warm start too (lp_checkpoint_seconds turns the LP's saves on): a run
           // gone on from it starts its round 1 there, not cold.
           if (options_.lp_checkpoint_seconds > 0.0) a.rounding.warm.keep(m, x, y);
-          attempted(std::move(a));
+          try {
+            attempted(std::move(a));
+          } catch (const IoError& e) {  // (the rounding goes on; the last checkpoint stands)
+            spdlog::warn("level {}: its rounding's checkpoint was not saved: {}", l + 1, e.what());
+          }
           last_save_seconds = saving.seconds();
           since_saved.reset();
         };

@@ -1266,10 +1266,11 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
   if (!fixer.propagate_all())
     throw InfeasibleError("rounding: the matching LP is infeasible (found before any fixing)", {fixer.failed_row()});
 
-  // The next round's warm start over the whole LP: round 1's given one (a run gone on from a
-  // checkpoint: where its round 1 is undone, round 2 starts there too), then each round's iterate.
-  const bool given_start =
-      options.lp.initial_x.size() == size_t(lp.cols()) && options.lp.initial_y.size() == size_t(lp.rows());
+  // The next round's warm start over the whole LP: where round 1 goes on from carried fixings
+  // with a given one (a run gone on from a rounding checkpoint: where its round 1 is undone, round
+  // 2 starts there too), that one; then each round's iterate.
+  const bool given_start = !options.start_ones.empty() && options.lp.initial_x.size() == size_t(lp.cols()) &&
+                           options.lp.initial_y.size() == size_t(lp.rows());
   std::vector<double> x_full = given_start ? options.lp.initial_x : std::vector<double>(lp.cols(), 0.0);
   std::vector<double> y_full = given_start ? options.lp.initial_y : std::vector<double>(lp.rows(), 0.0);
   // Per column, the primal weight of the last first-order solve that had it (0: none yet), for
