@@ -58,13 +58,7 @@ struct ProofPlace {
   }
 };
 
-std::vector<int> faces_on(const Mesh& mesh, const std::vector<char>& vertices, int rings) {
-  std::vector<int> seed;
-  for (int v = 0; v < mesh.num_vertices(); ++v)
-    if (vertices[v]) seed.push_back(v);
-  if (seed.empty()) return {};
-  return ring_faces(mesh, vertex_face_table(mesh), seed, rings);
-}
+using detail::faces_on;  // (suspicion_margin.hpp)
 
 // The fine X faces to widen for a proof: those on its X vertices, grown by `margin` rings (the
 // faces whose candidates ran out there). With `carry_y`, also every X face of a variable that

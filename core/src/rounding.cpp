@@ -1711,12 +1711,17 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
       params.max_iterations = std::max<int64_t>(params.max_iterations - options.resumed_iterations, 1);
       params.time_limit -= options.resumed_seconds;
     }
-    // An iterate of red.lp over the whole LP: fixed variables at their values.
+    // An iterate of red.lp over the whole LP: fixed variables at their values, rows it lacks at 0.
     auto full_x = [&](const std::vector<double>& reduced) {
       std::vector<double> x(lp.cols());
       for (int64_t j = 0; j < lp.cols(); ++j) x[j] = fixer.state().value[j] == 1 ? 1.0 : 0.0;
       for (size_t j = 0; j < red.cols.size(); ++j) x[red.cols[j]] = reduced[j];
       return x;
+    };
+    auto full_y = [&](const std::vector<double>& reduced) {
+      std::vector<double> y(lp.rows(), 0.0);
+      for (size_t i = 0; i < red.rows.size() && i < reduced.size(); ++i) y[red.rows[i]] = reduced[i];
+      return y;
     };
     JoinedSolve joined;
     double round_one_weight = 0.0;  // the ω round 1's (first) solve was asked to start from
@@ -1732,8 +1737,7 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
       auto snapshot = [&](const SolveSnapshot& s) {
         SolveSnapshot whole;
         whole.x = full_x(s.x);
-        whole.y.assign(lp.rows(), 0.0);
-        for (size_t i = 0; i < red.rows.size() && i < s.y.size(); ++i) whole.y[red.rows[i]] = s.y[i];
+        whole.y = full_y(s.y);
         whole.primal_weight = s.primal_weight;
         whole.iterations = snapshot_iterations + s.iterations;
         whole.seconds = snapshot_seconds + s.seconds;
@@ -1774,9 +1778,7 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
         loose.tolerance = options.probe_tolerance;
         LpResult p = solver->solve(red.lp, loose);
         if (p.status == LpStatus::Optimal && p.x.size() == red.cols.size() && p.y.size() == red.rows.size()) {
-          std::vector<double> y(lp.rows(), 0.0);
-          for (size_t i = 0; i < red.rows.size(); ++i) y[red.rows[i]] = p.y[i];
-          options.probe(full_x(p.x), y, p.primal_weight);
+          options.probe(full_x(p.x), full_y(p.y), p.primal_weight);
           params.initial_x = std::move(p.x);
           params.initial_y = std::move(p.y);
           if (std::isfinite(p.primal_weight) && p.primal_weight > 0.0) params.initial_primal_weight = p.primal_weight;

@@ -9,16 +9,21 @@
 
 namespace shapematch::detail {
 
-// The faces within `rings` fine rings of the faces `seeds` (ring_faces from their vertices).
+// The faces within `rings` rings of the vertices flagged in `vertices` (one flag per vertex).
+inline std::vector<int> faces_on(const Mesh& mesh, const std::vector<char>& vertices, int rings) {
+  std::vector<int> seed;
+  for (int v = 0; v < mesh.num_vertices(); ++v)
+    if (vertices[v]) seed.push_back(v);
+  if (seed.empty()) return {};
+  return ring_faces(mesh, vertex_face_table(mesh), seed, rings);
+}
+
+// The faces within `rings` fine rings of the faces `seeds` (faces_on their vertices).
 inline std::vector<int> faces_near(const Mesh& mesh, const std::vector<int>& seeds, int rings) {
   std::vector<char> on(mesh.num_vertices(), 0);
   for (int f : seeds)
     for (int v : mesh.faces[f]) on[v] = 1;
-  std::vector<int> vertices;
-  for (int v = 0; v < mesh.num_vertices(); ++v)
-    if (on[v]) vertices.push_back(v);
-  if (vertices.empty()) return {};
-  return ring_faces(mesh, vertex_face_table(mesh), vertices, rings);
+  return faces_on(mesh, on, rings);
 }
 
 // The margin's faces: near every face with extra rings at the level (MarginScope::widened), or
