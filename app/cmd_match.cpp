@@ -84,6 +84,7 @@ struct MatchArgs {
   int suspicion_rings = CoarseToFineOptions{}.suspicion_rings;
   int suspicion_margins = CoarseToFineOptions{}.suspicion_margins;
   std::string suspicion_margin_around = "widened";
+  double divergence_bound_factor = CoarseToFineOptions{}.divergence_bound_factor;
   int zero_cost_proof_rings = CoarseToFineOptions{}.zero_cost_proof_rings;
   double second_start_budget = CoarseToFineOptions{}.second_start_budget;
   bool warm_widening = CoarseToFineOptions{}.warm_widening;
@@ -216,6 +217,7 @@ int run_match(const MatchArgs& args) {
   co.suspicion_margins = args.suspicion_margins;
   co.suspicion_margin_scope = args.suspicion_margin_around == "named" ? CoarseToFineOptions::MarginScope::named
                                                                       : CoarseToFineOptions::MarginScope::widened;
+  co.divergence_bound_factor = args.divergence_bound_factor;
   co.zero_cost_proof_rings = args.zero_cost_proof_rings;
   co.second_start_budget = args.second_start_budget;
   co.warm_widening = args.warm_widening;
@@ -587,6 +589,7 @@ int run_match(const MatchArgs& args) {
                               .set("suspicion_rings", args.suspicion_rings)
                               .set("suspicion_margins", args.suspicion_margins)
                               .set("suspicion_margin_around", args.suspicion_margin_around)
+                              .set("divergence_bound_factor", args.divergence_bound_factor)
                               .set("zero_cost_proof_rings", args.zero_cost_proof_rings)
                               .set("second_start_budget", args.second_start_budget)
                               .set("warm_widening", args.warm_widening)
@@ -974,6 +977,11 @@ Action add_match_command(CLI::App& app) {
                  "what a --suspicion-rings margin is drawn around: widened (every X face widened so far at the "
                  "level) or named (only the X faces the suspicion itself named)")
       ->check(CLI::IsMember({"widened", "named"}))
+      ->capture_default_str();
+  app.add_option("--divergence-bound-factor", a->divergence_bound_factor,
+                 "a watched first LP of a refined level also stops as diverging where its dual proves its optimum "
+                 "above this many times the coarser level's energy (0: off)")
+      ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   app.add_option("--zero-cost-proof-rings", a->zero_cost_proof_rings,
                  "where --feasibility-first proves a level's first LP infeasible for the first time at its ring, "

@@ -652,6 +652,42 @@ TEST_CASE("pdhg-cpu: feasible LPs never stop as diverging") {
   CHECK(solve_lp(m.lp, "pdhg-cpu", params).status == LpStatus::Optimal);
 }
 
+TEST_CASE("pdhg-cpu: a watched LP whose certified bound passes divergence_bound stops there, feasible or not") {
+  std::mt19937 rng(5);
+  const LpProblem p = random_lp(70, 240, 3, rng);
+  for (const char* solver : kNative) {
+    CAPTURE(solver);
+    SolverParams params = tight(1e-6);
+    params.stop_on_divergence = true;
+    params.patient_divergence_watch = true;
+    const LpResult whole = solve_lp(p, solver, params);
+    CAPTURE(std::string(to_string(whole.status)));
+    REQUIRE(whole.status == LpStatus::Optimal);
+    REQUIRE(whole.iterations > 1024);  // (windows of 512: room for a stop before the optimum)
+    // Below the optimum: a dual iterate proves more, and the solve stops at that window's end.
+    params.divergence_bound = whole.objective - 1e-4 * (1.0 + std::abs(whole.objective));
+    const LpResult stopped = solve_lp(p, solver, params);
+    MESSAGE("optimal " << whole.objective << " in " << whole.iterations << " iterations; stopped at "
+                       << stopped.iterations << " with a certified bound of " << stopped.lower_bound);
+    CHECK(stopped.status == LpStatus::Diverging);
+    CHECK(stopped.iterations < whole.iterations);
+    CHECK(stopped.iterations % 512 == 0);
+    CHECK(stopped.lower_bound > params.divergence_bound);
+    CHECK(stopped.lower_bound <= whole.objective + 1e-6 * (1.0 + std::abs(whole.objective)));
+    REQUIRE(stopped.last_y.size() == size_t(p.rows()));
+    CHECK(certified_lower_bound(p, stopped.last_y) > params.divergence_bound);
+    // Above the optimum no dual gets there: the same solve, iteration for iteration.
+    params.divergence_bound = whole.objective + 0.05 * (1.0 + std::abs(whole.objective));
+    const LpResult above = solve_lp(p, solver, params);
+    CHECK(above.status == LpStatus::Optimal);
+    CHECK(above.iterations == whole.iterations);
+    // Unwatched, the bound is not looked at.
+    params.divergence_bound = whole.objective - 0.05 * (1.0 + std::abs(whole.objective));
+    params.stop_on_divergence = false;
+    CHECK(solve_lp(p, solver, params).status == LpStatus::Optimal);
+  }
+}
+
 TEST_CASE("pdhg: the divergence watch on the windows of measured full-resolution LPs") {
   // (primal residual, gap, objective, bound) at the end of each 512-iteration window, tolerance
   // 3e-3, from the logs of the FAUST_r and TOSCA_r runs in docs/results-log.md.

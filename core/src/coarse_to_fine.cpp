@@ -538,6 +538,8 @@ CoarseToFineMatcher::CoarseToFineMatcher(const Mesh& x, const Mesh& y, CoarseToF
   if (options_.suspicion_margin_scope != CoarseToFineOptions::MarginScope::widened &&
       options_.suspicion_margin_scope != CoarseToFineOptions::MarginScope::named)
     throw InvalidInputError("coarse to fine: unknown suspicion margin scope");
+  if (!(options_.divergence_bound_factor >= 0.0) || !std::isfinite(options_.divergence_bound_factor))
+    throw InvalidInputError("coarse to fine: need a divergence bound factor of 0 or more");
   // Both shapes get the same number of levels (the larger shape's count), each its own face counts.
   HierarchyOptions ho = options_.hierarchy;
   if (ho.levels == 0)
@@ -718,8 +720,13 @@ CoarseToFineResult CoarseToFineMatcher::run(const Progress& progress, const Leve
         };
       const LevelAttempt* attempt = l == start && !c.resume.empty() ? &c.resume : nullptr;
       LevelReport rep = header;
+      ChainRules chain_rules = rules;
+      if (l > 0)
+        chain_rules.coarser_energy = !c.pending.empty()         ? c.pending.back().energy
+                                     : !result.levels.empty() ? result.levels.back().energy
+                                                              : chain_rules.coarser_energy;
       try {
-        solve_refined(l, model, rep, c.gamma, result, progress, c.widened, attempt, attempted, rules);
+        solve_refined(l, model, rep, c.gamma, result, progress, c.widened, attempt, attempted, chain_rules);
       } catch (const Outmatched& o) {
         LevelReport& kept = next.front().pending.back();
         spdlog::info("level {}: the second lookahead chain's LP bound {:.6g} is at or above the first chain's energy "
@@ -1420,6 +1427,8 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
                                              .watch_resolve = options_.watch_resolve};
       ro.lp.patient_divergence_watch = watched_patiently = detail::watch_patiently(first_state);
       ro.lp.stop_on_divergence = detail::watch_divergence(first_state) || ro.lp.patient_divergence_watch;
+      if (options_.divergence_bound_factor > 0.0 && rules.coarser_energy > 0.0)
+        ro.lp.divergence_bound = options_.divergence_bound_factor * rules.coarser_energy;
       if (l > 0 && options_.warm_widening && !carrying && !going_on) {  // (a restart starts cold)
         if (!warm.empty()) warm.apply(m, ro.lp);
       }

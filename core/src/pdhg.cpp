@@ -162,7 +162,10 @@ LpResult PdhgSolver::solve(const LpProblem& problem, const SolverParams& params)
   // the growth returned as the ray.
   detail::DivergenceWatch watch(params.tolerance, params.patient_divergence_watch);
   int64_t window_end = detail::DivergenceWatch::kWindow;
+  // (From the start: a bound past params.divergence_bound may stop the first window, its growth
+  // from the starting dual; the watch's own rules wait for a second.)
   std::vector<double> window_y;
+  if (params.stop_on_divergence) window_y = y0;
   int restarts = 0;
   Stopwatch since_snapshot;
   result.status = LpStatus::IterationLimit;
@@ -232,7 +235,17 @@ LpResult PdhgSolver::solve(const LpProblem& problem, const SolverParams& params)
     if (params.stop_on_divergence && total >= window_end) {
       std::vector<double> xh, yh;
       backend->read(xh, yh);
-      const bool diverging = watch.diverging(primal, gap, s.cx, dual_obj) && !window_y.empty();
+      const bool watched = watch.diverging(primal, gap, s.cx, dual_obj) && !window_y.empty();
+      // A bound past params.divergence_bound, confirmed in double precision (the running one is
+      // an fp32 reduction on a device).
+      double certified = -std::numeric_limits<double>::infinity();
+      if (dual_obj * problem.objective_scale > params.divergence_bound) {
+        std::vector<double> y(m);
+        for (int64_t i = 0; i < m; ++i) y[i] = r[i] * yh[i];
+        certified = certified_lower_bound(problem, y);
+      }
+      const bool bounded = certified > params.divergence_bound;
+      const bool diverging = watched || bounded;
       const bool debug = !window_y.empty() && spdlog::should_log(spdlog::level::debug);
       std::vector<double> ray;  // the window's dual growth: about a Farkas ray where the LP is infeasible
       if (diverging || debug) {
@@ -243,7 +256,11 @@ LpResult PdhgSolver::solve(const LpProblem& problem, const SolverParams& params)
         double bd = 0.0;
         for (int64_t i = 0; i < m; ++i) bd += problem.b[i] * ray[i];
         spdlog::debug("{}: window to {} it: the dual's growth has bᵀd {:.4g}, Farkas rate {:.4g}{}", name(), total,
-                      bd, farkas_rate(problem, ray), diverging ? " (the watch stops it)" : "");
+                      bd, farkas_rate(problem, ray),
+                      watched   ? " (the watch stops it)"
+                      : bounded ? fmt::format(" (stopped: its certified bound {:.6g} is above {:.6g})", certified,
+                                              params.divergence_bound)
+                                : std::string());
       }
       if (diverging) {
         result.status = LpStatus::Diverging;
@@ -294,7 +311,8 @@ LpResult PdhgSolver::solve(const LpProblem& problem, const SolverParams& params)
   }
 
   if (result.status == LpStatus::Diverging) {
-    result.lower_bound = certified_lower_bound(problem, result.y);  // valid for any y, if weak
+    // (Valid for any y: the growth's is weak, the last iterate's the one divergence_bound saw.)
+    result.lower_bound = std::max(certified_lower_bound(problem, result.y), certified_lower_bound(problem, result.last_y));
   } else if (result.status != LpStatus::Infeasible) {
     std::vector<double> xh, yh;
     backend->read(xh, yh);

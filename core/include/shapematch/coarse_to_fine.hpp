@@ -173,6 +173,16 @@ struct CoarseToFineOptions {
   // seventy-seventh session); the measured cure on FAUST_r 029-063 (above) was the first.
   enum class MarginScope { widened, named };
   MarginScope suspicion_margin_scope = MarginScope::widened;
+  // A watched first LP of a refined level (divergence watch, quick or patient) also stops as
+  // diverging where its dual proves its optimum above this many times the coarser level's energy
+  // (SolverParams::divergence_bound): no Γ of that space is one the level wants, and widening is
+  // what a stop leads to. The finest LP's optimum against the coarser level's energy, measured at
+  // full resolution: 0.58 (TOSCA_r horse0-horse5, 2.66 against 4.56) to 1.24 (david0-david6 without
+  // WKS, level 2 from 1). The watch's own rules let a plainly infeasible LP climb for eight windows:
+  // TOSCA_r david0-david6 without WKS, `--suspicion-margin-around named`, level 6: its bound 7.0
+  // against an objective of 3.19 and a coarser energy of 3.04, residual flat at 1.06e-2, ω 1 580,
+  // after 45 minutes on one core (seventy-eighth session). 0: off.
+  double divergence_bound_factor = 2.0;
   // Where the zero-cost pre-test (RoundingOptions::feasibility_iterations) proves a level's first
   // LP infeasible for the first time at its ring, every X face within this many fine rings of the
   // faces widened so far gets one more ring too, as after the suspicion that the divergence watch
@@ -642,6 +652,7 @@ private:
   struct ChainRules {
     bool drop_when_stuck = false;
     double beat = std::numeric_limits<double>::quiet_NaN();
+    double coarser_energy = std::numeric_limits<double>::quiet_NaN();  // the Γ it starts from (divergence_bound_factor)
   };
   // Level l from the coarser level's Γ (the full space at l = 0), widening where it is
   // infeasible; throws InfeasibleError when the largest ring is. Replaces `gamma` with level l's.

@@ -62,6 +62,11 @@ struct SolverParams {
   // With stop_on_divergence: only the slowest climb stops it, held twice as long
   // (detail::DivergenceWatch, patient). For an LP whose earlier suspicions came to nothing.
   bool patient_divergence_watch = false;
+  // With stop_on_divergence: a dual iterate whose certified bound (certified_lower_bound, in
+  // double precision) lies above this at a window's end stops the LP as Diverging too, whatever
+  // the watch's rules say: its optimum lies above it. For a caller that knows no optimum that high
+  // is worth finishing (coarse to fine: CoarseToFineOptions::divergence_bound_factor). +∞: never.
+  double divergence_bound = std::numeric_limits<double>::infinity();
   // Warm start (first-order methods): both empty or of the right sizes.
   std::vector<double> initial_x;
   std::vector<double> initial_y;
@@ -101,7 +106,8 @@ struct LpResult {
   double gap = std::numeric_limits<double>::quiet_NaN();  // |objective − bound| / (1 + |objective| + |bound|)
   std::vector<double> x;
   std::vector<double> y;
-  // Diverging only (y holds the dual's growth there): the dual iterate where it stopped.
+  // Diverging only (y holds the dual's growth there): the dual iterate where it stopped. There
+  // lower_bound is the better of the two duals' certified bounds.
   std::vector<double> last_y;
   // Infeasible (PDHG, with PdhgOptions::ray_iterations): the dual's growth over those iterations
   // after the proof, where that is a Farkas ray (empty otherwise). Its large entries name the
