@@ -2328,3 +2328,45 @@ TEST_CASE("coarse to fine: the coarsest dive keeps its bound and ends below a fr
   CHECK(none.levels[0].branch_roundings == 0);
   CHECK(none.levels[0].gamma == p.gamma);
 }
+
+TEST_CASE("coarse to fine: the divergence bound is the factor times the coarser energy while a ring is left") {
+  using detail::divergence_bound;
+  const detail::FirstLpState ring_left{.refined = true, .ring_left = true};
+  CHECK(divergence_bound(ring_left, 2.0, 3.0) == 6.0);
+  CHECK(std::isinf(divergence_bound(ring_left, 0.0, 3.0)));  // off
+  CHECK(std::isinf(divergence_bound(ring_left, 2.0, std::nan(""))));  // no coarser level
+  CHECK(std::isinf(divergence_bound(ring_left, 2.0, 0.0)));  // (nothing to scale)
+  detail::FirstLpState last = ring_left;
+  last.ring_left = false;  // at the last ring a stop could end the level: none
+  last.widenings_left = true;
+  CHECK(std::isinf(divergence_bound(last, 2.0, 3.0)));
+  CHECK(CoarseToFineOptions{}.divergence_bound_factor == 2.0);
+  CoarseToFineOptions o;
+  o.divergence_bound_factor = -1.0;
+  CHECK_THROWS_AS(CoarseToFineMatcher(shapes::octahedron(), shapes::octahedron(), o), InvalidInputError);
+}
+
+TEST_CASE("coarse to fine: watched first LPs stop where their bound passes the factor; the run still ends") {
+  // Under a factor of 10⁻⁶ every watched first LP whose certified bound turns positive stops at
+  // its window's end, feasible or not: the levels widen more, and still end with a Γ (at the
+  // last ring no bound applies). At the default the finger pair's LPs stay far below it.
+  auto run = [](double factor) {
+    CoarseToFineOptions o = small_levels();
+    o.divergence_bound_factor = factor;
+    const CoarseToFineMatcher matcher = finger_matcher(o);
+    const CoarseToFineResult r = matcher.run();
+    CHECK(check_graph_surface(r.finest.space, r.rounding.gamma).ok());
+    int widenings = 0;
+    for (const LevelReport& l : r.levels) widenings += l.widenings + l.local_widenings;
+    return std::pair{widenings, r.levels.back().energy};
+  };
+  const auto [off_widenings, off_energy] = run(0.0);
+  const auto [tiny_widenings, tiny_energy] = run(1e-6);
+  const auto [default_widenings, default_energy] = run(CoarseToFineOptions{}.divergence_bound_factor);
+  MESSAGE("widenings: off " << off_widenings << ", factor 1e-6 " << tiny_widenings << ", default "
+                            << default_widenings);
+  CHECK(tiny_widenings > off_widenings);
+  CHECK(std::isfinite(tiny_energy));
+  CHECK(default_widenings == off_widenings);
+  CHECK(default_energy == off_energy);
+}

@@ -1427,8 +1427,8 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
                                              .watch_resolve = options_.watch_resolve};
       ro.lp.patient_divergence_watch = watched_patiently = detail::watch_patiently(first_state);
       ro.lp.stop_on_divergence = detail::watch_divergence(first_state) || ro.lp.patient_divergence_watch;
-      if (options_.divergence_bound_factor > 0.0 && rules.coarser_energy > 0.0)
-        ro.lp.divergence_bound = options_.divergence_bound_factor * rules.coarser_energy;
+      ro.lp.divergence_bound =
+          detail::divergence_bound(first_state, options_.divergence_bound_factor, rules.coarser_energy);
       if (l > 0 && options_.warm_widening && !carrying && !going_on) {  // (a restart starts cold)
         if (!warm.empty()) warm.apply(m, ro.lp);
       }

@@ -2,6 +2,8 @@
 // Which first LP of a refined level may stop as diverging (SolverParams::stop_on_divergence),
 // kept apart from the level loop so that the rules are tested on their own.
 
+#include <limits>
+
 namespace shapematch::detail {
 
 struct FirstLpState {
@@ -33,6 +35,18 @@ inline bool watch_divergence(const FirstLpState& s) { return watchable(s) && s.w
 // after 45 minutes; at 4.9 iterations a second on one core, 10⁶ is 57 hours).
 inline bool watch_patiently(const FirstLpState& s) {
   return watchable(s) && !watch_divergence(s) && (s.widenings_left || s.ring_left);
+}
+
+// The certified bound past which a watched first LP stops too (SolverParams::divergence_bound):
+// `factor` times the coarser level's energy (CoarseToFineOptions::divergence_bound_factor), only
+// while a ring is left to widen to. Its stop may come on a feasible LP (one whose optimum lies
+// that high, e.g. in a space already full); with a ring left every stop ends in more rings, and
+// at the last one the LP runs on to its end. Measured at test scale (the finger pair under a
+// factor of 10⁻⁶, any positive bound): stopped at the last ring too, it widened a full space 36
+// faces at a time until the level failed. +∞: no such bound.
+inline double divergence_bound(const FirstLpState& s, double factor, double coarser_energy) {
+  if (!(factor > 0.0) || !(coarser_energy > 0.0) || !s.ring_left) return std::numeric_limits<double>::infinity();
+  return factor * coarser_energy;
 }
 
 // Whether a level still trusts the watch: after `limit` widenings in a row on suspicions
