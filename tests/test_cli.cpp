@@ -325,7 +325,7 @@ TEST_CASE("cli: match writes a verified, complete output directory, or nothing")
   // itself is tested in test_rounding).
   const fs::path closed = out.string() + "_pockets";
   r = run("match --faces 30 --backend cpu --close-pockets --max-rounds 9 --feasibility-skip-row 0.05 "
-          "--feasibility-skip-below 64 --max-ring 4 --suspicion-margins 3 --recurring-beyond 2 --suspicion-margin-around named -o " +
+          "--feasibility-skip-below 64 --max-ring 4 --suspicion-margins 3 --recurring-beyond 2 --suspicion-margin-around named --divergence-bound-factor 1.5 -o " +
           closed.string());
   REQUIRE(r.code == 0);
   std::ifstream fc(closed / "report.json");
@@ -339,6 +339,7 @@ TEST_CASE("cli: match writes a verified, complete output directory, or nothing")
   CHECK(json_number(with, "suspicion_margins") == 3);
   CHECK(json_number(with, "recurring_beyond") == 2);
   CHECK(json_string(with, "suspicion_margin_around") == "named");
+  CHECK(json_number(with, "divergence_bound_factor") == 1.5);
   CHECK(json_number(with, "pockets_closed") >= 0);
   CHECK(with.find("\"verified\": true") != std::string::npos);
   fs::remove_all(closed);
@@ -442,6 +443,7 @@ TEST_CASE("cli: match --checkpoint goes on after the levels a stopped run finish
   CHECK(json_number(first, "suspicion_margins") == 1);              // the default
   CHECK(json_number(first, "recurring_beyond") == 3);               // the default
   CHECK(json_string(first, "suspicion_margin_around") == "widened");  // the default
+  CHECK(json_number(first, "divergence_bound_factor") == 2);          // the default
   CHECK(json_number(first, "lp_checkpoint_seconds") == 600);          // the default
   CHECK(json_number(first, "max_suspected_widenings") == 1);        // the default
   CHECK(first.find("\"stuck_restarts\": 1") != std::string::npos);
@@ -460,6 +462,10 @@ TEST_CASE("cli: match --checkpoint goes on after the levels a stopped run finish
   r = run("match " + dolphin + " " + swimming + " --lp-checkpoint-seconds -1 -o " + (tmp.path / "d").string());
   CHECK(r.code != 0);
   CHECK(r.err.find("--lp-checkpoint-seconds") != std::string::npos);
+  CHECK_FALSE(fs::exists(tmp.path / "d"));
+  r = run("match " + dolphin + " " + swimming + " --divergence-bound-factor -1 -o " + (tmp.path / "d").string());
+  CHECK(r.code != 0);
+  CHECK(r.err.find("--divergence-bound-factor") != std::string::npos);
   CHECK_FALSE(fs::exists(tmp.path / "d"));
   r = run("match " + dolphin + " " + swimming + " --suspicion-margin-around all -o " + (tmp.path / "d").string());
   CHECK(r.code != 0);
