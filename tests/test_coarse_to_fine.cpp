@@ -2370,3 +2370,69 @@ TEST_CASE("coarse to fine: watched first LPs stop where their bound passes the f
   CHECK(default_widenings == off_widenings);
   CHECK(default_energy == off_energy);
 }
+
+TEST_CASE("coarse to fine: a rounding's round under way is saved as its warm start, and a run goes on from there") {
+  // lp_checkpoint_seconds (here at every residual check): besides the checkpoint after round k,
+  // saves inside round k + 1 with the same decisions and that round's iterate so far as the warm
+  // start; a run gone on from the last of them redoes less of round k + 1 than from round k's.
+  CoarseToFineOptions o = slow_finest_rounding();
+  o.lookahead_levels = 0;
+  o.rounding.alternative_thresholds = {};
+  o.rounding_checkpoint_seconds = 0.0;
+  o.rounding.later_feasibility_iterations = 0;  // (the costed solves alone: what a save shortens)
+  o.rounding.exact_below = 0;                   // (every round on PDHG, which saves)
+  o.rounding.search_below = 0;
+  o.lp_checkpoint_seconds = 1e-9;
+  const CoarseToFineMatcher matcher(fine_fingers().first, fine_fingers().second, o);
+  const int levels = matcher.x_levels().size();
+  std::vector<LevelCheckpoint> inside;  // the finest level's rounding checkpoints, in order
+  const CoarseToFineResult whole = matcher.run({}, nullptr, [&](const LevelCheckpoint& c) {
+    if (!c.attempt.rounding.empty() && int(c.levels.size()) == levels - 1) inside.push_back(c);
+  });
+  REQUIRE_FALSE(inside.empty());
+  // The last round k with saves inside round k + 1: the first save of k is after it, the last inside.
+  const LevelCheckpoint *after = nullptr, *under_way = nullptr;
+  for (size_t i = 1; i < inside.size(); ++i) {
+    const auto &a = inside[i - 1].attempt, &b = inside[i].attempt;
+    if (a.widenings() != b.widenings() || a.rounding.rounds != b.rounding.rounds) continue;
+    CHECK(b.rounding.ones == a.rounding.ones);  // the same decisions
+    CHECK(b.rounding.iterations == a.rounding.iterations);
+    CHECK_FALSE(b.rounding.warm.empty());
+    under_way = &inside[i];
+    size_t first = i - 1;
+    while (first > 0 && inside[first - 1].attempt.rounding.rounds == a.rounding.rounds &&
+           inside[first - 1].attempt.widenings() == a.widenings())
+      --first;
+    after = &inside[first];
+  }
+  REQUIRE(under_way != nullptr);
+  auto first_round = [&](const LevelCheckpoint& from, int64_t& iterations) {
+    test::TempDir tmp;
+    const std::string file = (tmp.path / "c.ckpt").string();
+    save_checkpoint(file, from);
+    const LevelCheckpoint loaded = load_checkpoint(file);
+    REQUIRE_FALSE(loaded.attempt.rounding.warm.empty());
+    iterations = -1;
+    const CoarseToFineResult r = matcher.run([&](const LevelReport& l, const RoundingRound& q) {
+      if (l.level == levels - 1 && iterations < 0) iterations = q.iterations;
+    }, &loaded);
+    // (Theorem 1's conditions; on this pair at ring 0 with every round on PDHG the whole run's Γ
+    // is not continuous either.)
+    CHECK(satisfies_exactly(r.finest.lp, r.rounding.gamma));
+    const GraphSurfaceCheck g = check_graph_surface(r.finest.space, r.rounding.gamma);
+    CHECK(g.covers_x);
+    CHECK(g.covers_y);
+    CHECK(g.orientation);
+    for (int64_t j : from.attempt.rounding.ones)
+      CHECK(std::binary_search(r.rounding.gamma.begin(), r.rounding.gamma.end(), j));
+  };
+  int64_t from_after = 0, from_inside = 0;
+  first_round(*after, from_after);
+  first_round(*under_way, from_inside);
+  MESSAGE("round " << after->attempt.rounding.rounds + 1 << " gone on from the checkpoint after round "
+                   << after->attempt.rounding.rounds << ": " << from_after << " iterations; from its last save inside: "
+                   << from_inside);
+  CHECK(from_inside < from_after);
+  // At the default cadence (600 s) a test-sized rounding saves only after its rounds.
+  CHECK(CoarseToFineOptions{}.lp_checkpoint_seconds == 600.0);
+}

@@ -189,6 +189,76 @@ TEST_CASE("rounding: after each round it hands out its decisions, and a rounding
   CHECK(w.rounds.front().iterations <= g.rounds.front().iterations);
 }
 
+TEST_CASE("rounding: a round's LP under way is snapshot as the next warm start, and a rounding goes on from it") {
+  // Threshold 0 on the dolphins at 60 faces: several rounds on PDHG. Snapshots at every residual
+  // check of the rounds from fixings (not round 1, which first_snapshot covers), each the point
+  // the round would hand `decided` were it to end there.
+  const MatchingLp& m = dolphin_ball_60();
+  RoundingOptions o;
+  o.solver = "pdhg-cpu";
+  o.exact_below = 0;  // (every round on PDHG)
+  o.search_below = 0;
+  o.alternative_thresholds = {};
+  o.close_pockets = false;
+  o.later_feasibility_iterations = 0;  // (the costed solves alone: what a snapshot shortens)
+  struct Decided {
+    std::vector<int64_t> ones;
+    std::vector<int32_t> steps;
+    std::vector<double> x, y;
+  };
+  std::vector<Decided> decided;
+  struct Snap {
+    size_t after;  // decided calls before it: it is inside round after + 1
+    std::vector<double> x, y;
+  };
+  std::vector<Snap> snaps;
+  o.decided = [&](const RoundingRound&, const std::vector<int64_t>& ones, const std::vector<int32_t>& steps, double,
+                  const std::vector<double>& x, const std::vector<double>& y) { decided.push_back({ones, steps, x, y}); };
+  o.snapshot_seconds = 1e-9;  // (at every residual check)
+  o.round_snapshot = [&](const std::vector<double>& x, const std::vector<double>& y) {
+    snaps.push_back({decided.size(), x, y});
+  };
+  const RoundingResult r = round_to_graph_surface(m.space, m.lp, m.energy, o);
+  REQUIRE(r.rounds.size() >= 2);
+  REQUIRE_FALSE(snaps.empty());
+  for (const Snap& s : snaps) {
+    CHECK(s.after >= 1);  // none in round 1
+    CHECK(s.x.size() == size_t(m.lp.cols()));
+    CHECK(s.y.size() == size_t(m.lp.rows()));
+  }
+  // The longest later round with snapshots; its last snapshot against the round before's iterate.
+  size_t round = 0;  // index into r.rounds
+  for (const Snap& s : snaps)
+    if (round == 0 || r.rounds[s.after].iterations > r.rounds[round].iterations) round = s.after;
+  const Snap* last = nullptr;
+  for (const Snap& s : snaps)
+    if (s.after == round) last = &s;
+  REQUIRE(last != nullptr);
+  RoundingOptions from = o;
+  from.decided = {};
+  from.round_snapshot = {};
+  from.start_ones = decided[round - 1].ones;
+  from.start_steps = decided[round - 1].steps;
+  from.lp.initial_x = decided[round - 1].x;
+  from.lp.initial_y = decided[round - 1].y;
+  const RoundingResult before = round_to_graph_surface(m.space, m.lp, m.energy, from);
+  from.lp.initial_x = last->x;
+  from.lp.initial_y = last->y;
+  const RoundingResult inside = round_to_graph_surface(m.space, m.lp, m.energy, from);
+  MESSAGE("round " << round + 1 << ": " << r.rounds[round].iterations << " iterations; gone on from the round before's "
+                   << "iterate " << before.rounds.front().iterations << ", from its last snapshot "
+                   << inside.rounds.front().iterations);
+  CHECK(inside.rounds.front().iterations < before.rounds.front().iterations);
+  CHECK(satisfies_exactly(m.lp, inside.gamma));
+  CHECK(check_graph_surface(m.space, inside.gamma).ok());
+  for (int64_t j : decided[round - 1].ones) CHECK(std::binary_search(inside.gamma.begin(), inside.gamma.end(), j));
+  // Without snapshot_seconds: never called.
+  o.snapshot_seconds = 0.0;
+  snaps.clear();
+  round_to_graph_surface(m.space, m.lp, m.energy, o);
+  CHECK(snaps.empty());
+}
+
 TEST_CASE("rounding: a rounding gone on from decisions with their steps keeps the steps apart") {
   // The dolphin and the bumpy ball round in several rounds (see the budget test). Gone on from
   // the decisions before the last round, with their steps: those stay apart in the undo history,

@@ -1549,11 +1549,21 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
       iterations_so_far = going_on ? going_on->iterations : from_solving ? solving_done : 0;
       Stopwatch since_saved;
       double last_save_seconds = 0.0;  // how long the last rounding checkpoint took
+      // The decisions as of the last round (or the checkpoint gone on from), for the saves inside a
+      // round (round_snapshot below).
+      std::vector<int64_t> last_ones = going_on ? going_on->ones : std::vector<int64_t>{};
+      std::vector<int32_t> last_steps = going_on ? going_on->steps : std::vector<int32_t>{};
+      double last_cap = going_on ? going_on->cap_scale : 1.0;
+      bool decisions_known = going_on != nullptr;
       if (tracking)
         ro.decided = [&](const RoundingRound& r, const std::vector<int64_t>& ones, const std::vector<int32_t>& steps,
                          double bound, const std::vector<double>& x, const std::vector<double>& y) {
           iterations_so_far += r.iterations;
           rounds_so_far = (going_on ? going_on->rounds : 0) + r.round;
+          last_ones = ones;
+          last_steps = steps;
+          last_cap = r.cap_scale;
+          decisions_known = true;
           if (r.round == 1 && !going_on) first_bound = bound;
           // At most every rounding_checkpoint_seconds, and (where that is not 0) at most a twentieth
           // of the time on saves: with the warm start below one takes seconds at full resolution
@@ -1607,6 +1617,26 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
             attempted(std::move(a));
           } catch (const IoError& e) {  // (the solve goes on; the last checkpoint stands)
             spdlog::warn("level {}: its first LP's checkpoint was not saved: {}", l + 1, e.what());
+          }
+        };
+      }
+      // A round's LP under way saved as the warm start of the checkpoint after the round before it,
+      // every lp_checkpoint_seconds: at full resolution a later round's LP takes up to an hour and
+      // a half on one core (TOSCA_r david0-david6 without WKS, level 6: a 4.8 M × 14.4 M part, 6 144
+      // iterations at zero cost and over 5 632 costed, seventy-eighth session), and a run gone on
+      // from the round before's checkpoint started that round over.
+      if (tracking && attempted && options_.lp_checkpoint_seconds > 0.0) {
+        ro.snapshot_seconds = options_.lp_checkpoint_seconds;
+        ro.round_snapshot = [&](const std::vector<double>& x, const std::vector<double>& y) {
+          if (!decisions_known) return;
+          LevelAttempt a = current_attempt();
+          a.rounding = rounding_now(last_ones, last_steps, last_cap);
+          a.rounding.warm.keep(m, x, y);
+          spdlog::debug("level {}: round {}'s LP so far saved as its warm start", l + 1, rounds_so_far + 1);
+          try {
+            attempted(std::move(a));
+          } catch (const IoError& e) {  // (the rounding goes on; the last checkpoint stands)
+            spdlog::warn("level {}: its rounding's checkpoint was not saved: {}", l + 1, e.what());
           }
         };
       }

@@ -400,6 +400,10 @@ JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpS
   // A part's parameters: `params` with its own slice of the whole LP's warm start, which is
   // moved out first so that copying `params` per part does not copy it.
   std::vector<double> warm_x, warm_y;
+  // params.snapshot is the whole LP's: a part's solve calls it with its own iterate in the point
+  // the round would leave were it to end there (part_snapshot below).
+  std::function<void(const SolveSnapshot&)> whole_snapshot = std::move(params.snapshot);
+  params.snapshot = {};
   if (!whole) {
     warm_x = std::move(params.initial_x);
     warm_y = std::move(params.initial_y);
@@ -421,7 +425,7 @@ JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpS
   std::vector<int64_t> pretested(parts.size(), 0);  // iterations, added to the part's costed solve
   // Part k's first-order parameters: `params` with the part's slice of the warm start (in `own`;
   // `params` itself for the whole LP) and its ω.
-  const auto first_order_params = [&](size_t k, SolverParams& own) -> const SolverParams& {
+  const auto first_order_params = [&](size_t k, SolverParams& own) -> SolverParams& {
     const double w = weighted ? part_weight(*warm_weight, parts[k].cols) : 0.0;
     if (whole) {
       if (w > 0.0) params.initial_primal_weight = w;
@@ -539,11 +543,27 @@ JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpS
     // The first-order solver's parameters: `params` with the part's slice of the warm start (made
     // only where that solver runs).
     SolverParams own;
-    auto first_order = [&]() -> const SolverParams& { return first_order_params(k, own); };
+    auto first_order = [&]() -> SolverParams& { return first_order_params(k, own); };
     double asked = 0.0;  // the ω this part's first-order solve was asked to start from
+    // Part k's iterate in the whole LP's point: the parts before it as they ended, those after it
+    // as they start (the warm start, or 0).
+    const auto part_snapshot = [&, k](const SolveSnapshot& at) {
+      if (whole) return whole_snapshot(at);
+      SolveSnapshot w = at;
+      w.x = warm_x.empty() ? std::vector<double>(lp.cols(), 0.0) : warm_x;
+      w.y = warm_y.empty() ? std::vector<double>(lp.rows(), 0.0) : warm_y;
+      for (size_t q = 0; q < k; ++q) {
+        for (int64_t j : parts[q].cols) w.x[j] = r.x[j];
+        for (int64_t i : parts[q].rows) w.y[i] = r.y[i];
+      }
+      for (size_t j = 0; j < parts[k].cols.size() && j < at.x.size(); ++j) w.x[parts[k].cols[j]] = at.x[j];
+      for (size_t i = 0; i < parts[k].rows.size() && i < at.y.size(); ++i) w.y[parts[k].rows[i]] = at.y[i];
+      whole_snapshot(w);
+    };
     auto first_order_solve = [&]() {
-      const SolverParams& p = first_order();
+      SolverParams& p = first_order();
       asked = p.initial_primal_weight;
+      if (whole_snapshot) p.snapshot = part_snapshot;  // (the costed solve only: not the pre-test)
       LpResult costed;
       if (!quick[k]) {
         costed = solver.solve(plp, p);
@@ -564,6 +584,7 @@ JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpS
         costed.seconds += q.seconds;
       }
       quick[k].reset();
+      p.snapshot = {};  // (it refers to this part)
       costed.iterations += pretested[k];
       return costed;
     };
@@ -1803,6 +1824,11 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
         warm_weight.resize(red.cols.size());
         for (size_t j = 0; j < red.cols.size(); ++j) warm_weight[j] = w_full[red.cols[j]];
       }
+      // The round's iterate so far as the next round's warm start, for a checkpoint (round_snapshot).
+      if (options.round_snapshot && options.snapshot_seconds > 0.0) {
+        params.snapshot_seconds = options.snapshot_seconds;
+        params.snapshot = [&](const SolveSnapshot& s) { options.round_snapshot(full_x(s.x), full_y(s.y)); };
+      }
       joined = detail::solve_in_parts(red.lp, std::move(params), *solver, exact ? exact_solver.get() : nullptr,
                               options.exact_below, exact_params, options.split_parts,
                               {options.exact_pivots_per_column, options.exact_part_seconds}, &exact_cache, &warm_weight, options.slow_part,
@@ -2108,6 +2134,7 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
     alt.probe = {};
     alt.probe_tolerance = 0.0;
     alt.first_snapshot = {};
+    alt.round_snapshot = {};
     alt.resumed_iterations = 0;  // (its round 1 is that optimum's)
     alt.resumed_seconds = 0.0;
     alt.first_max_iterations = 0;

@@ -322,6 +322,13 @@ struct RoundingOptions {
   // off), for a checkpoint that a later run starts that LP from (SolverParams::snapshot).
   std::function<void(const SolveSnapshot& whole, bool watched)> first_snapshot;
   double snapshot_seconds = 0.0;
+  // Where set and snapshot_seconds > 0: called every snapshot_seconds at most during each round
+  // from fixings (a later round, or round 1 from start_ones), in its parts' costed first-order
+  // solves (not their pre-tests), with the next round's warm start as it would be were the round
+  // to end there, over the whole LP as `decided`'s (the parts solved so far as they ended, the one
+  // under way where it is, the others as they started): for a checkpoint beside the last `decided`
+  // one, so that a later run starts that round there rather than from the round before's iterate.
+  std::function<void(const std::vector<double>& x, const std::vector<double>& y)> round_snapshot;
   // Round 1's LP goes on from such a snapshot (its warm start in `lp`) after these: they count in
   // round 1's iterations and seconds wherever those scale the later rounds (where reference_*
   // are not given) and in its snapshots.
