@@ -980,7 +980,7 @@ Action add_match_command(CLI::App& app) {
       ->capture_default_str();
   app.add_option("--divergence-bound-factor", a->divergence_bound_factor,
                  "a watched first LP of a refined level also stops as diverging where its dual proves its optimum "
-                 "above this many times the coarser level's energy (0: off)")
+                 "above this many times the coarser level's energy, while a ring is left to widen to (0: off)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   app.add_option("--zero-cost-proof-rings", a->zero_cost_proof_rings,

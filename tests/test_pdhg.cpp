@@ -672,10 +672,19 @@ TEST_CASE("pdhg-cpu: a watched LP whose certified bound passes divergence_bound 
     CHECK(stopped.status == LpStatus::Diverging);
     CHECK(stopped.iterations < whole.iterations);
     CHECK(stopped.iterations % 512 == 0);
+    CHECK(stopped.iterations >= 1024);  // cold: not at the first window (its "growth" is the whole dual)
     CHECK(stopped.lower_bound > params.divergence_bound);
     CHECK(stopped.lower_bound <= whole.objective + 1e-6 * (1.0 + std::abs(whole.objective)));
     REQUIRE(stopped.last_y.size() == size_t(p.rows()));
     CHECK(certified_lower_bound(p, stopped.last_y) > params.divergence_bound);
+    {  // From a warm start's dual that proves it already: at the first window.
+      SolverParams warm = params;
+      warm.initial_y = whole.y;
+      const LpResult first = solve_lp(p, solver, warm);
+      CHECK(first.status == LpStatus::Diverging);
+      CHECK(first.iterations == 512);
+      CHECK(first.lower_bound > warm.divergence_bound);
+    }
     // Above the optimum no dual gets there: the same solve, iteration for iteration.
     params.divergence_bound = whole.objective + 0.05 * (1.0 + std::abs(whole.objective));
     const LpResult above = solve_lp(p, solver, params);

@@ -1429,6 +1429,55 @@ public:
 };
 }  // namespace
 
+TEST_CASE("rounding: a snapshot of a part under way is the whole LP's point: parts done as they ended, later ones as they start") {
+  // Two independent copies of the octahedron's matching LP (the second with other costs), solved
+  // in parts from a flat warm start, a snapshot at every residual check.
+  const Mesh x = shapes::octahedron();
+  const Mesh y = test::deformed(x, [](const Eigen::Vector3d& p) { return Eigen::Vector3d(1.2 * p.x(), p.y(), 0.9 * p.z()); });
+  const MatchingLp m = build_matching_lp(x, compute_geometry(x), y, compute_geometry(y));
+  const int64_t n = m.lp.cols(), rows = m.lp.rows();
+  std::vector<std::vector<int>> dense(2 * rows, std::vector<int>(2 * n, 0));
+  for (int64_t i = 0; i < rows; ++i)
+    for (uint32_t k = m.lp.a.row_ptr[i]; k < m.lp.a.row_ptr[i + 1]; ++k) {
+      const int v = is_negative(m.lp.a.entry[k]) ? -1 : 1;
+      dense[i][col_of(m.lp.a.entry[k])] = v;
+      dense[rows + i][n + col_of(m.lp.a.entry[k])] = v;
+    }
+  std::vector<double> b = m.lp.b, c = m.lp.c;
+  b.insert(b.end(), m.lp.b.begin(), m.lp.b.end());
+  for (int64_t j = 0; j < n; ++j) c.push_back(1.3 * m.lp.c[j] + 0.01);
+  const LpProblem two = test::dense_lp(dense, b, c);
+  SolverParams params;
+  params.tolerance = 1e-6;
+  params.initial_x.assign(2 * n, 0.25);
+  params.initial_y.assign(2 * rows, 0.0);
+  params.snapshot_seconds = 1e-9;
+  std::vector<SolveSnapshot> seen;
+  params.snapshot = [&](const SolveSnapshot& s) { seen.push_back(s); };
+  const auto pdhg = make_solver("pdhg-cpu");
+  const detail::JoinedSolve j = detail::solve_in_parts(two, params, *pdhg, nullptr, 0, params, true);
+  REQUIRE(j.parts == 2);
+  REQUIRE(j.r.status == LpStatus::Optimal);
+  REQUIRE(seen.size() >= 2);
+  // Block k of a snapshot's x equals `v`'s block k.
+  auto block_is = [&](const std::vector<double>& s, int k, const std::vector<double>& v) {
+    return std::equal(s.begin() + k * n, s.begin() + (k + 1) * n, v.begin() + k * n);
+  };
+  for (const SolveSnapshot& s : seen) {
+    REQUIRE(s.x.size() == size_t(2 * n));
+    REQUIRE(s.y.size() == size_t(2 * rows));
+  }
+  // The first: the part under way, the other as it starts; the last: the first part as it ended.
+  const SolveSnapshot &first = seen.front(), &last = seen.back();
+  const int later = block_is(first.x, 0, params.initial_x) ? 0 : 1;  // solved second
+  CHECK(block_is(first.x, later, params.initial_x));
+  CHECK_FALSE(block_is(first.x, 1 - later, params.initial_x));
+  CHECK(block_is(last.x, 1 - later, j.r.x));
+  CHECK_FALSE(block_is(last.x, later, params.initial_x));
+  CHECK(std::equal(last.y.begin() + (1 - later) * rows, last.y.begin() + (2 - later) * rows,
+                   j.r.y.begin() + (1 - later) * rows));
+}
+
 TEST_CASE("rounding: a part one solver gives up on goes to the other") {
   const Mesh x = shapes::octahedron();
   const Mesh y = test::deformed(x, [](const Eigen::Vector3d& p) { return Eigen::Vector3d(1.2 * p.x(), p.y(), 0.9 * p.z()); });

@@ -1629,6 +1629,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
         ro.snapshot_seconds = options_.lp_checkpoint_seconds;
         ro.round_snapshot = [&](const std::vector<double>& x, const std::vector<double>& y) {
           if (!decisions_known) return;
+          Stopwatch saving;
           LevelAttempt a = current_attempt();
           a.rounding = rounding_now(last_ones, last_steps, last_cap);
           a.rounding.warm.keep(m, x, y);
@@ -1638,6 +1639,8 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
           } catch (const IoError& e) {  // (the rounding goes on; the last checkpoint stands)
             spdlog::warn("level {}: its rounding's checkpoint was not saved: {}", l + 1, e.what());
           }
+          last_save_seconds = saving.seconds();  // (counts in the rounding checkpoints' throttle)
+          since_saved.reset();
         };
       }
       // Where rounding gets stuck, widen around it (as for an infeasible LP) and solve again.

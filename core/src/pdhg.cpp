@@ -162,10 +162,11 @@ LpResult PdhgSolver::solve(const LpProblem& problem, const SolverParams& params)
   // the growth returned as the ray.
   detail::DivergenceWatch watch(params.tolerance, params.patient_divergence_watch);
   int64_t window_end = detail::DivergenceWatch::kWindow;
-  // (From the start: a bound past params.divergence_bound may stop the first window, its growth
-  // from the starting dual; the watch's own rules wait for a second.)
+  // (From a warm start's dual: a bound past params.divergence_bound may stop the first window, its
+  // growth a change of a given dual. From a cold start the first window's "growth" would be the
+  // whole dual, its ordinary duals included: it waits for a second, as the watch's own rules do.)
   std::vector<double> window_y;
-  if (params.stop_on_divergence) window_y = y0;
+  if (params.stop_on_divergence && !params.initial_y.empty()) window_y = y0;
   int restarts = 0;
   Stopwatch since_snapshot;
   result.status = LpStatus::IterationLimit;
@@ -244,7 +245,7 @@ LpResult PdhgSolver::solve(const LpProblem& problem, const SolverParams& params)
         for (int64_t i = 0; i < m; ++i) y[i] = r[i] * yh[i];
         certified = certified_lower_bound(problem, y);
       }
-      const bool bounded = certified > params.divergence_bound;
+      const bool bounded = certified > params.divergence_bound && !window_y.empty();
       const bool diverging = watched || bounded;
       const bool debug = !window_y.empty() && spdlog::should_log(spdlog::level::debug);
       std::vector<double> ray;  // the window's dual growth: about a Farkas ray where the LP is infeasible

@@ -404,6 +404,8 @@ JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpS
   // the round would leave were it to end there (part_snapshot below).
   std::function<void(const SolveSnapshot&)> whole_snapshot = std::move(params.snapshot);
   params.snapshot = {};
+  const double every = params.snapshot_seconds;
+  Stopwatch since_saved;
   if (!whole) {
     warm_x = std::move(params.initial_x);
     warm_y = std::move(params.initial_y);
@@ -548,8 +550,14 @@ JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpS
     // Part k's iterate in the whole LP's point: the parts before it as they ended, those after it
     // as they start (the warm start, or 0).
     const auto part_snapshot = [&, k](const SolveSnapshot& at) {
+      // (Not once a part failed: its zeros would stand in the point, and the round is undone.)
+      if (infeasible || out.suspect || since_saved.seconds() < every) return;
+      since_saved.reset();
       if (whole) return whole_snapshot(at);
-      SolveSnapshot w = at;
+      SolveSnapshot w;
+      w.primal_weight = at.primal_weight;
+      w.iterations = at.iterations;
+      w.seconds = at.seconds;
       w.x = warm_x.empty() ? std::vector<double>(lp.cols(), 0.0) : warm_x;
       w.y = warm_y.empty() ? std::vector<double>(lp.rows(), 0.0) : warm_y;
       for (size_t q = 0; q < k; ++q) {
@@ -563,7 +571,12 @@ JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpS
     auto first_order_solve = [&]() {
       SolverParams& p = first_order();
       asked = p.initial_primal_weight;
-      if (whole_snapshot) p.snapshot = part_snapshot;  // (the costed solve only: not the pre-test)
+      if (whole_snapshot) {  // (the costed solve only: not the pre-test)
+        p.snapshot = part_snapshot;
+        // At most every `every` seconds over the round (part_snapshot): parts each shorter than
+        // that still save where the round is longer.
+        p.snapshot_seconds = std::max(every - since_saved.seconds(), 0.1 * every);
+      }
       LpResult costed;
       if (!quick[k]) {
         costed = solver.solve(plp, p);
@@ -1794,6 +1807,8 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
         params.snapshot_seconds = options.snapshot_seconds;
         params.snapshot = snapshot;
       }
+      // The divergence bound is the whole LP's: this one leaves out what propagation fixed to 1.
+      if (std::isfinite(params.divergence_bound)) params.divergence_bound -= lp.objective_scale * red.fixed_cost;
       if (options.probe && options.probe_tolerance > params.tolerance) {
         SolverParams loose = params;
         loose.tolerance = options.probe_tolerance;
@@ -1899,7 +1914,9 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
     }
 
     if (r.status == LpStatus::Diverging)  // only asked for in round 1 (above)
-      throw InfeasibleError("rounding: the matching LP is probably infeasible (PDHG diverging)",
+      throw InfeasibleError(r.lower_bound + lp.objective_scale * red.fixed_cost > options.lp.divergence_bound
+                                ? "rounding: the matching LP's optimum lies above its divergence bound (PDHG)"
+                                : "rounding: the matching LP is probably infeasible (PDHG diverging)",
                             certificate_rows(r.y, red.rows), false);
     // A later round (or part of one) at its cap whose certified bound lies well above its own
     // objective behaves like an infeasible LP (its dual grows along a Farkas ray; the proof takes

@@ -181,7 +181,9 @@ struct CoarseToFineOptions {
   // WKS, level 2 from 1). The watch's own rules let a plainly infeasible LP climb for eight windows:
   // TOSCA_r david0-david6 without WKS, `--suspicion-margin-around named`, level 6: its bound 7.0
   // against an objective of 3.19 and a coarser energy of 3.04, residual flat at 1.06e-2, ω 1 580,
-  // after 45 minutes on one core (seventy-eighth session). 0: off.
+  // after 45 minutes on one core (seventy-eighth session). Only while a ring is left
+  // (detail::divergence_bound says why); the bound is the whole LP's, what propagation fixed
+  // included. 0: off.
   double divergence_bound_factor = 2.0;
   // Where the zero-cost pre-test (RoundingOptions::feasibility_iterations) proves a level's first
   // LP infeasible for the first time at its ring, every X face within this many fine rings of the
@@ -382,7 +384,9 @@ struct CoarseToFineOptions {
   // an LP runs 30-60 minutes (TOSCA_r david0-david6 without WKS, level 6: 7 296 iterations in
   // 3 731 s, seventy-seventh session), and every stop inside it lost all of it. Each save writes
   // the iterate (about 16 bytes per nonzero primal value and per closedness row: some hundred MB
-  // at 30 M variables, a few seconds). 0: never.
+  // at 30 M variables, a few seconds). As often inside a rounding's rounds from fixings (their
+  // costed solves), the checkpoint after the round before is saved again with the round's iterate
+  // so far as its warm start (RoundingOptions::round_snapshot). 0: never.
   double lp_checkpoint_seconds = 600.0;
 };
 
@@ -545,8 +549,9 @@ struct LevelAttempt {
     double reference_seconds = 0.0;  // round 1's cold solve (RoundingOptions::reference_*)
     int64_t reference_iterations = 0;
     double cap_scale = 1.0;          // RoundingOptions::start_cap_scale (version 12; before: 1)
-    // The next round's warm start (RoundingOptions::decided), which the run gone on from here
-    // starts its round 1 from (version 14, where lp_checkpoint_seconds > 0; empty: cold).
+    // The next round's warm start (RoundingOptions::decided; saved inside that round, its iterate
+    // so far: round_snapshot), which the run gone on from here starts its round 1 from (version
+    // 14, where lp_checkpoint_seconds > 0; empty: cold).
     CarriedIterate warm;
     bool empty() const { return rounds == 0; }
     // How many steps its fixings form (one where `steps` is empty, none without fixings).

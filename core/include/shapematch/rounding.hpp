@@ -324,7 +324,8 @@ struct RoundingOptions {
   double snapshot_seconds = 0.0;
   // Where set and snapshot_seconds > 0: called every snapshot_seconds at most during each round
   // from fixings (a later round, or round 1 from start_ones), in its parts' costed first-order
-  // solves (not their pre-tests), with the next round's warm start as it would be were the round
+  // solves (not their pre-tests, nor the short first solves that may skip one), until a part
+  // fails, with the next round's warm start as it would be were the round
   // to end there, over the whole LP as `decided`'s (the parts solved so far as they ended, the one
   // under way where it is, the others as they started): for a checkpoint beside the last `decided`
   // one, so that a later run starts that round there rather than from the round before's iterate.
