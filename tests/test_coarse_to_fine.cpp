@@ -2398,6 +2398,7 @@ TEST_CASE("coarse to fine: a rounding's round under way is saved as its warm sta
     CHECK(b.rounding.ones == a.rounding.ones);  // the same decisions
     CHECK(b.rounding.iterations == a.rounding.iterations);
     CHECK_FALSE(b.rounding.warm.empty());
+    CHECK(b.rounding.warm.primal_weight() > 0.0);  // the part under way's ω
     under_way = &inside[i];
     size_t first = i - 1;
     while (first > 0 && inside[first - 1].attempt.rounding.rounds == a.rounding.rounds &&

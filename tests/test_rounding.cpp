@@ -215,7 +215,8 @@ TEST_CASE("rounding: a round's LP under way is snapshot as the next warm start, 
   o.decided = [&](const RoundingRound&, const std::vector<int64_t>& ones, const std::vector<int32_t>& steps, double,
                   const std::vector<double>& x, const std::vector<double>& y) { decided.push_back({ones, steps, x, y}); };
   o.snapshot_seconds = 1e-9;  // (at every residual check)
-  o.round_snapshot = [&](const std::vector<double>& x, const std::vector<double>& y) {
+  o.round_snapshot = [&](const std::vector<double>& x, const std::vector<double>& y, double omega) {
+    CHECK(omega > 0.0);
     snaps.push_back({decided.size(), x, y});
   };
   const RoundingResult r = round_to_graph_surface(m.space, m.lp, m.energy, o);

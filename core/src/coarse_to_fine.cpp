@@ -1627,12 +1627,12 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
       // from the round before's checkpoint started that round over.
       if (tracking && attempted && options_.lp_checkpoint_seconds > 0.0) {
         ro.snapshot_seconds = options_.lp_checkpoint_seconds;
-        ro.round_snapshot = [&](const std::vector<double>& x, const std::vector<double>& y) {
+        ro.round_snapshot = [&](const std::vector<double>& x, const std::vector<double>& y, double omega) {
           if (!decisions_known) return;
           Stopwatch saving;
           LevelAttempt a = current_attempt();
           a.rounding = rounding_now(last_ones, last_steps, last_cap);
-          a.rounding.warm.keep(m, x, y);
+          a.rounding.warm.keep(m, x, y, omega);  // (the round goes on at that ω, not PDHG's first guess)
           spdlog::debug("level {}: round {}'s LP so far saved as its warm start", l + 1, rounds_so_far + 1);
           try {
             attempted(std::move(a));

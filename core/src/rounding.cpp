@@ -1842,7 +1842,9 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
       // The round's iterate so far as the next round's warm start, for a checkpoint (round_snapshot).
       if (options.round_snapshot && options.snapshot_seconds > 0.0) {
         params.snapshot_seconds = options.snapshot_seconds;
-        params.snapshot = [&](const SolveSnapshot& s) { options.round_snapshot(full_x(s.x), full_y(s.y)); };
+        params.snapshot = [&](const SolveSnapshot& s) {
+          options.round_snapshot(full_x(s.x), full_y(s.y), s.primal_weight);
+        };
       }
       joined = detail::solve_in_parts(red.lp, std::move(params), *solver, exact ? exact_solver.get() : nullptr,
                               options.exact_below, exact_params, options.split_parts,

@@ -329,7 +329,8 @@ struct RoundingOptions {
   // to end there, over the whole LP as `decided`'s (the parts solved so far as they ended, the one
   // under way where it is, the others as they started): for a checkpoint beside the last `decided`
   // one, so that a later run starts that round there rather than from the round before's iterate.
-  std::function<void(const std::vector<double>& x, const std::vector<double>& y)> round_snapshot;
+  // (With the primal weight of the part under way.)
+  std::function<void(const std::vector<double>& x, const std::vector<double>& y, double primal_weight)> round_snapshot;
   // Round 1's LP goes on from such a snapshot (its warm start in `lp`) after these: they count in
   // round 1's iterations and seconds wherever those scale the later rounds (where reference_*
   // are not given) and in its snapshots.
