@@ -300,6 +300,14 @@ TEST_CASE("pdhg-cpu: a snapshot is a point the solve can start again from, near 
   seen.clear();
   solve_lp(m.lp, "pdhg-cpu", params);
   CHECK(seen.empty());
+  // The first call after its own wait (here none), then every snapshot_seconds (here never again).
+  params.snapshot_seconds = 1e9;
+  solve_lp(m.lp, "pdhg-cpu", params);
+  CHECK(seen.empty());
+  params.snapshot_first_seconds = 0.0;
+  solve_lp(m.lp, "pdhg-cpu", params);
+  REQUIRE(seen.size() == 1);
+  CHECK(seen.front().iterations == 64);  // (at the first residual check)
 }
 
 TEST_CASE("pdhg-cpu: the cold primal weight starts cold solves only; an explicit ω wins") {
@@ -672,7 +680,15 @@ TEST_CASE("pdhg-cpu: a watched LP whose certified bound passes divergence_bound 
     CHECK(stopped.status == LpStatus::Diverging);
     CHECK(stopped.iterations < whole.iterations);
     CHECK(stopped.iterations % 512 == 0);
-    CHECK(stopped.iterations >= 1024);  // cold: not at the first window (its "growth" is the whole dual)
+    {  // Cold, never at the first window (its "growth" would be the whole dual): a bound just under
+       // what the dual proves at 512 iterations stops it at 1 024 at the earliest.
+      SolverParams early = tight(1e-6);
+      early.max_iterations = 512;
+      const LpResult at512 = solve_lp(p, solver, early);
+      SolverParams cold = params;
+      cold.divergence_bound = certified_lower_bound(p, at512.y) - 1e-9;
+      CHECK(solve_lp(p, solver, cold).iterations >= 1024);
+    }
     CHECK(stopped.lower_bound > params.divergence_bound);
     CHECK(stopped.lower_bound <= whole.objective + 1e-6 * (1.0 + std::abs(whole.objective)));
     REQUIRE(stopped.last_y.size() == size_t(p.rows()));

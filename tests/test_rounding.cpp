@@ -1451,7 +1451,7 @@ TEST_CASE("rounding: a snapshot of a part under way is the whole LP's point: par
   SolverParams params;
   params.tolerance = 1e-6;
   params.initial_x.assign(2 * n, 0.25);
-  params.initial_y.assign(2 * rows, 0.0);
+  params.initial_y.assign(2 * rows, 0.125);
   params.snapshot_seconds = 1e-9;
   std::vector<SolveSnapshot> seen;
   params.snapshot = [&](const SolveSnapshot& s) { seen.push_back(s); };
@@ -1470,9 +1470,10 @@ TEST_CASE("rounding: a snapshot of a part under way is the whole LP's point: par
   }
   // The first: the part under way, the other as it starts; the last: the first part as it ended.
   const SolveSnapshot &first = seen.front(), &last = seen.back();
+  CHECK(block_is(first.x, 0, params.initial_x) != block_is(first.x, 1, params.initial_x));  // one at its start
   const int later = block_is(first.x, 0, params.initial_x) ? 0 : 1;  // solved second
-  CHECK(block_is(first.x, later, params.initial_x));
-  CHECK_FALSE(block_is(first.x, 1 - later, params.initial_x));
+  CHECK(std::all_of(first.y.begin() + later * rows, first.y.begin() + (later + 1) * rows,
+                    [](double v) { return v == 0.125; }));
   CHECK(block_is(last.x, 1 - later, j.r.x));
   CHECK_FALSE(block_is(last.x, later, params.initial_x));
   CHECK(std::equal(last.y.begin() + (1 - later) * rows, last.y.begin() + (2 - later) * rows,

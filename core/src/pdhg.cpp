@@ -169,6 +169,7 @@ LpResult PdhgSolver::solve(const LpProblem& problem, const SolverParams& params)
   if (params.stop_on_divergence && !params.initial_y.empty()) window_y = y0;
   int restarts = 0;
   Stopwatch since_snapshot;
+  int snapshots = 0;  // taken so far (params.snapshot_first_seconds)
   result.status = LpStatus::IterationLimit;
   while (true) {
     if (total >= params.max_iterations) {
@@ -240,12 +241,12 @@ LpResult PdhgSolver::solve(const LpProblem& problem, const SolverParams& params)
       // A bound past params.divergence_bound, confirmed in double precision (the running one is
       // an fp32 reduction on a device).
       double certified = -std::numeric_limits<double>::infinity();
-      if (dual_obj * problem.objective_scale > params.divergence_bound) {
+      if (!window_y.empty() && dual_obj * problem.objective_scale > params.divergence_bound) {
         std::vector<double> y(m);
         for (int64_t i = 0; i < m; ++i) y[i] = r[i] * yh[i];
         certified = certified_lower_bound(problem, y);
       }
-      const bool bounded = certified > params.divergence_bound && !window_y.empty();
+      const bool bounded = certified > params.divergence_bound;
       const bool diverging = watched || bounded;
       const bool debug = !window_y.empty() && spdlog::should_log(spdlog::level::debug);
       std::vector<double> ray;  // the window's dual growth: about a Farkas ray where the LP is infeasible
@@ -277,7 +278,9 @@ LpResult PdhgSolver::solve(const LpProblem& problem, const SolverParams& params)
     }
 
     // A point to start this solve again from, for the caller's checkpoint (SolverParams::snapshot).
-    if (params.snapshot && params.snapshot_seconds > 0.0 && since_snapshot.seconds() >= params.snapshot_seconds) {
+    const double wait =
+        snapshots == 0 && params.snapshot_first_seconds >= 0.0 ? params.snapshot_first_seconds : params.snapshot_seconds;
+    if (params.snapshot && params.snapshot_seconds > 0.0 && since_snapshot.seconds() >= wait) {
       SolveSnapshot snap;
       backend->read(snap.x, snap.y);
       for (int64_t j = 0; j < n; ++j) snap.x[j] *= d[j];  // (in place: at 30 M columns each copy counts)
@@ -287,6 +290,7 @@ LpResult PdhgSolver::solve(const LpProblem& problem, const SolverParams& params)
       snap.seconds = clock.seconds();
       params.snapshot(snap);
       since_snapshot.reset();
+      ++snapshots;
     }
 
     // Restarts on the fixed-point residual (cuPDLPx): sufficient decay, necessary decay without

@@ -551,7 +551,7 @@ JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpS
     // as they start (the warm start, or 0).
     const auto part_snapshot = [&, k](const SolveSnapshot& at) {
       // (Not once a part failed: its zeros would stand in the point, and the round is undone.)
-      if (infeasible || out.suspect || since_saved.seconds() < every) return;
+      if (infeasible || out.suspect) return;
       since_saved.reset();
       if (whole) return whole_snapshot(at);
       SolveSnapshot w;
@@ -573,9 +573,10 @@ JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpS
       asked = p.initial_primal_weight;
       if (whole_snapshot) {  // (the costed solve only: not the pre-test)
         p.snapshot = part_snapshot;
-        // At most every `every` seconds over the round (part_snapshot): parts each shorter than
-        // that still save where the round is longer.
-        p.snapshot_seconds = std::max(every - since_saved.seconds(), 0.1 * every);
+        // Every `every` seconds over the round, not per part: parts each shorter than that still
+        // save where the round is longer.
+        p.snapshot_seconds = every;
+        p.snapshot_first_seconds = std::max(every - since_saved.seconds(), 0.0);
       }
       LpResult costed;
       if (!quick[k]) {
@@ -598,6 +599,7 @@ JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpS
       }
       quick[k].reset();
       p.snapshot = {};  // (it refers to this part)
+      p.snapshot_first_seconds = -1.0;
       costed.iterations += pretested[k];
       return costed;
     };

@@ -90,6 +90,9 @@ struct SolverParams {
   // it. 0 or unset: never.
   std::function<void(const SolveSnapshot&)> snapshot;
   double snapshot_seconds = 0.0;
+  // The first call's wait, where ≥ 0 (then every snapshot_seconds): for a caller whose own clock
+  // started before this solve (a round solved in parts). < 0: snapshot_seconds.
+  double snapshot_first_seconds = -1.0;
 };
 
 struct LpResult {
