@@ -1555,6 +1555,23 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
       std::vector<int32_t> last_steps = going_on ? going_on->steps : std::vector<int32_t>{};
       double last_cap = going_on ? going_on->cap_scale : 1.0;
       bool decisions_known = going_on != nullptr;
+      // A rounding checkpoint of these decisions, with x, y (and ω) as its next round's warm start
+      // where `warm`; a failed save is a warning (the rounding goes on; the last checkpoint stands).
+      const auto save_rounding = [&](const std::vector<int64_t>& ones, const std::vector<int32_t>& steps, double cap,
+                                     const std::vector<double>& x, const std::vector<double>& y, double omega,
+                                     bool warm) {
+        Stopwatch saving;
+        LevelAttempt a = current_attempt();
+        a.rounding = rounding_now(ones, steps, cap);
+        if (warm) a.rounding.warm.keep(m, x, y, omega);
+        try {
+          attempted(std::move(a));
+        } catch (const IoError& e) {
+          spdlog::warn("level {}: its rounding's checkpoint was not saved: {}", l + 1, e.what());
+        }
+        last_save_seconds = saving.seconds();  // (the throttle below)
+        since_saved.reset();
+      };
       if (tracking)
         ro.decided = [&](const RoundingRound& r, const std::vector<int64_t>& ones, const std::vector<int32_t>& steps,
                          double bound, const std::vector<double>& x, const std::vector<double>& y) {
@@ -1572,19 +1589,9 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
                                  ? std::max(options_.rounding_checkpoint_seconds, 20.0 * last_save_seconds)
                                  : 0.0;
           if (!attempted || since_saved.seconds() < gap) return;
-          Stopwatch saving;
-          LevelAttempt a = current_attempt();
-          a.rounding = rounding_now(ones, steps, r.cap_scale);
           // Its next round's warm start too (lp_checkpoint_seconds turns the LP's saves on): a run
           // gone on from it starts its round 1 there, not cold.
-          if (options_.lp_checkpoint_seconds > 0.0) a.rounding.warm.keep(m, x, y);
-          try {
-            attempted(std::move(a));
-          } catch (const IoError& e) {  // (the rounding goes on; the last checkpoint stands)
-            spdlog::warn("level {}: its rounding's checkpoint was not saved: {}", l + 1, e.what());
-          }
-          last_save_seconds = saving.seconds();
-          since_saved.reset();
+          save_rounding(ones, steps, r.cap_scale, x, y, 0.0, options_.lp_checkpoint_seconds > 0.0);
         };
       // A lookahead chain that cannot win: out after the first LP (once pricing has not widened).
       // Gone on from inside the rounding, the first LP's bound is the saved one; a carried start's
@@ -1629,18 +1636,9 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
         ro.snapshot_seconds = options_.lp_checkpoint_seconds;
         ro.round_snapshot = [&](const std::vector<double>& x, const std::vector<double>& y, double omega) {
           if (!decisions_known) return;
-          Stopwatch saving;
-          LevelAttempt a = current_attempt();
-          a.rounding = rounding_now(last_ones, last_steps, last_cap);
-          a.rounding.warm.keep(m, x, y, omega);  // (the round goes on at that ω, not PDHG's first guess)
           spdlog::debug("level {}: round {}'s LP so far saved as its warm start", l + 1, rounds_so_far + 1);
-          try {
-            attempted(std::move(a));
-          } catch (const IoError& e) {  // (the rounding goes on; the last checkpoint stands)
-            spdlog::warn("level {}: its rounding's checkpoint was not saved: {}", l + 1, e.what());
-          }
-          last_save_seconds = saving.seconds();  // (counts in the rounding checkpoints' throttle)
-          since_saved.reset();
+          // (With the part's ω: the round goes on at that ω, not PDHG's first guess.)
+          save_rounding(last_ones, last_steps, last_cap, x, y, omega, true);
         };
       }
       // Where rounding gets stuck, widen around it (as for an infeasible LP) and solve again.
