@@ -47,6 +47,7 @@ struct MatchArgs {
   int greedy_margin = RoundingOptions{}.greedy_margin;
   double greedy_fallback = RoundingOptions{}.greedy_fallback;
   bool remember_refuted = RoundingOptions{}.remember_refuted;
+  bool certificate_release = RoundingOptions{}.certificate_release;
   int64_t search_below = RoundingOptions{}.search_below;
   bool converged_first = RoundingOptions{}.converged_first;
   double exact_pivots_per_column = RoundingOptions{}.exact_pivots_per_column;
@@ -274,6 +275,7 @@ int run_match(const MatchArgs& args) {
   ro.greedy_margin = args.greedy_margin;
   ro.greedy_fallback = args.greedy_fallback;
   ro.remember_refuted = args.remember_refuted;
+  ro.certificate_release = args.certificate_release;
   ro.search_below = args.search_below;
   ro.stuck_stalled = args.stuck_stalled;
   ro.converged_first = args.converged_first;
@@ -352,7 +354,10 @@ int run_match(const MatchArgs& args) {
                                                 -r.fixed_to_zero)
                                   : fmt::format("fixed {} to 1 and {} to 0", r.fixed_to_one, r.fixed_to_zero);
     const std::string undone =
-        r.released > 0 ? fmt::format(" (a part failed away from the last fixing or again after trims: released {} "
+        r.certificate_released > 0
+            ? fmt::format(" (its proof survives undoing the last fixing: released {} earlier fixings that carry it)",
+                          r.certificate_released)
+        : r.released > 0 ? fmt::format(" (a part failed away from the last fixing or again after trims: released {} "
                                      "fixings around it)",
                                      r.released)
         : r.undone     ? std::string(" (undone: fixed fewer)")
@@ -471,6 +476,7 @@ int run_match(const MatchArgs& args) {
                       .set("search", r.search)
                       .set("searched_parts", r.searched_parts)
                       .set("released", r.released)
+                      .set("certificate_released", r.certificate_released)
                       .set("seconds", r.seconds));
     Json report = Json::object();
     auto shape = [](const std::string& file, int input_vertices, const Mesh& mesh) {
@@ -534,6 +540,7 @@ int run_match(const MatchArgs& args) {
                               .set("greedy_margin", args.greedy_margin)
                               .set("greedy_fallback", args.greedy_fallback)
                               .set("remember_refuted", args.remember_refuted)
+                              .set("certificate_release", args.certificate_release)
                               .set("search_below", args.search_below)
                               .set("converged_first", args.converged_first)
                               .set("exact_pivots_per_column", args.exact_pivots_per_column)
@@ -819,6 +826,9 @@ Action add_match_command(CLI::App& app) {
   app.add_flag("--remember-refuted,!--no-remember-refuted", a->remember_refuted,
                "fixings an infeasibility proof blamed are not made again from the state they were made from, also "
                "after backtracking away from it and back (default on)");
+  app.add_flag("--certificate-release,!--no-certificate-release", a->certificate_release,
+               "where an infeasibility proof of a later round's LP would survive undoing the last fixing whole, "
+               "release the fixings of any round that carry it instead of trimming the last (default on)");
   app.add_flag("--whole-lp", a->whole_lp,
                "solve each rounding LP after the first as one, not as its independent parts (small parts exactly)");
   app.add_option("--tol", a->tolerance, "LP tolerance")->capture_default_str();

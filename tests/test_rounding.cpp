@@ -3,6 +3,7 @@
 #include "shapematch/matching.hpp"
 #include "shapematch/rounding.hpp"
 #include "shapematch/shapes.hpp"
+#include "certificate_blame.hpp"
 #include "failed_from.hpp"
 #include "failing_again.hpp"
 #include "release_reach.hpp"
@@ -1041,6 +1042,81 @@ TEST_CASE("rounding: it starts from carried fixings to 1, trims them like any fi
   // One naming no variable is invalid input.
   options.start_ones = {99};
   CHECK_THROWS_AS(round_cycle(options), InvalidInputError);
+}
+
+TEST_CASE("rounding: a certificate's margin falls by exactly the weight of each fixing freed") {
+  // x0 + x1 + x2 = 1, x1 − x3 = 0, x2 + x3 + x4 = 1. d = (1, −1, 1): Aᵀd = (1, 0, 2, 2, 1).
+  const LpProblem lp = test::dense_lp({{1, 1, 1, 0, 0}, {0, 1, 0, -1, 0}, {0, 0, 1, 1, 1}}, {1, 0, 1}, {0, 0, 0, 0, 0});
+  const detail::CertificateBlame blame(lp, {1.0, -1.0, 1.0});
+  // The state x0 = 1, x2 = x3 = x4 = 0 (x1 free): r = (0, 0, 1); margin 1 − max(0, 0) = 1 > 0, and
+  // indeed x1 = x3 = 0 leaves row 3 short.
+  std::vector<int8_t> value{1, -1, 0, 0, 0};
+  std::vector<int64_t> rhs{0, 0, 1};
+  const double m = blame.margin(value, rhs);
+  CHECK(m == doctest::Approx(1.0));
+  CHECK(blame.weight(0, 1) == 0.0);  // (Aᵀd)_0 = 1: a 1 there denies nothing
+  CHECK(blame.weight(2, 0) == doctest::Approx(2.0));
+  CHECK(blame.weight(4, 0) == doctest::Approx(1.0));
+  CHECK(blame.weight(1, 0) == 0.0);
+  // Each freed on its own: the margin falls by its weight, whatever its value was.
+  for (int64_t j : {0, 2, 3, 4}) {
+    std::vector<int8_t> v = value;
+    std::vector<int64_t> r = rhs;
+    if (v[j] == 1)
+      for (int64_t i = 0; i < lp.rows(); ++i)
+        for (uint32_t k = lp.a.row_ptr[i]; k < lp.a.row_ptr[i + 1]; ++k)
+          if (int64_t(col_of(lp.a.entry[k])) == j) r[i] += is_negative(lp.a.entry[k]) ? -1 : 1;
+    v[j] = -1;
+    CHECK(blame.margin(v, r) == doctest::Approx(m - blame.weight(j, value[j])));
+  }
+  // Along a trail x0 (decision), x2, x3 (its propagation), x4 (a decision of the next step): each
+  // decision is charged its own segment, each step all of its assignments.
+  const detail::TrailWeights w =
+      detail::trail_weights(blame, {0, 2, 3, 4}, value, {0, 3}, [](int64_t j) { return j == 0 || j == 4; });
+  REQUIRE(w.step.size() == 2);
+  CHECK(w.step[0] == doctest::Approx(4.0));
+  CHECK(w.step[1] == doctest::Approx(1.0));
+  REQUIRE(w.decision.size() == 2);
+  CHECK(w.decision[0] == std::pair<int64_t, double>{0, 4.0});
+  CHECK(w.decision[1] == std::pair<int64_t, double>{4, 1.0});
+  // The heaviest first, up to the margin; then as many as asked; none that weighs nothing.
+  CHECK(detail::heaviest_decisions(w.decision, 1.0) == std::vector<int64_t>{0});
+  CHECK(detail::heaviest_decisions(w.decision, 4.5) == std::vector<int64_t>{0, 4});
+  CHECK(detail::heaviest_decisions(w.decision, 1.0, 2) == std::vector<int64_t>{0, 4});
+  CHECK(detail::heaviest_decisions({{7, 0.0}, {8, 2.0}}, 1.0, 5) == std::vector<int64_t>{8});
+}
+
+TEST_CASE("rounding: a proof that undoing the last fixing cannot break releases the earlier fixing that carries it") {
+  // cycle_behind_a_fixing carried in two steps: a (which leaves no binary solution: the cycle
+  // needs c = 1/5), then b1 and b2 (harmless). Round 1's LP is infeasible; its proof lies on the
+  // cycle, where b1 and b2 take nothing off its margin, so trimming them cannot help: a goes,
+  // b1 and b2 stay, and the next LP is feasible.
+  RoundingOptions options;
+  options.start_ones = {0, 10, 12};
+  options.start_steps = {0, 1, 1};
+  const RoundingResult r = round_cycle(options);
+  CHECK(r.energy == 10.0);
+  CHECK(std::find(r.gamma.begin(), r.gamma.end(), 0) == r.gamma.end());
+  CHECK(std::find(r.gamma.begin(), r.gamma.end(), 10) != r.gamma.end());
+  CHECK(std::find(r.gamma.begin(), r.gamma.end(), 12) != r.gamma.end());
+  REQUIRE(r.rounds.size() >= 2);
+  CHECK(r.rounds[0].status == LpStatus::Infeasible);
+  CHECK(r.rounds[0].certificate_released == 1);
+  CHECK(r.rounds[0].fixed_to_one == -1);  // a alone
+  int infeasible = 0;
+  for (const auto& k : r.rounds) infeasible += k.status == LpStatus::Infeasible;
+  CHECK(infeasible == 1);
+  // Without it the proof trims the last step first: b1 and b2 go (by halves: the proof blames
+  // neither), each time the same LP proved infeasible again, before a does.
+  options.certificate_release = false;
+  const RoundingResult plain = round_cycle(options);
+  CHECK(plain.energy == 10.0);
+  int plain_infeasible = 0;
+  for (const auto& k : plain.rounds) {
+    plain_infeasible += k.status == LpStatus::Infeasible;
+    CHECK(k.certificate_released == 0);
+  }
+  CHECK(plain_infeasible > 1);
 }
 
 TEST_CASE("rounding: a big round fixes only candidates away from the LP's undecided part") {
