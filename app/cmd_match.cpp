@@ -355,7 +355,7 @@ int run_match(const MatchArgs& args) {
                                   : fmt::format("fixed {} to 1 and {} to 0", r.fixed_to_one, r.fixed_to_zero);
     const std::string undone =
         r.certificate_released > 0
-            ? fmt::format(" (its proof survives undoing the last fixing: released {} earlier fixings that carry it)",
+            ? fmt::format(" (its proof survives undoing the last fixing: released {} fixings that carry it)",
                           r.certificate_released)
         : r.released > 0 ? fmt::format(" (a part failed away from the last fixing or again after trims: released {} "
                                      "fixings around it)",

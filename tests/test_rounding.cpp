@@ -1045,34 +1045,44 @@ TEST_CASE("rounding: it starts from carried fixings to 1, trims them like any fi
 }
 
 TEST_CASE("rounding: a certificate's margin falls by exactly the weight of each fixing freed") {
-  // x0 + x1 + x2 = 1, x1 − x3 = 0, x2 + x3 + x4 = 1. d = (1, −1, 1): Aᵀd = (1, 0, 2, 2, 1).
+  // x0 + x1 + x2 = 1, x1 − x3 = 0, x2 + x3 + x4 = 1.
   const LpProblem lp = test::dense_lp({{1, 1, 1, 0, 0}, {0, 1, 0, -1, 0}, {0, 0, 1, 1, 1}}, {1, 0, 1}, {0, 0, 0, 0, 0});
-  const detail::CertificateBlame blame(lp, {1.0, -1.0, 1.0});
-  // The state x0 = 1, x2 = x3 = x4 = 0 (x1 free): r = (0, 0, 1); margin 1 − max(0, 0) = 1 > 0, and
-  // indeed x1 = x3 = 0 leaves row 3 short.
-  std::vector<int8_t> value{1, -1, 0, 0, 0};
-  std::vector<int64_t> rhs{0, 0, 1};
+  // The state x0 = 1, x2 = x3 = x4 = 0 (x1 free): r = (0, 0, 1).
+  const std::vector<int8_t> value{1, -1, 0, 0, 0};
+  const std::vector<int64_t> rhs{0, 0, 1};
+  // d = (1, −1, 1): Aᵀd = (1, 0, 2, 2, 1), margin 1 − max(0, 0) = 1 > 0 (indeed x1 = x3 = 0 leaves
+  // row 3 short). d' = (−1, 1, 0): Aᵀd' = (−1, 0, −1, −1, 0), a fixing to 1 against it (x0).
+  const std::vector<double> d{1.0, -1.0, 1.0}, d2{-1.0, 1.0, 0.0};
+  const detail::CertificateBlame blame(lp, d), blame2(lp, d2);
   const double m = blame.margin(value, rhs);
   CHECK(m == doctest::Approx(1.0));
   CHECK(blame.weight(0, 1) == 0.0);  // (Aᵀd)_0 = 1: a 1 there denies nothing
   CHECK(blame.weight(2, 0) == doctest::Approx(2.0));
   CHECK(blame.weight(4, 0) == doctest::Approx(1.0));
   CHECK(blame.weight(1, 0) == 0.0);
+  CHECK(blame2.weight(0, 1) == doctest::Approx(1.0));
+  CHECK(blame2.weight(2, 0) == 0.0);
   // Each freed on its own: the margin falls by its weight, whatever its value was.
-  for (int64_t j : {0, 2, 3, 4}) {
-    std::vector<int8_t> v = value;
-    std::vector<int64_t> r = rhs;
-    if (v[j] == 1)
-      for (int64_t i = 0; i < lp.rows(); ++i)
-        for (uint32_t k = lp.a.row_ptr[i]; k < lp.a.row_ptr[i + 1]; ++k)
-          if (int64_t(col_of(lp.a.entry[k])) == j) r[i] += is_negative(lp.a.entry[k]) ? -1 : 1;
-    v[j] = -1;
-    CHECK(blame.margin(v, r) == doctest::Approx(m - blame.weight(j, value[j])));
-  }
-  // Along a trail x0 (decision), x2, x3 (its propagation), x4 (a decision of the next step): each
-  // decision is charged its own segment, each step all of its assignments.
-  const detail::TrailWeights w =
-      detail::trail_weights(blame, {0, 2, 3, 4}, value, {0, 3}, [](int64_t j) { return j == 0 || j == 4; });
+  for (const detail::CertificateBlame* c : {&blame, &blame2})
+    for (int64_t j : {0, 2, 3, 4}) {
+      std::vector<int8_t> v = value;
+      std::vector<int64_t> r = rhs;
+      if (v[j] == 1)
+        for (int64_t i = 0; i < lp.rows(); ++i)
+          for (uint32_t k = lp.a.row_ptr[i]; k < lp.a.row_ptr[i + 1]; ++k)
+            if (int64_t(col_of(lp.a.entry[k])) == j) r[i] += is_negative(lp.a.entry[k]) ? -1 : 1;
+      v[j] = -1;
+      CHECK(c->margin(v, r) == doctest::Approx(c->margin(value, rhs) - c->weight(j, value[j])));
+    }
+  // Along a trail x0 (a fixing), x2, x3 (its propagation), x4 (a fixing of the next step): each
+  // fixing is charged its own segment, each step all of its assignments.
+  const std::vector<std::pair<int64_t, bool>> trail{{0, true}, {2, false}, {3, false}, {4, true}};
+  const detail::TrailWeights w = detail::trail_weights(
+      blame,
+      [&](auto&& visit) {
+        for (const auto& [j, fixed] : trail) visit(j, fixed);
+      },
+      value, {0, 3});
   REQUIRE(w.step.size() == 2);
   CHECK(w.step[0] == doctest::Approx(4.0));
   CHECK(w.step[1] == doctest::Approx(1.0));
@@ -1080,10 +1090,17 @@ TEST_CASE("rounding: a certificate's margin falls by exactly the weight of each 
   CHECK(w.decision[0] == std::pair<int64_t, double>{0, 4.0});
   CHECK(w.decision[1] == std::pair<int64_t, double>{4, 1.0});
   // The heaviest first, up to the margin; then as many as asked; none that weighs nothing.
-  CHECK(detail::heaviest_decisions(w.decision, 1.0) == std::vector<int64_t>{0});
-  CHECK(detail::heaviest_decisions(w.decision, 4.5) == std::vector<int64_t>{0, 4});
-  CHECK(detail::heaviest_decisions(w.decision, 1.0, 2) == std::vector<int64_t>{0, 4});
-  CHECK(detail::heaviest_decisions({{7, 0.0}, {8, 2.0}}, 1.0, 5) == std::vector<int64_t>{8});
+  const auto sorted = detail::by_weight(w.decision);
+  CHECK(detail::heaviest_decisions(sorted, 1.0) == std::vector<int64_t>{0});
+  CHECK(detail::heaviest_decisions(sorted, 4.5) == std::vector<int64_t>{0, 4});
+  CHECK(detail::heaviest_decisions(sorted, 1.0, 2) == std::vector<int64_t>{0, 4});
+  CHECK(detail::heaviest_decisions(detail::by_weight({{7, 0.0}, {8, 2.0}}), 1.0, 5) == std::vector<int64_t>{8});
+  // A proof's sign: the one whose rate is positive, none where neither is (x0 + x1 = 3 in [0, 1]).
+  const LpProblem bad = test::dense_lp({{1, 1}}, {3}, {0, 0});
+  CHECK(detail::oriented_certificate(bad, {-1.0}) == std::vector<double>{1.0});
+  CHECK(detail::oriented_certificate(bad, {2.0}) == std::vector<double>{2.0});
+  CHECK(detail::oriented_certificate(bad, {0.0}).empty());
+  CHECK(detail::oriented_certificate(test::dense_lp({{1, 1}}, {1}, {0, 0}), {1.0}).empty());
 }
 
 TEST_CASE("rounding: a proof that undoing the last fixing cannot break releases the earlier fixing that carries it") {

@@ -15,89 +15,108 @@
 
 #include <algorithm>
 #include <cstdint>
-#include <unordered_map>
 #include <vector>
 
 namespace shapematch::detail {
 
+// `y` (one value per row of `lp`) or its negative, whichever proves `lp` infeasible (its Farkas
+// rate positive; a first-order proof at zero cost is one, Clp's ray comes with Clp's sign); empty
+// where neither does (a costed first-order proof is a dual point, not a ray).
+inline std::vector<double> oriented_certificate(const LpProblem& lp, std::vector<double> y) {
+  if (y.size() != size_t(lp.rows())) return {};
+  if (farkas_rate(lp, y) > 0.0) return y;
+  for (double& v : y) v = -v;
+  if (farkas_rate(lp, y) > 0.0) return y;
+  return {};
+}
+
 class CertificateBlame {
 public:
-  // `d`: one value per row of `lp` (0 on rows no longer open).
-  CertificateBlame(const LpProblem& lp, std::vector<double> d) : d_(std::move(d)) {
-    for (int64_t i = 0; i < lp.rows() && i < static_cast<int64_t>(d_.size()); ++i) {
-      if (d_[i] == 0.0) continue;
-      for (uint32_t k = lp.a.row_ptr[i]; k < lp.a.row_ptr[i + 1]; ++k) {
-        const uint32_t e = lp.a.entry[k];
-        a_[col_of(e)] += is_negative(e) ? -d_[i] : d_[i];
-      }
+  // `d`: one value per row of `lp` (0 on rows no longer open). Both are kept by reference.
+  CertificateBlame(const LpProblem& lp, const std::vector<double>& d) : lp_(lp), d_(d) {}
+  // (Aᵀd)_j.
+  double pressure(int64_t j) const {
+    double a = 0.0;
+    for (uint32_t k = lp_.at.row_ptr[j]; k < lp_.at.row_ptr[j + 1]; ++k) {
+      const uint32_t e = lp_.at.entry[k];
+      a += is_negative(e) ? -d_[col_of(e)] : d_[col_of(e)];
     }
+    return a;
   }
   // The margin of d on the LP that the state (`value`: −1 free, 0, 1 per column; `rhs`: b less the
   // columns fixed to 1) leaves. Positive: that LP is infeasible.
   double margin(const std::vector<int8_t>& value, const std::vector<int64_t>& rhs) const {
     double m = 0.0;
-    for (size_t i = 0; i < d_.size() && i < rhs.size(); ++i) m += d_[i] * static_cast<double>(rhs[i]);
-    for (const auto& [j, a] : a_)
-      if (value[j] < 0 && a > 0.0) m -= a;
+    std::vector<int64_t> free;  // the free columns of d's rows
+    for (int64_t i = 0; i < lp_.rows(); ++i) {
+      if (d_[i] == 0.0) continue;
+      m += d_[i] * static_cast<double>(rhs[i]);
+      for (uint32_t k = lp_.a.row_ptr[i]; k < lp_.a.row_ptr[i + 1]; ++k)
+        if (value[col_of(lp_.a.entry[k])] < 0) free.push_back(col_of(lp_.a.entry[k]));
+    }
+    std::sort(free.begin(), free.end());
+    free.erase(std::unique(free.begin(), free.end()), free.end());
+    for (int64_t j : free) m -= std::max(0.0, pressure(j));
     return m;
   }
   // What freeing column j, fixed to v, takes off the margin.
   double weight(int64_t j, int v) const {
-    const auto it = a_.find(j);
-    if (it == a_.end()) return 0.0;
-    return v ? std::max(0.0, -it->second) : std::max(0.0, it->second);
+    const double a = pressure(j);
+    return v ? std::max(0.0, -a) : std::max(0.0, a);
   }
-  const std::vector<double>& d() const { return d_; }
 
 private:
-  std::vector<double> d_;
-  std::unordered_map<int64_t, double> a_;  // (Aᵀd)_j over the columns of d's rows
+  const LpProblem& lp_;
+  const std::vector<double>& d_;
 };
 
-// The certificate's weights along a trail of assignments (`assigned`, in order, with `value` per
-// column), cut into steps at `starts` (each step's first position in `assigned`, increasing, the
-// first 0). `decision` names, per column, whether it was a fixing of its step (a decision) rather
-// than propagated. Each decision is charged what it and the assignments after it up to the next
-// decision weigh (fixings go in one at a time, each followed by its propagation); each step, what
-// all its assignments weigh: the exact amount that undoing it takes off the margin.
+// The certificate's weights along a trail of assignments, cut into steps at `starts` (each step's
+// first position on the trail, increasing, the first 0). `trail(visit)` calls visit(j, fixed) for
+// each assignment in order, `fixed` where it was a fixing (a decision) rather than propagated;
+// `value` gives each column's value. Each decision is charged what it and the assignments after it
+// up to the next decision weigh (fixings go in one at a time, each followed by its propagation);
+// each step, what all its assignments weigh: the exact amount that undoing it takes off the margin.
 struct TrailWeights {
   std::vector<double> step;                          // per step
   std::vector<std::pair<int64_t, double>> decision;  // (column, weight), in trail order
 };
 
-template <class IsDecision>
-TrailWeights trail_weights(const CertificateBlame& blame, const std::vector<int64_t>& assigned,
-                           const std::vector<int8_t>& value, const std::vector<size_t>& starts,
-                           IsDecision&& decision) {
+template <class Trail>
+TrailWeights trail_weights(const CertificateBlame& blame, Trail&& trail, const std::vector<int8_t>& value,
+                           const std::vector<size_t>& starts) {
   TrailWeights w;
   w.step.assign(starts.size(), 0.0);
-  size_t s = 0;
-  for (size_t t = 0; t < assigned.size(); ++t) {
+  size_t s = 0, t = 0;
+  trail([&](int64_t j, bool fixed) {
     while (s + 1 < starts.size() && t >= starts[s + 1]) ++s;
-    const int64_t j = assigned[t];
+    ++t;
     const double wj = blame.weight(j, value[j]);
-    if (decision(j)) w.decision.push_back({j, 0.0});
+    if (fixed) w.decision.push_back({j, 0.0});
     w.step[s] += wj;
     if (!w.decision.empty()) w.decision.back().second += wj;
-  }
+  });
   return w;
 }
 
-// The decisions to release first: the heaviest, until their weights add up to the margin (at least
-// one), out of those that weigh anything at all. `count` > 0 asks for that many instead.
-inline std::vector<int64_t> heaviest_decisions(std::vector<std::pair<int64_t, double>> decisions, double margin,
+// The decisions to release first, out of `sorted` (by_weight): the heaviest, until their weights
+// add up to the margin (at least one), of those that weigh anything at all. `count` > 0 asks for
+// that many instead.
+inline std::vector<int64_t> heaviest_decisions(const std::vector<std::pair<int64_t, double>>& sorted, double margin,
                                                size_t count = 0) {
-  decisions.erase(std::remove_if(decisions.begin(), decisions.end(), [](const auto& p) { return !(p.second > 0.0); }),
-                  decisions.end());
-  std::stable_sort(decisions.begin(), decisions.end(), [](const auto& p, const auto& q) { return p.second > q.second; });
   std::vector<int64_t> out;
   double sum = 0.0;
-  for (const auto& [j, wj] : decisions) {
-    if (count > 0 ? out.size() >= count : (!out.empty() && sum >= margin)) break;
+  for (const auto& [j, wj] : sorted) {
+    if (!(wj > 0.0) || (count > 0 ? out.size() >= count : (!out.empty() && sum >= margin))) break;
     out.push_back(j);
     sum += wj;
   }
   return out;
+}
+
+// `decisions` heaviest first (ties in trail order), for heaviest_decisions.
+inline std::vector<std::pair<int64_t, double>> by_weight(std::vector<std::pair<int64_t, double>> decisions) {
+  std::stable_sort(decisions.begin(), decisions.end(), [](const auto& p, const auto& q) { return p.second > q.second; });
+  return decisions;
 }
 
 }  // namespace shapematch::detail

@@ -60,10 +60,21 @@ public:
   // it changed: rounding backtracks over several rounds without keeping copies of the state.
   size_t mark() const { return trail_.size(); }
   // The variables assigned since `mark`, in order (each fixing followed by what it propagated).
-  std::vector<int64_t> assigned_since(size_t mark) const { return {trail_.begin() + mark, trail_.end()}; }
+  std::vector<int64_t> assigned_since(size_t mark) const {
+    std::vector<int64_t> out;
+    out.reserve(trail_.size() - std::min(mark, trail_.size()));
+    for (size_t t = mark; t < trail_.size(); ++t) out.push_back(trail_[t] & ~kFixed);
+    return out;
+  }
+  // Visits each assignment since `mark` in order as (variable, whether `fix` set it rather than
+  // propagation), without copying the trail.
+  template <class Visit>
+  void visit_since(size_t mark, Visit&& visit) const {
+    for (size_t t = mark; t < trail_.size(); ++t) visit(static_cast<int64_t>(trail_[t] & ~kFixed), (trail_[t] & kFixed) != 0);
+  }
   void undo_to(size_t mark) {
     while (trail_.size() > mark) {
-      const int64_t j = trail_.back();
+      const int64_t j = trail_.back() & ~kFixed;
       trail_.pop_back();
       const int v = s_.value[j];
       s_.value[j] = -1;
@@ -95,7 +106,7 @@ public:
   bool fix(const std::vector<std::pair<int64_t, int>>& assignments) {
     std::deque<int64_t> queue;
     for (const auto& [j, v] : assignments)
-      if (!assign(j, v, queue)) return false;
+      if (!assign(j, v, queue, true)) return false;
     return propagate(queue);
   }
 
@@ -112,10 +123,11 @@ public:
   }
 
 private:
-  bool assign(int64_t j, int v, std::deque<int64_t>& queue) {
+  bool assign(int64_t j, int v, std::deque<int64_t>& queue, bool fixed = false) {
     if (s_.value[j] >= 0) return s_.value[j] == v;
     s_.value[j] = static_cast<int8_t>(v);
-    trail_.push_back(static_cast<uint32_t>(j));  // < 2^31 columns (build_constraints checks)
+    // < 2^31 columns (build_constraints checks): the top bit says whether `fix` set it
+    trail_.push_back(static_cast<uint32_t>(j) | (fixed ? kFixed : 0u));
     ++(v ? s_.ones : s_.zeros);
     for (uint32_t k = lp_.at.row_ptr[j]; k < lp_.at.row_ptr[j + 1]; ++k) {
       const uint32_t e = lp_.at.entry[k];
@@ -164,7 +176,8 @@ private:
   const LpProblem& lp_;
   FixState s_;
   int64_t failed_row_ = -1;
-  std::vector<uint32_t> trail_;  // assigned variables, in order
+  static constexpr uint32_t kFixed = 1u << 31;
+  std::vector<uint32_t> trail_;  // assigned variables, in order (kFixed: by `fix`)
   const std::vector<char>* skip_ = nullptr;
 };
 
@@ -394,6 +407,13 @@ JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpS
   const bool weighted = warm_weight && warm_weight->size() == size_t(lp.cols());
   std::vector<double> suspect_proof(lp.rows(), 0.0);
   bool infeasible = false;
+  // An infeasible part's proof, where it is a Farkas certificate of the part, into out.certificate.
+  const auto certify = [&](const LpProblem& plp, const std::vector<int64_t>& rows, const std::vector<double>& y) {
+    const std::vector<double> c = detail::oriented_certificate(plp, y);
+    if (c.empty()) return;
+    out.certificate.resize(lp.rows(), 0.0);
+    for (size_t i = 0; i < rows.size() && i < c.size(); ++i) out.certificate[rows[i]] = c[i];
+  };
   int64_t exactly = 0, largest = 0, reused = 0, first_order_largest = 0;
   std::vector<ExactCache::Entry> kept;  // this call's new exact results, for the next calls (cache)
   // The parts below this go to the exact solver: exact_below, or less where parts reached its cap.
@@ -521,6 +541,7 @@ JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpS
       infeasible = true;
       out.failed_rows.insert(out.failed_rows.end(), parts[k].rows.begin(), parts[k].rows.end());
       for (size_t i = 0; i < parts[k].rows.size() && i < z.y.size(); ++i) out.proof[parts[k].rows[i]] = z.y[i];
+      certify(plp, parts[k].rows, z.y);
     }
     if (pretest.cache) {
       // Kept until kKeepCalls calls in a row have not had the part (as ExactCache).
@@ -700,6 +721,7 @@ JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpS
       infeasible = true;
       out.failed_rows.insert(out.failed_rows.end(), part.rows.begin(), part.rows.end());
       for (size_t i = 0; i < part.rows.size() && i < s.y.size(); ++i) out.proof[part.rows[i]] = s.y[i];
+      certify(plp, part.rows, s.y);
       if (s.y.empty())  // no ray (Clp): the whole part is the proof
         for (int64_t i : part.rows) out.proof[i] = 1.0;
       continue;
@@ -1524,72 +1546,82 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
   // off it (certificate_blame.hpp), trimming or undoing that fixing only costs another solve of an
   // LP the same proof still refutes: release instead the fixings, of whatever step, that carry
   // the margin, heaviest first, until the proof no longer holds (checked on the state after them;
-  // where it still does, twice as many, and so on), keeping every other fixing in its step. Measured,
-  // TOSCA_r horse0-horse5 at full resolution (seventy-ninth session): proofs blamed 18 of 75, 3 of
-  // 57 and 1 of 54 of the last fixings in turn, 5-15 minutes of zero-cost solving each, and the
-  // LP stayed infeasible. False, with nothing changed, where the proof is no Farkas certificate
-  // (a suspect LP at its cap, a part with no ray), the last fixing may carry it, or no release
-  // breaks it.
-  auto release_by_certificate = [&](const Reduced& red, const std::vector<double>& proof, RoundingRound& info) {
-    if (!options.certificate_release || history.empty() || backtracks >= options.max_backtracks) return false;
+  // where it still does, twice as many, and so on), keeping every other fixing in its step. The
+  // released fixings to 1 are not made again from the state after the release (remember_refuted),
+  // nor, while anything else remains, until a backtrack. Measured, TOSCA_r horse0-horse5 at full
+  // resolution (seventy-ninth session's log, without it): proofs blamed 18 of 75, 3 of 57 and 1 of
+  // 54 of the last fixings in turn, 5-15 minutes of zero-cost solving each, and the LP stayed
+  // infeasible. False, with the fixings as they were, where no part's proof is a Farkas certificate
+  // (a costed first-order proof, a part with no ray), the last fixing may carry its margin, or
+  // nothing releasable does. `certificate`: JoinedSolve::certificate, over red's rows.
+  auto release_by_certificate = [&](const Reduced& red, const std::vector<double>& certificate, RoundingRound& info) {
+    if (!options.certificate_release || history.empty() || certificate.empty() ||
+        backtracks >= options.max_backtracks)
+      return false;
     std::vector<double> d(lp.rows(), 0.0);
     double largest = 0.0;
-    for (size_t i = 0; i < red.rows.size() && i < proof.size(); ++i) {
-      d[red.rows[i]] = proof[i];
-      largest = std::max(largest, std::abs(proof[i]));
+    for (size_t i = 0; i < red.rows.size() && i < certificate.size(); ++i) {
+      d[red.rows[i]] = certificate[i];
+      largest = std::max(largest, std::abs(certificate[i]));
     }
-    if (!(largest > 0.0)) return false;
     const double noise = 1e-9 * largest;
-    std::optional<detail::CertificateBlame> blame;
-    blame.emplace(lp, d);
-    double margin = blame->margin(fixer.state().value, fixer.state().rhs);
-    if (!(margin > noise)) {  // Clp's rays come with its own sign
-      for (double& v : d) v = -v;
-      blame.emplace(lp, std::move(d));
-      margin = blame->margin(fixer.state().value, fixer.state().rhs);
-      if (!(margin > noise)) return false;
-    }
+    const detail::CertificateBlame blame(lp, d);
+    const double margin = blame.margin(fixer.state().value, fixer.state().rhs);
+    if (!(margin > noise)) return false;
     const size_t base = history.front().mark;
     std::vector<size_t> starts;
-    std::unordered_set<int64_t> decided;
-    for (const Step& st : history) {
-      starts.push_back(st.mark - base);
-      for (const auto& a : st.batch) decided.insert(a.first);
-    }
-    const detail::TrailWeights w =
-        detail::trail_weights(*blame, fixer.assigned_since(base), fixer.state().value, starts,
-                              [&](int64_t j) { return decided.count(j) > 0; });
-    if (!(w.step.back() < margin)) return false;  // undoing the last fixing may break it: trim as usual
+    for (const Step& st : history) starts.push_back(st.mark - base);
+    const detail::TrailWeights w = detail::trail_weights(
+        blame, [&](auto&& visit) { fixer.visit_since(base, visit); }, fixer.state().value, starts);
+    // Undoing steps from the last back changes the margin by exactly their weights: the LP before
+    // the last step is infeasible too where margin − its weight stays positive, and no release at
+    // all breaks the proof where margin − all of them does (propagation before the first step).
+    double all = 0.0;
+    for (double ws : w.step) all += ws;
+    if (!(margin - w.step.back() > noise) || margin - all > noise) return false;
+    const auto sorted = detail::by_weight(w.decision);
     size_t weighing = 0;
-    for (const auto& p : w.decision) weighing += p.second > 0.0;
+    while (weighing < sorted.size() && sorted[weighing].second > 0.0) ++weighing;
     const int64_t ones_before = fixer.state().ones, zeros_before = fixer.state().zeros;
-    // Every step again without `out` (fewer fixings propagate to a subset of a consistent state,
-    // so each goes through whole).
+    std::unordered_map<int64_t, size_t> step_of;  // decision -> its step
+    for (size_t k = 0; k < history.size(); ++k)
+      for (const auto& a : history[k].batch) step_of.emplace(a.first, k);
+    const std::vector<Step> before = history;
+    // The steps from the first that holds one of `out` again without them (fewer fixings propagate
+    // to a subset of a consistent state, so each goes through whole).
     const auto rebuild_without = [&](const std::unordered_set<int64_t>& out) {
-      fixer.undo_to(base);
-      std::vector<Step> kept;
-      for (Step& st : history) {
-        Step again{fixer.mark(), fixer.state().ones, fixer.state().zeros, {}, st.capped};
+      size_t first = before.size();
+      for (int64_t j : out)
+        if (const auto it = step_of.find(j); it != step_of.end()) first = std::min(first, it->second);
+      if (first == before.size()) first = 0;
+      fixer.undo_to(before[first].mark);
+      history.assign(before.begin(), before.begin() + static_cast<std::ptrdiff_t>(first));
+      for (size_t k = first; k < before.size(); ++k) {
+        Step again{fixer.mark(), fixer.state().ones, fixer.state().zeros, {}, before[k].capped};
         std::vector<std::pair<int64_t, int>> batch;
-        for (const auto& a : st.batch)
+        for (const auto& a : before[k].batch)
           if (!out.count(a.first)) batch.push_back(a);
         if (batch.empty()) continue;
         again.batch = shrink_and_fix(fixer, std::move(batch), again.mark, true);
-        kept.push_back(std::move(again));
+        history.push_back(std::move(again));
       }
-      history = std::move(kept);
     };
     size_t count = 0;  // first: the heaviest up to the margin
     for (;;) {
-      const std::vector<int64_t> chosen = detail::heaviest_decisions(w.decision, margin, count);
+      const std::vector<int64_t> chosen = detail::heaviest_decisions(sorted, margin, count);
       const std::unordered_set<int64_t> out(chosen.begin(), chosen.end());
       rebuild_without(out);
-      const double after = blame->margin(fixer.state().value, fixer.state().rhs);
-      if (!(after > noise) || history.empty()) {
+      const double after = blame.margin(fixer.state().value, fixer.state().rhs);
+      if (!(after > noise)) {
         ++backtracks;
-        for (int64_t j : chosen) refuted.insert(j);  // (left out while anything else remains)
+        std::vector<int64_t> ones;  // (a released fixing to 0 says nothing against a 1 there)
+        for (const Step& st : before)
+          for (const auto& a : st.batch)
+            if (a.second == 1 && out.count(a.first)) ones.push_back(a.first);
+        refuted.insert(ones.begin(), ones.end());
+        if (options.remember_refuted) failed_from.blamed(detail::state_hash(fixer.state().value), ones);
         spdlog::debug("rounding: the proof's margin {:.4g} outweighs what undoing the last fixing frees ({:.4g}): "
-                      "released {} of {} fixings that carry it (its margin now {:.4g})",
+                      "released {} of the {} fixings that carry it (its margin now {:.4g})",
                       margin, w.step.back(), chosen.size(), weighing, after);
         info.certificate_released = static_cast<int64_t>(chosen.size());
         info.fixed_to_one = fixer.state().ones - ones_before;
@@ -1599,7 +1631,9 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
       if (chosen.size() >= weighing) break;
       count = std::min(weighing, 2 * chosen.size());
     }
-    rebuild_without({});  // the same steps again: the state as it was
+    rebuild_without({});  // the same steps again
+    if (fixer.state().ones != ones_before || fixer.state().zeros != zeros_before)
+      throw SolverError("rounding: the fixings made again after a release attempt differ (a bug)");
     spdlog::debug("rounding: no release of the {} fixings that carry the proof's margin {:.4g} breaks it", weighing,
                   margin);
     return false;
@@ -1918,7 +1952,10 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
       } else {
         joined.r = solver->solve(red.lp, params);
       }
-      if (joined.r.status == LpStatus::Infeasible) joined.proof = joined.r.y;
+      if (joined.r.status == LpStatus::Infeasible) {
+        joined.proof = joined.r.y;
+        joined.certificate = detail::oriented_certificate(red.lp, joined.r.y);
+      }
       params.snapshot = {};  // (it refers to this block)
     } else {
       std::vector<double> warm_weight;
@@ -2046,7 +2083,7 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
         away = fixings_away_from(lp, fixer.state().value, blame.empty() ? failed : blame, history.back().batch,
                                  fixer.assigned_since(history.back().mark), &touched);
       const bool proven = r.status == LpStatus::Infeasible;
-      if (proven && release_by_certificate(red, joined.proof, info)) {
+      if (proven && release_by_certificate(red, joined.certificate, info)) {
         // (released where the proof lies: neither a trim of the last fixing nor a release around a part)
       } else if (touched == 0 && !proven && cap_scale < kMaxCapScale) {
         cap_scale = std::min(2.0 * cap_scale, kMaxCapScale);

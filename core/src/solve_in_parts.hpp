@@ -35,6 +35,9 @@ namespace shapematch::detail {
 struct JoinedSolve {
   LpResult r;
   std::vector<double> proof;
+  // The infeasible parts' proofs that are Farkas certificates, each oriented so that its rate is
+  // positive (oriented_certificate), zero elsewhere; empty where no part is infeasible.
+  std::vector<double> certificate;
   bool suspect = false;
   int64_t parts = 1, exact_parts = 0;
   // Every row of the parts that are infeasible (or, where none is, suspect), in the LP's
