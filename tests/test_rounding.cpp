@@ -1134,6 +1134,25 @@ TEST_CASE("rounding: a proof that undoing the last fixing cannot break releases 
     CHECK(k.certificate_released == 0);
   }
   CHECK(plain_infeasible > 1);
+  // The culprit between two harmless steps: only its step goes, the others stay apart as they were
+  // (what a checkpoint after that round keeps).
+  options.certificate_release = true;
+  options.start_ones = {10, 0, 12};
+  options.start_steps = {0, 1, 2};
+  std::vector<int64_t> ones_after;
+  std::vector<int32_t> steps_after;
+  options.decided = [&](const RoundingRound& round, const std::vector<int64_t>& ones, const std::vector<int32_t>& steps,
+                        double, const std::vector<double>&, const std::vector<double>&) {
+    if (round.round != 1) return;
+    ones_after = ones;
+    steps_after = steps;
+  };
+  const RoundingResult middle = round_cycle(options);
+  CHECK(middle.energy == 10.0);
+  REQUIRE(!middle.rounds.empty());
+  CHECK(middle.rounds[0].certificate_released == 1);
+  CHECK(ones_after == std::vector<int64_t>{10, 12});
+  CHECK(steps_after == std::vector<int32_t>{0, 1});
 }
 
 TEST_CASE("rounding: a big round fixes only candidates away from the LP's undecided part") {
