@@ -1134,6 +1134,7 @@ TEST_CASE("rounding: a proof that undoing the last fixing cannot break releases 
     CHECK(k.certificate_released == 0);
   }
   CHECK(plain_infeasible > 1);
+  CHECK(plain.rounds.size() > r.rounds.size());  // (5 against 3)
   // The culprit between two harmless steps: only its step goes, the others stay apart as they were
   // (what a checkpoint after that round keeps).
   options.certificate_release = true;
