@@ -782,10 +782,11 @@ namespace {
 
 // Variables a, a', c, y1..y5, w1, w2, b1, b1', b2, b2'. a + a' = 1; a' = c; y_i + y_{i+1} + c = 1
 // around a 5-cycle; y1 + ... + y5 + w1 + w2 = 2; b_k + b_k' = 1. a' and b_k' cost 10 (`cost`).
-// `links` 1: b1 = 1 forces a = 1 too; 2: b1 and b2 force each other, and together a = 1.
+// `links` 1: b1 = 1 forces a = 1 too; 2: b1 and b2 force each other, and together a = 1; 3: a
+// second way to c = 0, e = 1 (e + c + s = 1).
 LpProblem cycle_behind_a_fixing(std::vector<double>& cost, int links = 0) {
-  const int n = 14 + links + (links == 2);
-  std::vector<std::vector<int>> rows(10 + links + (links == 2), std::vector<int>(n, 0));
+  const int n = 14 + (links == 1 ? 1 : links == 2 ? 3 : links == 3 ? 2 : 0);
+  std::vector<std::vector<int>> rows(10 + (links == 1 || links == 3 ? 1 : links == 2 ? 3 : 0), std::vector<int>(n, 0));
   rows[0][0] = rows[0][1] = 1;
   rows[1][1] = 1;
   rows[1][2] = -1;
@@ -805,6 +806,9 @@ LpProblem cycle_behind_a_fixing(std::vector<double>& cost, int links = 0) {
     rows[11][12] = rows[11][11] = rows[11][15] = 1;
     rows[12][10] = rows[12][12] = rows[12][1] = rows[12][16] = 1;
     b.insert(b.end(), {1, 1, 2});
+  } else if (links == 3) {
+    rows[10][14] = rows[10][2] = rows[10][15] = 1;
+    b.push_back(1);
   }
   cost.assign(n, 0.0);
   cost[1] = cost[11] = cost[13] = 10.0;
@@ -1154,6 +1158,24 @@ TEST_CASE("rounding: a proof that undoing the last fixing cannot break releases 
   CHECK(middle.rounds[0].certificate_released == 1);
   CHECK(ones_after == std::vector<int64_t>{10, 12});
   CHECK(steps_after == std::vector<int32_t>{0, 1});
+  // Where the fixing that carries the margin is not the only way to it (e = 1 forces c = 0 as a
+  // does, and propagates nothing the proof weighs), releasing it leaves the proof standing: the
+  // fixings go back as they were, and the rounding goes on exactly as without the rule.
+  options.decided = {};
+  options.start_ones = {0, 14, 10, 12};
+  options.start_steps = {0, 1, 2, 2};
+  const RoundingResult twice = round_cycle(options, 3);
+  options.certificate_release = false;
+  const RoundingResult twice_plain = round_cycle(options, 3);
+  CHECK(twice.energy == 10.0);
+  CHECK(twice.gamma == twice_plain.gamma);
+  REQUIRE(twice.rounds.size() == twice_plain.rounds.size());
+  for (size_t k = 0; k < twice.rounds.size(); ++k) {
+    CHECK(twice.rounds[k].certificate_released == 0);
+    CHECK(twice.rounds[k].status == twice_plain.rounds[k].status);
+    CHECK(twice.rounds[k].fixed_to_one == twice_plain.rounds[k].fixed_to_one);
+    CHECK(twice.rounds[k].fixed_to_zero == twice_plain.rounds[k].fixed_to_zero);
+  }
 }
 
 TEST_CASE("rounding: a big round fixes only candidates away from the LP's undecided part") {
