@@ -99,14 +99,12 @@ TrailWeights trail_weights(const CertificateBlame& blame, Trail&& trail, const s
 }
 
 // The decisions to release first, out of `sorted` (by_weight): the heaviest, until their weights
-// add up to the margin (at least one), of those that weigh anything at all. `count` > 0 asks for
-// that many instead.
-inline std::vector<int64_t> heaviest_decisions(const std::vector<std::pair<int64_t, double>>& sorted, double margin,
-                                               size_t count = 0) {
+// add up to the margin (at least one), of those that weigh anything at all.
+inline std::vector<int64_t> heaviest_decisions(const std::vector<std::pair<int64_t, double>>& sorted, double margin) {
   std::vector<int64_t> out;
   double sum = 0.0;
   for (const auto& [j, wj] : sorted) {
-    if (!(wj > 0.0) || (count > 0 ? out.size() >= count : (!out.empty() && sum >= margin))) break;
+    if (!(wj > 0.0) || (!out.empty() && sum >= margin)) break;
     out.push_back(j);
     sum += wj;
   }

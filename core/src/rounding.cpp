@@ -1546,7 +1546,8 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
   // off it (certificate_blame.hpp), trimming or undoing that fixing only costs another solve of an
   // LP the same proof still refutes: release instead the fixings, of whatever step, that carry
   // the margin, heaviest first, until the proof no longer holds (checked on the state after them;
-  // where it still does, twice as many, and so on), keeping every other fixing in its step. The
+  // where it still does, the fixings weighed again there, up to 8 passes), keeping every other
+  // fixing in its step. The
   // released fixings to 1 are not made again from the state after the release (remember_refuted),
   // nor, while anything else remains, until a backtrack. Measured, TOSCA_r horse0-horse5 at full
   // resolution (seventy-ninth session's log, without it): proofs blamed 18 of 75, 3 of 57 and 1 of
@@ -1579,9 +1580,6 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
     double all = 0.0;
     for (double ws : w.step) all += ws;
     if (!(margin - w.step.back() > noise) || margin - all > noise) return false;
-    const auto sorted = detail::by_weight(w.decision);
-    size_t weighing = 0;
-    while (weighing < sorted.size() && sorted[weighing].second > 0.0) ++weighing;
     const int64_t ones_before = fixer.state().ones, zeros_before = fixer.state().zeros;
     std::unordered_map<int64_t, size_t> step_of;  // decision -> its step
     for (size_t k = 0; k < history.size(); ++k)
@@ -1606,13 +1604,20 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
         history.push_back(std::move(again));
       }
     };
-    size_t count = 0;  // first: the heaviest up to the margin
-    for (;;) {
-      const std::vector<int64_t> chosen = detail::heaviest_decisions(sorted, margin, count);
-      const std::unordered_set<int64_t> out(chosen.begin(), chosen.end());
+    // Released fixings' variables can be set again by the propagation of others (which carried
+    // nothing while they came first): then the margin stands, and the next pass weighs the
+    // fixings as they are now.
+    constexpr int kPasses = 8;
+    std::unordered_set<int64_t> out;
+    double now = margin;
+    detail::TrailWeights weights = w;
+    for (int pass = 0; pass < kPasses; ++pass) {
+      const std::vector<int64_t> chosen = detail::heaviest_decisions(detail::by_weight(weights.decision), now);
+      if (chosen.empty()) break;
+      out.insert(chosen.begin(), chosen.end());
       rebuild_without(out);
-      const double after = blame.margin(fixer.state().value, fixer.state().rhs);
-      if (!(after > noise)) {
+      now = blame.margin(fixer.state().value, fixer.state().rhs);
+      if (!(now > noise)) {
         ++backtracks;
         std::vector<int64_t> ones;  // (a released fixing to 0 says nothing against a 1 there)
         for (const Step& st : before)
@@ -1621,20 +1626,23 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
         refuted.insert(ones.begin(), ones.end());
         if (options.remember_refuted) failed_from.blamed(detail::state_hash(fixer.state().value), ones);
         spdlog::debug("rounding: the proof's margin {:.4g} outweighs what undoing the last fixing frees ({:.4g}): "
-                      "released {} of the {} fixings that carry it (its margin now {:.4g})",
-                      margin, w.step.back(), chosen.size(), weighing, after);
-        info.certificate_released = static_cast<int64_t>(chosen.size());
+                      "released {} fixings that carry it in {} pass(es) (its margin now {:.4g})",
+                      margin, w.step.back(), out.size(), pass + 1, now);
+        info.certificate_released = static_cast<int64_t>(out.size());
         info.fixed_to_one = fixer.state().ones - ones_before;
         info.fixed_to_zero = fixer.state().zeros - zeros_before;
         return true;
       }
-      if (chosen.size() >= weighing) break;
-      count = std::min(weighing, 2 * chosen.size());
+      if (history.empty()) break;
+      std::vector<size_t> at;
+      for (const Step& st : history) at.push_back(st.mark - base);
+      weights = detail::trail_weights(
+          blame, [&](auto&& visit) { fixer.visit_since(base, visit); }, fixer.state().value, at);
     }
     rebuild_without({});  // the same steps again
     if (fixer.state().ones != ones_before || fixer.state().zeros != zeros_before)
       throw SolverError("rounding: the fixings made again after a release attempt differ (a bug)");
-    spdlog::debug("rounding: no release of the {} fixings that carry the proof's margin {:.4g} breaks it", weighing,
+    spdlog::debug("rounding: no release of up to {} fixings that carry the proof's margin {:.4g} breaks it", out.size(),
                   margin);
     return false;
   };
