@@ -1099,6 +1099,16 @@ TEST_CASE("rounding: a certificate's margin falls by exactly the weight of each 
   CHECK(detail::heaviest_decisions(sorted, 4.5) == std::vector<int64_t>{0, 4});
   CHECK(detail::heaviest_decisions(detail::by_weight({{7, 0.0}, {8, 2.0}}), 5.0) == std::vector<int64_t>{8});
   CHECK(detail::heaviest_decisions(detail::by_weight({{7, 0.0}}), 5.0).empty());
+  // Two independent parts' certificates in one d (x0 + x1 = 3, x2 + x3 = 3, both in [0, 1]): each
+  // has its own margin, and freeing a fixing of one leaves the other's.
+  const LpProblem two = test::dense_lp({{1, 1, 0, 0}, {0, 0, 1, 1}}, {3, 3}, {0, 0, 0, 0});
+  const std::vector<double> both{1.0, 2.0};
+  const detail::CertificateBlame blame_two(two, both);
+  const std::vector<int32_t> parts_of{0, 1};
+  CHECK(blame_two.margins({-1, -1, -1, -1}, {3, 3}, parts_of, 2) == std::vector<double>{1.0, 2.0});
+  // x0 fixed to 0 (weight 1): part 0 at 2 (> 1, infeasible still: x1 alone reaches 1 of 3)
+  CHECK(blame_two.margins({0, -1, -1, -1}, {3, 3}, parts_of, 2) == std::vector<double>{2.0, 2.0});
+  CHECK(blame_two.margin({0, -1, -1, -1}, {3, 3}) == doctest::Approx(4.0));
   // A proof's sign: the one whose rate is positive, none where neither is (x0 + x1 = 3 in [0, 1]).
   const LpProblem bad = test::dense_lp({{1, 1}}, {3}, {0, 0});
   CHECK(detail::oriented_certificate(bad, {-1.0}) == std::vector<double>{1.0});

@@ -15,6 +15,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <stdexcept>
 #include <vector>
 
 namespace shapematch::detail {
@@ -33,7 +34,10 @@ inline std::vector<double> oriented_certificate(const LpProblem& lp, std::vector
 class CertificateBlame {
 public:
   // `d`: one value per row of `lp` (0 on rows no longer open). Both are kept by reference.
-  CertificateBlame(const LpProblem& lp, const std::vector<double>& d) : lp_(lp), d_(d) {}
+  CertificateBlame(const LpProblem& lp, const std::vector<double>& d) : lp_(lp), d_(d) {
+    if (d.size() != size_t(lp.rows())) throw std::invalid_argument("CertificateBlame: one value per row");
+  }
+  CertificateBlame(const LpProblem&, std::vector<double>&&) = delete;
   // (Aᵀd)_j.
   double pressure(int64_t j) const {
     double a = 0.0;
@@ -46,17 +50,25 @@ public:
   // The margin of d on the LP that the state (`value`: −1 free, 0, 1 per column; `rhs`: b less the
   // columns fixed to 1) leaves. Positive: that LP is infeasible.
   double margin(const std::vector<int8_t>& value, const std::vector<int64_t>& rhs) const {
-    double m = 0.0;
-    std::vector<int64_t> free;  // the free columns of d's rows
+    return margins(value, rhs, {}, 1).front();
+  }
+  // The same per part, where d joins the certificates of independent parts of the LP (`part`: per
+  // row, its part in [0, parts), −1 for none; empty: all one part): each proves its own part
+  // infeasible, and one that no longer does says nothing of the others.
+  std::vector<double> margins(const std::vector<int8_t>& value, const std::vector<int64_t>& rhs,
+                              const std::vector<int32_t>& part, int32_t parts) const {
+    std::vector<double> m(static_cast<size_t>(std::max(parts, 1)), 0.0);
+    std::vector<std::pair<int64_t, int32_t>> free;  // the free columns of d's rows, with their part
     for (int64_t i = 0; i < lp_.rows(); ++i) {
-      if (d_[i] == 0.0) continue;
-      m += d_[i] * static_cast<double>(rhs[i]);
+      const int32_t p = part.empty() ? 0 : part[i];
+      if (d_[i] == 0.0 || p < 0) continue;
+      m[p] += d_[i] * static_cast<double>(rhs[i]);
       for (uint32_t k = lp_.a.row_ptr[i]; k < lp_.a.row_ptr[i + 1]; ++k)
-        if (value[col_of(lp_.a.entry[k])] < 0) free.push_back(col_of(lp_.a.entry[k]));
+        if (value[col_of(lp_.a.entry[k])] < 0) free.push_back({col_of(lp_.a.entry[k]), p});
     }
     std::sort(free.begin(), free.end());
-    free.erase(std::unique(free.begin(), free.end()), free.end());
-    for (int64_t j : free) m -= std::max(0.0, pressure(j));
+    free.erase(std::unique(free.begin(), free.end()), free.end());  // (a column lies in one part)
+    for (const auto& [j, p] : free) m[p] -= std::max(0.0, pressure(j));
     return m;
   }
   // What freeing column j, fixed to v, takes off the margin.
@@ -85,7 +97,7 @@ template <class Trail>
 TrailWeights trail_weights(const CertificateBlame& blame, Trail&& trail, const std::vector<int8_t>& value,
                            const std::vector<size_t>& starts) {
   TrailWeights w;
-  w.step.assign(starts.size(), 0.0);
+  w.step.assign(std::max<size_t>(starts.size(), 1), 0.0);
   size_t s = 0, t = 0;
   trail([&](int64_t j, bool fixed) {
     while (s + 1 < starts.size() && t >= starts[s + 1]) ++s;

@@ -408,11 +408,17 @@ JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpS
   std::vector<double> suspect_proof(lp.rows(), 0.0);
   bool infeasible = false;
   // An infeasible part's proof, where it is a Farkas certificate of the part, into out.certificate.
+  int32_t certified = 0;
   const auto certify = [&](const LpProblem& plp, const std::vector<int64_t>& rows, const std::vector<double>& y) {
     const std::vector<double> c = detail::oriented_certificate(plp, y);
     if (c.empty()) return;
     out.certificate.resize(lp.rows(), 0.0);
-    for (size_t i = 0; i < rows.size() && i < c.size(); ++i) out.certificate[rows[i]] = c[i];
+    out.certificate_part.resize(lp.rows(), -1);
+    const int32_t index = certified++;
+    for (size_t i = 0; i < rows.size() && i < c.size(); ++i) {
+      out.certificate[rows[i]] = c[i];
+      out.certificate_part[rows[i]] = index;
+    }
   };
   int64_t exactly = 0, largest = 0, reused = 0, first_order_largest = 0;
   std::vector<ExactCache::Entry> kept;  // this call's new exact results, for the next calls (cache)
@@ -1555,20 +1561,45 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
   // infeasible. False, with the fixings as they were, where no part's proof is a Farkas certificate
   // (a costed first-order proof, a part with no ray), the last fixing may carry its margin, or
   // nothing releasable does. `certificate`: JoinedSolve::certificate, over red's rows.
-  auto release_by_certificate = [&](const Reduced& red, const std::vector<double>& certificate, RoundingRound& info) {
+  auto release_by_certificate = [&](const Reduced& red, const JoinedSolve& joined, RoundingRound& info) {
+    const std::vector<double>& certificate = joined.certificate;
     if (!options.certificate_release || history.empty() || certificate.empty() ||
-        backtracks >= options.max_backtracks)
+        joined.certificate_part.size() != certificate.size() || backtracks >= options.max_backtracks)
       return false;
     std::vector<double> d(lp.rows(), 0.0);
-    double largest = 0.0;
+    std::vector<int32_t> part(lp.rows(), -1);
+    int32_t parts = 0;
     for (size_t i = 0; i < red.rows.size() && i < certificate.size(); ++i) {
       d[red.rows[i]] = certificate[i];
-      largest = std::max(largest, std::abs(certificate[i]));
+      part[red.rows[i]] = joined.certificate_part[i];
+      parts = std::max(parts, joined.certificate_part[i] + 1);
     }
-    const double noise = 1e-9 * largest;
+    if (parts == 0) return false;
     const detail::CertificateBlame blame(lp, d);
-    const double margin = blame.margin(fixer.state().value, fixer.state().rhs);
-    if (!(margin > noise)) return false;
+    // Each part's certificate scaled to margin 1 here (the solvers' scales are their own), so that
+    // weights compare across parts; a part's that proves nothing on this state is dropped.
+    {
+      const std::vector<double> m = blame.margins(fixer.state().value, fixer.state().rhs, part, parts);
+      for (int64_t i = 0; i < lp.rows(); ++i)
+        if (part[i] >= 0) d[i] = m[part[i]] > 0.0 ? d[i] / m[part[i]] : 0.0;
+    }
+    double largest = 0.0;
+    for (double v : d) largest = std::max(largest, std::abs(v));
+    const double noise = 1e-9 * largest;
+    // Proved infeasible while any part's margin is above the noise; their sum steers the release.
+    const auto standing = [&](double* sum) {
+      const std::vector<double> m = blame.margins(fixer.state().value, fixer.state().rhs, part, parts);
+      bool any = false;
+      *sum = 0.0;
+      for (double v : m)
+        if (v > noise) {
+          any = true;
+          *sum += v;
+        }
+      return any;
+    };
+    double margin = 0.0;
+    if (!standing(&margin)) return false;
     const size_t base = history.front().mark;
     std::vector<size_t> starts;
     for (const Step& st : history) starts.push_back(st.mark - base);
@@ -1616,8 +1647,7 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
       if (chosen.empty()) break;
       out.insert(chosen.begin(), chosen.end());
       rebuild_without(out);
-      now = blame.margin(fixer.state().value, fixer.state().rhs);
-      if (!(now > noise)) {
+      if (!standing(&now)) {
         ++backtracks;
         std::vector<int64_t> ones;  // (a released fixing to 0 says nothing against a 1 there)
         for (const Step& st : before)
@@ -1625,9 +1655,9 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
             if (a.second == 1 && out.count(a.first)) ones.push_back(a.first);
         refuted.insert(ones.begin(), ones.end());
         if (options.remember_refuted) failed_from.blamed(detail::state_hash(fixer.state().value), ones);
-        spdlog::debug("rounding: the proof's margin {:.4g} outweighs what undoing the last fixing frees ({:.4g}): "
-                      "released {} fixings that carry it in {} pass(es) (its margin now {:.4g})",
-                      margin, w.step.back(), out.size(), pass + 1, now);
+        spdlog::debug("rounding: the proof's margin ({} part(s), each scaled to 1) outweighs what undoing the last "
+                      "fixing frees ({:.4g}): released {} fixings that carry it in {} pass(es)",
+                      parts, w.step.back(), out.size(), pass + 1);
         info.certificate_released = static_cast<int64_t>(out.size());
         info.fixed_to_one = fixer.state().ones - ones_before;
         info.fixed_to_zero = fixer.state().zeros - zeros_before;
@@ -1963,6 +1993,7 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
       if (joined.r.status == LpStatus::Infeasible) {
         joined.proof = joined.r.y;
         joined.certificate = detail::oriented_certificate(red.lp, joined.r.y);
+        if (!joined.certificate.empty()) joined.certificate_part.assign(joined.certificate.size(), 0);
       }
       params.snapshot = {};  // (it refers to this block)
     } else {
@@ -2091,7 +2122,7 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
         away = fixings_away_from(lp, fixer.state().value, blame.empty() ? failed : blame, history.back().batch,
                                  fixer.assigned_since(history.back().mark), &touched);
       const bool proven = r.status == LpStatus::Infeasible;
-      if (proven && release_by_certificate(red, joined.certificate, info)) {
+      if (proven && release_by_certificate(red, joined, info)) {
         // (released where the proof lies: neither a trim of the last fixing nor a release around a part)
       } else if (touched == 0 && !proven && cap_scale < kMaxCapScale) {
         cap_scale = std::min(2.0 * cap_scale, kMaxCapScale);

@@ -38,6 +38,8 @@ struct JoinedSolve {
   // The infeasible parts' proofs that are Farkas certificates, each oriented so that its rate is
   // positive (oriented_certificate), zero elsewhere; empty where no part is infeasible.
   std::vector<double> certificate;
+  // Per row, which of those certificates it carries (0, 1, … in the order found; −1: none).
+  std::vector<int32_t> certificate_part;
   bool suspect = false;
   int64_t parts = 1, exact_parts = 0;
   // Every row of the parts that are infeasible (or, where none is, suspect), in the LP's
