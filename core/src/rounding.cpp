@@ -1553,14 +1553,13 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
   // LP the same proof still refutes: release instead the fixings, of whatever step, that carry
   // the margin, heaviest first, until the proof no longer holds (checked on the state after them;
   // where it still does, the fixings weighed again there, up to 8 passes), keeping every other
-  // fixing in its step. The
-  // released fixings to 1 are not made again from the state after the release (remember_refuted),
-  // nor, while anything else remains, until a backtrack. Measured, TOSCA_r horse0-horse5 at full
+  // fixing in its step. The released fixings to 1 are not made again from the state after the
+  // release (remember_refuted), nor, while anything else remains, until a backtrack. Measured, TOSCA_r horse0-horse5 at full
   // resolution (seventy-ninth session's log, without it): proofs blamed 18 of 75, 3 of 57 and 1 of
   // 54 of the last fixings in turn, 5-15 minutes of zero-cost solving each, and the LP stayed
   // infeasible. False, with the fixings as they were, where no part's proof is a Farkas certificate
   // (a costed first-order proof, a part with no ray), the last fixing may carry its margin, or
-  // nothing releasable does. `certificate`: JoinedSolve::certificate, over red's rows.
+  // nothing releasable does. `joined`: the round's solve (its certificate, over red's rows).
   auto release_by_certificate = [&](const Reduced& red, const JoinedSolve& joined, RoundingRound& info) {
     const std::vector<double>& certificate = joined.certificate;
     if (!options.certificate_release || history.empty() || certificate.empty() ||
