@@ -1109,6 +1109,12 @@ TEST_CASE("rounding: a certificate's margin falls by exactly the weight of each 
   // x0 fixed to 0 (weight 1): part 0 at 2 (> 1, infeasible still: x1 alone reaches 1 of 3)
   CHECK(blame_two.margins({0, -1, -1, -1}, {3, 3}, parts_of, 2) == std::vector<double>{2.0, 2.0});
   CHECK(blame_two.margin({0, -1, -1, -1}, {3, 3}) == doctest::Approx(4.0));
+  // A column in both parts' rows (as after a release joins them) counts in each with its own rows:
+  // x4 in both rows with 1 and −1, d = (1, 2): part 0 sees +1, part 1 sees −2 (nothing to take).
+  const LpProblem joined = test::dense_lp({{1, 1, 0, 0, 1}, {0, 0, 1, 1, -1}}, {3, 3}, {0, 0, 0, 0, 0});
+  const detail::CertificateBlame blame_joined(joined, both);
+  CHECK(blame_joined.margins({-1, -1, -1, -1, -1}, {3, 3}, parts_of, 2) == std::vector<double>{0.0, 2.0});
+  CHECK(blame_joined.margin({-1, -1, -1, -1, -1}, {3, 3}) == doctest::Approx(3.0));  // (Aᵀd)_4 = −1 as one
   // A proof's sign: the one whose rate is positive, none where neither is (x0 + x1 = 3 in [0, 1]).
   const LpProblem bad = test::dense_lp({{1, 1}}, {3}, {0, 0});
   CHECK(detail::oriented_certificate(bad, {-1.0}) == std::vector<double>{1.0});

@@ -38,11 +38,12 @@ public:
     if (d.size() != size_t(lp.rows())) throw std::invalid_argument("CertificateBlame: one value per row");
   }
   CertificateBlame(const LpProblem&, std::vector<double>&&) = delete;
-  // (Aᵀd)_j.
-  double pressure(int64_t j) const {
+  // (Aᵀd)_j; with `part`, over the rows of part p alone.
+  double pressure(int64_t j, const std::vector<int32_t>* part = nullptr, int32_t p = 0) const {
     double a = 0.0;
     for (uint32_t k = lp_.at.row_ptr[j]; k < lp_.at.row_ptr[j + 1]; ++k) {
       const uint32_t e = lp_.at.entry[k];
+      if (part && (*part)[col_of(e)] != p) continue;
       a += is_negative(e) ? -d_[col_of(e)] : d_[col_of(e)];
     }
     return a;
@@ -53,8 +54,9 @@ public:
     return margins(value, rhs, {}, 1).front();
   }
   // The same per part, where d joins the certificates of independent parts of the LP (`part`: per
-  // row, its part in [0, parts), −1 for none; empty: all one part): each proves its own part
-  // infeasible, and one that no longer does says nothing of the others.
+  // row, its part in [0, parts), −1 for none; empty: all one part): each, zero elsewhere, is a
+  // Farkas vector of the whole LP, and one that no longer proves it infeasible says nothing of the
+  // others. (Fixings released can join parts: a column then counts in each with its rows there.)
   std::vector<double> margins(const std::vector<int8_t>& value, const std::vector<int64_t>& rhs,
                               const std::vector<int32_t>& part, int32_t parts) const {
     std::vector<double> m(static_cast<size_t>(std::max(parts, 1)), 0.0);
@@ -67,8 +69,8 @@ public:
         if (value[col_of(lp_.a.entry[k])] < 0) free.push_back({col_of(lp_.a.entry[k]), p});
     }
     std::sort(free.begin(), free.end());
-    free.erase(std::unique(free.begin(), free.end()), free.end());  // (a column lies in one part)
-    for (const auto& [j, p] : free) m[p] -= std::max(0.0, pressure(j));
+    free.erase(std::unique(free.begin(), free.end()), free.end());
+    for (const auto& [j, p] : free) m[p] -= std::max(0.0, pressure(j, part.empty() ? nullptr : &part, p));
     return m;
   }
   // What freeing column j, fixed to v, takes off the margin.
