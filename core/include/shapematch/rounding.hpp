@@ -153,12 +153,15 @@ struct RoundingOptions {
   // the pair's first completed run; docs/results-log.md, thirtieth session).
   int release_after_trims = 0;
   // Where an LP after fixings is proved infeasible by a Farkas certificate whose margin outweighs
-  // everything undoing the last fixing could take off it (so that LP would be infeasible too),
-  // release the fixings of any step that carry the margin, heaviest first, until the certificate
-  // no longer holds, instead of trimming the last fixing (certificate_blame.hpp). Measured, TOSCA_r
-  // horse0-horse5 at full resolution (seventy-ninth session, without it): after a round from a
-  // capped LP, trims of the last fixing by proof blamed 18 of 75, 3 of 57 and 1 of 54 fixings in
-  // turn, each after 5-15 minutes of zero-cost solving, until the stuck rule widened the level.
+  // everything undoing the last fixing could take off it (so the LP before that fixing is
+  // infeasible too), release the fixings of any step that carry the margin, heaviest first, until
+  // the certificate no longer holds, instead of trimming the last fixing (certificate_blame.hpp).
+  // Why: TOSCA_r horse0-horse5 at full resolution (seventy-ninth session's log, without it): after
+  // a round from a capped LP, trims of the last fixing by proof blamed 18 of 75, 3 of 57 and 1 of
+  // 54 fixings in turn, each after 5-15 minutes of zero-cost solving, until the stuck rule widened
+  // the level. Measured at test scale only (the rounding tests' cycle carried in steps: 3 rounds
+  // and one infeasible LP against 5 and two); not yet seen firing at 3 000 faces or above
+  // (docs/results-log.md, eightieth session).
   bool certificate_release = true;
   int max_backtracks = 200;    // fixings undone after an infeasible LP (each one more, smaller LP
                                // solve) since the last round with fewer free variables than any
