@@ -1094,11 +1094,10 @@ TEST_CASE("rounding: a certificate's margin falls by exactly the weight of each 
   CHECK(w.decision[0] == std::pair<int64_t, double>{0, 4.0});
   CHECK(w.decision[1] == std::pair<int64_t, double>{4, 1.0});
   // The heaviest first, up to the margin; none that weighs nothing.
-  const auto sorted = detail::by_weight(w.decision);
-  CHECK(detail::heaviest_decisions(sorted, 1.0) == std::vector<int64_t>{0});
-  CHECK(detail::heaviest_decisions(sorted, 4.5) == std::vector<int64_t>{0, 4});
-  CHECK(detail::heaviest_decisions(detail::by_weight({{7, 0.0}, {8, 2.0}}), 5.0) == std::vector<int64_t>{8});
-  CHECK(detail::heaviest_decisions(detail::by_weight({{7, 0.0}}), 5.0).empty());
+  CHECK(detail::heaviest_decisions(w.decision, 1.0) == std::vector<int64_t>{0});
+  CHECK(detail::heaviest_decisions(w.decision, 4.5) == std::vector<int64_t>{0, 4});
+  CHECK(detail::heaviest_decisions({{7, 0.0}, {8, 2.0}}, 5.0) == std::vector<int64_t>{8});
+  CHECK(detail::heaviest_decisions({{7, 0.0}}, 5.0).empty());
   // Two independent parts' certificates in one d (x0 + x1 = 3, x2 + x3 = 3, both in [0, 1]): each
   // has its own margin, and freeing a fixing of one leaves the other's.
   const LpProblem two = test::dense_lp({{1, 1, 0, 0}, {0, 0, 1, 1}}, {3, 3}, {0, 0, 0, 0});

@@ -112,23 +112,18 @@ TrailWeights trail_weights(const CertificateBlame& blame, Trail&& trail, const s
   return w;
 }
 
-// The decisions to release first, out of `sorted` (by_weight): the heaviest, until their weights
-// add up to the margin (at least one), of those that weigh anything at all.
-inline std::vector<int64_t> heaviest_decisions(const std::vector<std::pair<int64_t, double>>& sorted, double margin) {
+// The decisions to release first: the heaviest (ties in trail order), until their weights add up
+// to the margin (at least one), of those that weigh anything at all.
+inline std::vector<int64_t> heaviest_decisions(std::vector<std::pair<int64_t, double>> decisions, double margin) {
+  std::stable_sort(decisions.begin(), decisions.end(), [](const auto& p, const auto& q) { return p.second > q.second; });
   std::vector<int64_t> out;
   double sum = 0.0;
-  for (const auto& [j, wj] : sorted) {
+  for (const auto& [j, wj] : decisions) {
     if (!(wj > 0.0) || (!out.empty() && sum >= margin)) break;
     out.push_back(j);
     sum += wj;
   }
   return out;
-}
-
-// `decisions` heaviest first (ties in trail order), for heaviest_decisions.
-inline std::vector<std::pair<int64_t, double>> by_weight(std::vector<std::pair<int64_t, double>> decisions) {
-  std::stable_sort(decisions.begin(), decisions.end(), [](const auto& p, const auto& q) { return p.second > q.second; });
-  return decisions;
 }
 
 }  // namespace shapematch::detail

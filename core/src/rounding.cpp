@@ -1642,7 +1642,7 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
     double now = margin;
     detail::TrailWeights weights = w;
     for (int pass = 0; pass < kPasses; ++pass) {
-      const std::vector<int64_t> chosen = detail::heaviest_decisions(detail::by_weight(weights.decision), now);
+      const std::vector<int64_t> chosen = detail::heaviest_decisions(weights.decision, now);
       if (chosen.empty()) break;
       out.insert(chosen.begin(), chosen.end());
       rebuild_without(out);
