@@ -49,6 +49,7 @@ struct MatchArgs {
   bool remember_refuted = RoundingOptions{}.remember_refuted;
   bool certificate_release = RoundingOptions{}.certificate_release;
   int64_t search_below = RoundingOptions{}.search_below;
+  bool search_backjump = RoundingOptions{}.search_backjump;
   bool converged_first = RoundingOptions{}.converged_first;
   double exact_pivots_per_column = RoundingOptions{}.exact_pivots_per_column;
   double exact_part_seconds = RoundingOptions{}.exact_part_seconds;
@@ -277,6 +278,7 @@ int run_match(const MatchArgs& args) {
   ro.remember_refuted = args.remember_refuted;
   ro.certificate_release = args.certificate_release;
   ro.search_below = args.search_below;
+  ro.search_backjump = args.search_backjump;
   ro.stuck_stalled = args.stuck_stalled;
   ro.converged_first = args.converged_first;
   ro.exact_pivots_per_column = args.exact_pivots_per_column;
@@ -542,6 +544,7 @@ int run_match(const MatchArgs& args) {
                               .set("remember_refuted", args.remember_refuted)
                               .set("certificate_release", args.certificate_release)
                               .set("search_below", args.search_below)
+                              .set("search_backjump", args.search_backjump)
                               .set("converged_first", args.converged_first)
                               .set("exact_pivots_per_column", args.exact_pivots_per_column)
                               .set("exact_part_seconds", args.exact_part_seconds)
@@ -799,6 +802,9 @@ Action add_match_command(CLI::App& app) {
                  "search over exact LPs, releasing the fixings around a part without a binary solution (0: never)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
+  app.add_flag("--search-backjump,!--no-search-backjump", a->search_backjump,
+               "where both values of a search's branch have failed, go back to the deepest decision that the "
+               "failures' proofs need, not one level up (default on)");
   app.add_option("--later-round-iterations", a->later_round_iterations,
                  "LP iterations of a rounding round after the first, at most this many times the first LP's (at "
                  "least 2000; then it fixes from its iterate); 0: no limit")

@@ -6,6 +6,7 @@
 #include "certificate_blame.hpp"
 #include "failed_from.hpp"
 #include "failing_again.hpp"
+#include "part_search.hpp"
 #include "release_reach.hpp"
 #include "solve_in_parts.hpp"
 #include "test_helpers.hpp"
@@ -2544,4 +2545,302 @@ TEST_CASE("rounding: the budget of undone fixings counts since the last round wi
   CHECK(undone >= 4);
   options.max_backtracks = 2;
   CHECK_THROWS_AS(round_to_graph_surface(space, lp, cost, options), InfeasibleError);
+}
+
+namespace {
+
+// `blocks` independent patches that each branch at a fractional vertex with both values viable,
+// then a core with no binary solution, its columns last (ties in branching go to the lowest
+// column, so the blocks are decided first). Block: x1 + x2 + e1 = 1, x2 + x3 + e2 = 1,
+// x3 + x1 + e3 = 1, the e costing 1 (the LP's only optimum is x = 1/2). Core `pigeons` false: an
+// odd cycle c1 + c2 = c2 + c3 = c3 + c1 = 1, each value of c1 refuted by propagation. True: c
+// and two gadgets of three pigeons, two holes and two extra holes, whose capacity is 1 − c in
+// the first and c in the second (the LP needs c = 1/2); either value of c closes one gadget's
+// extra holes, which propagation sees, and leaves three pigeons in two holes, which only the LP
+// does (Clp's ray).
+LpProblem blocks_then_core(int blocks, bool pigeons) {
+  std::vector<std::vector<std::pair<int, int>>> rows;  // (column, ±1)
+  std::vector<double> b, c;
+  const auto column = [&](double cost) {
+    c.push_back(cost);
+    return static_cast<int>(c.size()) - 1;
+  };
+  for (int k = 0; k < blocks; ++k) {
+    const int x = column(0), y = column(0), z = column(0);
+    const int e1 = column(1), e2 = column(1), e3 = column(1);
+    rows.push_back({{x, 1}, {y, 1}, {e1, 1}});
+    rows.push_back({{y, 1}, {z, 1}, {e2, 1}});
+    rows.push_back({{z, 1}, {x, 1}, {e3, 1}});
+    b.insert(b.end(), {1, 1, 1});
+  }
+  if (!pigeons) {
+    const int c1 = column(0), c2 = column(0), c3 = column(0);
+    rows.push_back({{c1, 1}, {c2, 1}});
+    rows.push_back({{c2, 1}, {c3, 1}});
+    rows.push_back({{c3, 1}, {c1, 1}});
+    b.insert(b.end(), {1, 1, 1});
+  } else {
+    const int cc = column(0);
+    for (int gadget = 0; gadget < 2; ++gadget) {
+      int x[3][4];  // pigeon p in hole h (h1, h2, then the extra w1, w2)
+      for (int p = 0; p < 3; ++p)
+        for (int h = 0; h < 4; ++h)
+          x[p][h] = column((p == 0 && h == 0) || (p == 1 && h == 1) ? 0.0 : p == 2 && h >= 2 ? 1.0 : 5.0);
+      for (int p = 0; p < 3; ++p) {
+        rows.push_back({{x[p][0], 1}, {x[p][1], 1}, {x[p][2], 1}, {x[p][3], 1}});
+        b.push_back(1);
+      }
+      for (int h = 0; h < 4; ++h) {
+        rows.push_back({{x[0][h], 1}, {x[1][h], 1}, {x[2][h], 1}, {column(0), 1}});
+        if (h < 2) b.push_back(1);
+        else if (gadget == 0) {
+          rows.back().push_back({cc, 1});  // capacity 1 − c
+          b.push_back(1);
+        } else {
+          rows.back().push_back({cc, -1});  // capacity c
+          b.push_back(0);
+        }
+      }
+    }
+  }
+  std::vector<std::vector<int>> dense(rows.size(), std::vector<int>(c.size(), 0));
+  for (size_t i = 0; i < rows.size(); ++i)
+    for (const auto& [j, v] : rows[i]) dense[i][j] = v;
+  return test::dense_lp(dense, b, c);
+}
+
+}  // namespace
+
+TEST_CASE("rounding: the search jumps back over decisions that its failures' proofs do not need") {
+  constexpr int kBlocks = 6;
+  for (const bool pigeons : {false, true}) {
+    CAPTURE(pigeons);
+    const LpProblem lp = blocks_then_core(kBlocks, pigeons);
+    auto clp = make_solver("clp-dual");
+    std::vector<int8_t> value;
+    int64_t jumping = 0, stepping = 0;
+    detail::SearchStats with, without;
+    CHECK(detail::search_part(lp, *clp, {}, 100000, value, jumping, nullptr, true, &with) == detail::SearchEnd::none);
+    CHECK(detail::search_part(lp, *clp, {}, 100000, value, stepping, nullptr, false, &without) ==
+          detail::SearchEnd::none);
+    MESSAGE("blocks then ", std::string(pigeons ? "pigeons" : "an odd cycle"), ": ", jumping, " nodes jumping back (",
+            with.failures, " failures, ", with.short_nogoods, " short proofs, ", with.jumps, " jumps over ",
+            with.levels_skipped, " levels), ", stepping, " nodes stepping back");
+    // Jumping: the blocks are decided once, the core fails both ways, and its proofs need none of
+    // them. Stepping back tries the core again under all 2^6 combinations of the blocks.
+    CHECK(jumping <= kBlocks + 3);
+    CHECK(with.short_nogoods == 2);
+    CHECK(with.jumps == 1);
+    CHECK(with.levels_skipped == kBlocks);
+    CHECK(stepping >= (1 << kBlocks));
+    CHECK(without.jumps == 0);
+    CHECK(without.short_nogoods == 0);
+  }
+}
+
+TEST_CASE("rounding: the search's verdicts, jumping back or not, match brute force") {
+  // Random systems of three or four independent gadgets over shuffled columns: an odd cycle with
+  // costly escapes (a fractional optimum, both values of a branch viable), an odd cycle without
+  // (no binary solution), and small random blocks (mostly +1 entries as in a matching's rows,
+  // some −1) with a planted binary solution or none. `found` must satisfy A x = b; the verdicts
+  // must match the search that steps back one level at a time, and brute force where there are
+  // at most 16 columns.
+  std::mt19937 rng(81);
+  auto clp = make_solver("clp-dual");
+  int feasible = 0, infeasible = 0, brute = 0;
+  int64_t nodes_with = 0, nodes_without = 0;
+  detail::SearchStats stats;
+  for (int trial = 0; trial < 600; ++trial) {
+    std::vector<std::vector<std::pair<int, int>>> rows;  // gadget-local columns, in order of creation
+    std::vector<double> b, cost;
+    const auto column = [&](double c) {
+      cost.push_back(c + 0.01 * static_cast<double>(rng() % 10));
+      return static_cast<int>(cost.size()) - 1;
+    };
+    // Every other trial: one system of sparse rows over all its columns (3-5 entries each, as a
+    // matching's rows are), planted or with one right-hand side off by one, where a decision's
+    // effect reaches across the system (the gadgets are independent of each other).
+    if (trial % 2) {
+      const int n = trial % 4 == 1 ? 13 + static_cast<int>(rng() % 4) : 40, m = n * 2 / 3;
+      std::vector<int> cols(n), planted(n);
+      for (int j = 0; j < n; ++j) {
+        cols[j] = column(static_cast<double>(rng() % 4));
+        planted[j] = rng() % 3 == 0;
+      }
+      for (int r = 0; r < m; ++r) {
+        std::vector<int> pick(cols);
+        std::shuffle(pick.begin(), pick.end(), rng);
+        pick.resize(3 + rng() % 3);
+        std::vector<std::pair<int, int>> row;
+        int sum = 0;
+        for (int j : pick) {
+          row.push_back({j, rng() % 10 == 0 ? -1 : 1});
+          sum += row.back().second * planted[j];
+        }
+        rows.push_back(row);
+        b.push_back(sum);
+      }
+      if (rng() % 2) b[rng() % m] += 1.0;
+    }
+    const int gadgets = trial % 2 ? 0 : 3 + static_cast<int>(rng() % 3);
+    std::vector<int> escapes;  // a column of each odd cycle with escapes
+    for (int g = 0; g < gadgets; ++g) {
+      const unsigned kind = rng() % 10;
+      if (kind < 4) {  // odd cycle with escapes
+        const int x = column(0), y = column(0), z = column(0), e1 = column(1), e2 = column(1), e3 = column(1);
+        rows.push_back({{x, 1}, {y, 1}, {e1, 1}});
+        rows.push_back({{y, 1}, {z, 1}, {e2, 1}});
+        rows.push_back({{z, 1}, {x, 1}, {e3, 1}});
+        b.insert(b.end(), {1, 1, 1});
+        escapes.push_back(x);
+      } else if (kind < 6) {  // odd cycle, with an escape u set by earlier cycles' x where there are some
+        const int x = column(0), y = column(0), z = column(0);
+        rows.push_back({{x, 1}, {y, 1}});
+        rows.push_back({{y, 1}, {z, 1}});
+        rows.push_back({{z, 1}, {x, 1}});
+        b.insert(b.end(), {1, 1, 1});
+        if (escapes.size() >= 2 && rng() % 2) {  // u = 2 − x − x' (a propagation that needs both)
+          const int u = column(0);
+          rows[rows.size() - 3].push_back({u, 1});
+          const size_t one = rng() % escapes.size(), other = (one + 1 + rng() % (escapes.size() - 1)) % escapes.size();
+          rows.push_back({{u, 1}, {escapes[one], 1}, {escapes[other], 1}});
+          b.push_back(2);
+        } else if (!escapes.empty()) {
+          const int u = column(0);
+          rows[rows.size() - 3].push_back({u, 1});
+          rows.push_back({{u, 1}, {escapes[rng() % escapes.size()], 1}});
+          b.push_back(1);
+        }
+      } else {  // random, planted or not
+        const bool plant = kind < 9;
+        std::vector<int> cols, planted;
+        for (int k = 0; k < 5; ++k) {
+          cols.push_back(column(static_cast<double>(rng() % 4)));
+          planted.push_back(static_cast<int>(rng() % 2));
+        }
+        for (int r = 0; r < 3; ++r) {
+          std::vector<std::pair<int, int>> row;
+          int sum = 0;
+          for (int k = 0; k < 5; ++k) {
+            const unsigned u = rng() % 10;
+            if (u > 4) continue;
+            row.push_back({cols[k], u == 0 ? -1 : 1});
+            sum += row.back().second * planted[k];
+          }
+          rows.push_back(row);
+          b.push_back(plant ? sum : 1.0);
+        }
+      }
+    }
+    const int n = static_cast<int>(cost.size()), m = static_cast<int>(rows.size());
+    std::vector<int> where(n);  // shuffled: the branching order mixes the gadgets
+    std::iota(where.begin(), where.end(), 0);
+    std::shuffle(where.begin(), where.end(), rng);
+    std::vector<std::vector<int>> a(m, std::vector<int>(n, 0));
+    std::vector<double> c(n);
+    for (int i = 0; i < m; ++i)
+      for (const auto& [j, v] : rows[i]) a[i][where[j]] = v;
+    for (int j = 0; j < n; ++j) c[where[j]] = cost[j];
+    const LpProblem lp = test::dense_lp(a, b, c);
+    CAPTURE(trial);
+    std::vector<int8_t> value;
+    detail::SearchEnd end[2];
+    for (const bool backjump : {true, false}) {
+      CAPTURE(backjump);
+      int64_t nodes = 0;
+      end[backjump] =
+          detail::search_part(lp, *clp, {}, 100000, value, nodes, nullptr, backjump, backjump ? &stats : nullptr);
+      (backjump ? nodes_with : nodes_without) += nodes;
+      REQUIRE(end[backjump] != detail::SearchEnd::node_limit);
+      if (end[backjump] == detail::SearchEnd::found) {
+        REQUIRE(value.size() == size_t(n));
+        for (int i = 0; i < m; ++i) {
+          int s = 0;
+          for (int j = 0; j < n; ++j) s += a[i][j] * value[j];
+          CHECK(s == static_cast<int>(b[i]));
+        }
+      }
+    }
+    const bool found = end[1] == detail::SearchEnd::found;
+    CHECK(found == (end[0] == detail::SearchEnd::found));
+    (found ? feasible : infeasible) += 1;
+    if (n <= 16) {
+      ++brute;
+      bool exists = false;
+      for (uint32_t x = 0; x < (1u << n) && !exists; ++x) {
+        bool ok = true;
+        for (int i = 0; i < m && ok; ++i) {
+          int s = 0;
+          for (int j = 0; j < n; ++j) s += a[i][j] * static_cast<int>((x >> j) & 1u);
+          ok = s == static_cast<int>(b[i]);
+        }
+        exists = ok;
+      }
+      CHECK(found == exists);
+    }
+  }
+  MESSAGE(feasible, " with a binary solution, ", infeasible, " without, ", brute, " checked by brute force; nodes ",
+          nodes_with, " jumping back (", stats.failures, " failures, ", stats.short_nogoods, " short proofs, ",
+          stats.jumps, " jumps over ", stats.levels_skipped, " levels), ", nodes_without, " stepping back");
+  CHECK(feasible >= 80);
+  CHECK(infeasible >= 80);
+  CHECK(brute >= 40);
+  CHECK(stats.jumps >= 20);  // (the verdicts above are checked where jumps were made)
+  CHECK(nodes_with < nodes_without);
+}
+
+TEST_CASE("rounding: the search checks a shorter proof on its decisions alone") {
+  // u + p + q = 2, v = q (through h: q + h = v + h = 1), and two gadgets of three pigeons, two
+  // holes and two extra holes of capacity u and v (the LP needs each at least 1/2; a binary
+  // solution, 1). Costs p 1, q 2: the LP's optimum has p = q = 1/2, branched first, p before q.
+  // p = 1, then q = 1 sets u = 0 (that needs both), and the first gadget's LP has no solution;
+  // its ray weighs on what u = 0 closed, made at q's level, and on nothing of p's. Taken alone,
+  // q = 1 leaves u free and the ray proves nothing: the failure needs p too. q = 0 then fails in
+  // the second gadget, needing q alone. Going back over p on the strength of the short proof would
+  // end in "none"; the only solution has p = 0, q = 1.
+  std::vector<std::vector<std::pair<int, int>>> rows;
+  std::vector<double> b, c;
+  const auto column = [&](double cost) {
+    c.push_back(cost);
+    return static_cast<int>(c.size()) - 1;
+  };
+  const int p = column(1), q = column(2), u = column(0), h = column(0), v = column(0);
+  rows.push_back({{u, 1}, {p, 1}, {q, 1}});
+  b.push_back(2);
+  rows.push_back({{q, 1}, {h, 1}});
+  rows.push_back({{v, 1}, {h, 1}});
+  b.insert(b.end(), {1, 1});
+  for (const int capacity : {u, v}) {
+    int x[3][4];
+    for (int i = 0; i < 3; ++i)
+      for (int k = 0; k < 4; ++k) x[i][k] = column((i == 0 && k == 0) || (i == 1 && k == 1) ? 0.0 : i == 2 && k >= 2 ? 1.0 : 5.0);
+    for (int i = 0; i < 3; ++i) {
+      rows.push_back({{x[i][0], 1}, {x[i][1], 1}, {x[i][2], 1}, {x[i][3], 1}});
+      b.push_back(1);
+    }
+    for (int k = 0; k < 4; ++k) {
+      rows.push_back({{x[0][k], 1}, {x[1][k], 1}, {x[2][k], 1}, {column(0), 1}});
+      if (k >= 2) rows.back().push_back({capacity, -1});
+      b.push_back(k < 2 ? 1 : 0);
+    }
+  }
+  std::vector<std::vector<int>> dense(rows.size(), std::vector<int>(c.size(), 0));
+  for (size_t i = 0; i < rows.size(); ++i)
+    for (const auto& [j, s] : rows[i]) dense[i][j] = s;
+  const LpProblem lp = test::dense_lp(dense, b, c);
+  auto clp = make_solver("clp-dual");
+  for (const bool backjump : {true, false}) {
+    CAPTURE(backjump);
+    std::vector<int8_t> value;
+    int64_t nodes = 0;
+    detail::SearchStats stats;
+    REQUIRE(detail::search_part(lp, *clp, {}, 1000, value, nodes, nullptr, backjump, &stats) ==
+            detail::SearchEnd::found);
+    CHECK(value[p] == 0);
+    CHECK(value[q] == 1);
+    CHECK(value[u] == 1);
+    MESSAGE(nodes, " nodes, ", stats.failures, " failures, ", stats.short_nogoods, " short proofs, ", stats.jumps,
+            " jumps");
+    if (backjump) CHECK(stats.failures >= 2);
+  }
 }

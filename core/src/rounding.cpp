@@ -4,6 +4,7 @@
 #include "failing_again.hpp"
 #include "release_reach.hpp"
 #include "certificate_blame.hpp"
+#include "part_search.hpp"
 #include "solve_in_parts.hpp"
 
 #include "shapematch/errors.hpp"
@@ -26,6 +27,8 @@
 #include <unordered_set>
 
 namespace shapematch {
+using detail::SearchEnd;
+using detail::search_part;
 namespace {
 
 // The fixing state: each variable free (−1), 0 or 1, and for every row its residual right-hand
@@ -1048,38 +1051,105 @@ std::vector<std::pair<int64_t, int>> away_from_undecided(const LpProblem& lp, co
   return out;
 }
 
-// How a depth-first search for a binary solution of one part ended. `infeasible`: the part's LP
-// itself, at the root, has no solution (its fixings are wrong as an LP round would find them).
-enum class SearchEnd { found, none, node_limit, infeasible };
+}  // namespace
 
-// A binary solution of A x = b (one part of a late round's LP), by depth-first search: at each
-// node the exact LP over what is still free; an integral optimum ends it, otherwise it branches
-// on the largest fractional variable, 1 before 0, with propagation after every fixing. Complete:
-// `none` is a proof that no binary solution exists (the fixings around the part are wrong),
-// `infeasible` one that not even the LP has a solution. `value` gets one 0/1 per column on `found`.
-// With `root`, the root node's LP result is kept there, or taken from there where it holds one (a
-// search that goes on from a call that stopped after the root solves it once).
-SearchEnd search_part(const LpProblem& plp, LpSolver& exact, const SolverParams& params, int64_t max_nodes,
-                      std::vector<int8_t>& value, int64_t& nodes, std::optional<LpResult>* root = nullptr) {
+detail::SearchEnd detail::search_part(const LpProblem& plp, LpSolver& exact, const SolverParams& params, int64_t max_nodes,
+                              std::vector<int8_t>& value, int64_t& nodes, std::optional<LpResult>* root, bool backjump,
+                              SearchStats* stats) {
+  SearchStats local;
+  SearchStats& st = stats ? *stats : local;
   Fixer f(plp);
   if (!f.propagate_all()) return SearchEnd::none;
   struct Branch {
     size_t mark;
     int64_t col;
-    int value;  // the value being tried: 1 first, then 0
+    int value;                      // the value being tried: 1 first, then 0
+    std::vector<int32_t> conflict;  // levels below whose decisions its failed values needed
   };
   std::vector<Branch> stack;
-  // Back to the deepest branch with a value left to try; false where none is.
-  const auto retreat = [&] {
+  // The proof of a failed propagation: the row it stopped at, whose free entries can no longer
+  // reach its right-hand side (d = ±e_i; empty where that row does not show it).
+  const auto row_proof = [&] {
+    std::vector<double> d;
+    const int64_t i = f.failed_row();
+    if (i < 0 || i >= plp.rows()) return d;
+    const FixState& s = f.state();
+    const double sign = s.rhs[i] > s.free_pos[i] ? 1.0 : s.rhs[i] < -s.free_neg[i] ? -1.0 : 0.0;
+    if (sign != 0.0) {
+      d.assign(plp.rows(), 0.0);
+      d[i] = sign;
+    }
+    return d;
+  };
+  // The levels below the top whose decisions, with the top's, the proof `d` (one value per row of
+  // plp, on the state as it stands) needs: those it weighs anything on, where their decisions
+  // propagated afresh from the root still leave it a positive margin; else all of them.
+  const auto needed = [&](const std::vector<double>& d) {
+    ++st.failures;
+    const int32_t top = static_cast<int32_t>(stack.size()) - 1;
+    std::vector<int32_t> all(static_cast<size_t>(top));
+    std::iota(all.begin(), all.end(), 0);
+    if (!backjump || d.empty() || top == 0) return all;
+    const CertificateBlame blame(plp, d);
+    double largest = 0.0;
+    for (double v : d) largest = std::max(largest, std::abs(v));
+    const double noise = 1e-9 * largest;
+    const FixState& s = f.state();
+    if (!(blame.margin(s.value, s.rhs) > noise)) return all;
+    std::vector<double> weight(all.size(), 0.0);
+    size_t t = stack.front().mark, level = 0;
+    f.visit_since(stack.front().mark, [&](int64_t j, bool) {
+      while (level + 1 < stack.size() && t >= stack[level + 1].mark) ++level;
+      ++t;
+      if (level < all.size()) weight[level] += blame.weight(j, s.value[j]);
+    });
+    std::vector<int32_t> some;
+    for (int32_t l = 0; l < top; ++l)
+      if (weight[l] > 0.0) some.push_back(l);
+    if (some.size() == all.size()) return all;
+    Fixer g(plp);
+    bool holds = !g.propagate_all();
+    for (int32_t l : some) holds = holds || !g.fix({{stack[l].col, stack[l].value}});
+    holds = holds || !g.fix({{stack.back().col, stack.back().value}});
+    holds = holds || blame.margin(g.state().value, g.state().rhs) > noise;
+    if (!holds) return all;
+    ++st.short_nogoods;
+    return some;
+  };
+  // The top branch's value has failed, needing the decisions of levels `why`: the next value to
+  // try. Where both have failed, the decisions their failures needed alone leave no solution:
+  // back to the deepest of them (the levels between are not tried again), whose value has then
+  // failed needing the others. False where none is left: no binary solution.
+  const auto retreat = [&](std::vector<int32_t> why) {
     while (!stack.empty()) {
       Branch& b = stack.back();
+      b.conflict.insert(b.conflict.end(), why.begin(), why.end());
+      std::sort(b.conflict.begin(), b.conflict.end());
+      b.conflict.erase(std::unique(b.conflict.begin(), b.conflict.end()), b.conflict.end());
       f.undo_to(b.mark);
       if (b.value == 1) {
         b.value = 0;
         if (f.fix({{b.col, 0}})) return true;
-        f.undo_to(b.mark);
+        why = needed(row_proof());
+        continue;
       }
+      why = std::move(b.conflict);
       stack.pop_back();
+      if (why.empty()) {  // the root's state alone leaves none
+        if (!stack.empty()) {
+          ++st.jumps;
+          st.levels_skipped += static_cast<int64_t>(stack.size());
+        }
+        return false;
+      }
+      const size_t deepest = static_cast<size_t>(why.back());
+      if (deepest + 1 < stack.size()) {
+        ++st.jumps;
+        st.levels_skipped += static_cast<int64_t>(stack.size() - deepest - 1);
+        f.undo_to(stack[deepest + 1].mark);
+        stack.resize(deepest + 1);
+      }
+      why.pop_back();
     }
     return false;
   };
@@ -1088,7 +1158,7 @@ SearchEnd search_part(const LpProblem& plp, LpSolver& exact, const SolverParams&
     for (int64_t j = 0; j < plp.cols(); ++j) value[j] = f.state().value[j] == 1 ? 1 : 0;
     return SearchEnd::found;
   };
-  for (bool alive = true;; alive = true) {
+  for (;;) {
     if (f.state().unsatisfied == 0) return finish();  // what is still free is 0
     if (++nodes > max_nodes) return SearchEnd::node_limit;
     const Reduced red = reduce(plp, f.state());
@@ -1098,31 +1168,39 @@ SearchEnd search_part(const LpProblem& plp, LpSolver& exact, const SolverParams&
     const LpResult s = at_root ? **root : exact.solve(red.lp, params);
     if (s.status == LpStatus::Infeasible) {
       if (stack.empty()) return SearchEnd::infeasible;
-      alive = false;
-    } else if (s.status != LpStatus::Optimal || s.x.size() != red.cols.size()) {
-      return SearchEnd::node_limit;  // no answer: as good as running out of nodes
-    } else {
-      constexpr double kIntegral = 1e-6;
-      int64_t branch = -1;
-      for (size_t k = 0; k < red.cols.size(); ++k)
-        if (s.x[k] > kIntegral && s.x[k] < 1.0 - kIntegral && (branch < 0 || s.x[k] > s.x[branch])) branch = k;
-      if (branch < 0) {  // an integral vertex: it satisfies A x = b, so it is a solution
-        std::vector<std::pair<int64_t, int>> all;
-        for (size_t k = 0; k < red.cols.size(); ++k) all.push_back({red.cols[k], s.x[k] > 0.5 ? 1 : 0});
-        const size_t mark = f.mark();
-        if (f.fix(all) && f.state().unsatisfied == 0) return finish();
-        f.undo_to(mark);  // rounding error in the vertex: branch instead
-        branch = 0;
-        for (size_t k = 1; k < red.cols.size(); ++k)
-          if (std::abs(s.x[k] - 0.5) < std::abs(s.x[branch] - 0.5)) branch = k;
+      std::vector<double> d;  // the solver's ray, on plp's rows
+      if (backjump) {
+        const std::vector<double> y = oriented_certificate(red.lp, s.y);
+        if (!y.empty()) {
+          d.assign(plp.rows(), 0.0);
+          for (size_t i = 0; i < red.rows.size(); ++i) d[red.rows[i]] = y[i];
+        }
       }
-      stack.push_back({f.mark(), red.cols[branch], 1});
-      alive = f.fix({{red.cols[branch], 1}});
+      if (!retreat(needed(d))) return SearchEnd::none;
+      continue;
     }
-    if (!alive && !retreat()) return SearchEnd::none;
+    if (s.status != LpStatus::Optimal || s.x.size() != red.cols.size())
+      return SearchEnd::node_limit;  // no answer: as good as running out of nodes
+    constexpr double kIntegral = 1e-6;
+    int64_t branch = -1;
+    for (size_t k = 0; k < red.cols.size(); ++k)
+      if (s.x[k] > kIntegral && s.x[k] < 1.0 - kIntegral && (branch < 0 || s.x[k] > s.x[branch])) branch = k;
+    if (branch < 0) {  // an integral vertex: it satisfies A x = b, so it is a solution
+      std::vector<std::pair<int64_t, int>> all;
+      for (size_t k = 0; k < red.cols.size(); ++k) all.push_back({red.cols[k], s.x[k] > 0.5 ? 1 : 0});
+      const size_t mark = f.mark();
+      if (f.fix(all) && f.state().unsatisfied == 0) return finish();
+      f.undo_to(mark);  // rounding error in the vertex: branch instead
+      branch = 0;
+      for (size_t k = 1; k < red.cols.size(); ++k)
+        if (std::abs(s.x[k] - 0.5) < std::abs(s.x[branch] - 0.5)) branch = k;
+    }
+    stack.push_back({f.mark(), red.cols[branch], 1, {}});
+    if (!f.fix({{red.cols[branch], 1}}) && !retreat(needed(row_proof()))) return SearchEnd::none;
   }
 }
 
+namespace {
 // The columns within `depth` row-column-row steps of `rows` in the LP's graph (fixed or free):
 // the neighbourhood whose fixings are released where a part has no binary solution.
 std::vector<char> columns_near(const LpProblem& lp, const std::vector<int64_t>& rows, int depth) {
@@ -1694,10 +1772,11 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
     std::vector<SearchEnd> root(parts.size());
     std::vector<std::optional<LpResult>> root_lp(parts.size());  // each solved once
     std::vector<std::vector<int8_t>> value(parts.size());
+    detail::SearchStats stats;
     for (size_t k = 0; k < parts.size(); ++k) {
       const LpProblem& plp = whole ? red.lp : parts[k].lp;
       int64_t one = 0;
-      root[k] = search_part(plp, *search_solver, base_params, 1, value[k], one, &root_lp[k]);
+      root[k] = search_part(plp, *search_solver, base_params, 1, value[k], one, &root_lp[k], options.search_backjump);
       nodes += one;
       if (root[k] == SearchEnd::infeasible) {
         spdlog::debug("rounding: a part of {} variables has no LP solution at its search's root: solved as a round "
@@ -1711,7 +1790,8 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
       const LpProblem& plp = whole ? red.lp : part.lp;
       SearchEnd end = root[k];
       if (end == SearchEnd::node_limit)
-        end = search_part(plp, *search_solver, base_params, options.search_nodes, value[k], nodes, &root_lp[k]);
+        end = search_part(plp, *search_solver, base_params, options.search_nodes, value[k], nodes, &root_lp[k],
+                          options.search_backjump, &stats);
       if (end == SearchEnd::found) {
         ++info.searched_parts;
         for (size_t j = 0; j < part.cols.size(); ++j) found.push_back({red.cols[part.cols[j]], value[k][j]});
@@ -1739,7 +1819,10 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
     for (int64_t j = 0; j < lp.cols(); ++j)
       if (fixer.state().value[j] == 1) cost += lp.c[j];
     info.objective = lp.objective_scale * cost;
-    spdlog::debug("rounding: searched {} parts in {} nodes, {} finished", parts.size(), nodes, info.searched_parts);
+    spdlog::debug("rounding: searched {} parts in {} nodes, {} finished; {} failed nodes, {} proved by fewer than all "
+                  "decisions above, {} jumps over {} levels",
+                  parts.size(), nodes, info.searched_parts, stats.failures, stats.short_nogoods, stats.jumps,
+                  stats.levels_skipped);
     return true;
   };
   int64_t fewest_free = std::numeric_limits<int64_t>::max();

@@ -141,6 +141,10 @@ struct RoundingOptions {
   int64_t search_below = 20000;
   int search_stall = 3;
   int64_t search_nodes = 2000;
+  // The search goes back, where both values of a branch have failed, to the deepest decision
+  // that the failures' proofs needed (their Farkas rays, or the rows propagation stopped at,
+  // checked on those decisions alone), not to the one above it. False: back one level at a time.
+  bool search_backjump = true;
   int max_releases = 12;
   // Where a part's LP has failed after this many trims of the last fixing in a row (each failure
   // sharing a row with the next), release the fixings around it (as above) instead of trimming
