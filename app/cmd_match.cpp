@@ -50,6 +50,7 @@ struct MatchArgs {
   bool certificate_release = RoundingOptions{}.certificate_release;
   int64_t search_below = RoundingOptions{}.search_below;
   bool search_backjump = RoundingOptions{}.search_backjump;
+  bool search_proof_release = RoundingOptions{}.search_proof_release;
   bool converged_first = RoundingOptions{}.converged_first;
   double exact_pivots_per_column = RoundingOptions{}.exact_pivots_per_column;
   double exact_part_seconds = RoundingOptions{}.exact_part_seconds;
@@ -279,6 +280,7 @@ int run_match(const MatchArgs& args) {
   ro.certificate_release = args.certificate_release;
   ro.search_below = args.search_below;
   ro.search_backjump = args.search_backjump;
+  ro.search_proof_release = args.search_proof_release;
   ro.stuck_stalled = args.stuck_stalled;
   ro.converged_first = args.converged_first;
   ro.exact_pivots_per_column = args.exact_pivots_per_column;
@@ -346,7 +348,10 @@ int run_match(const MatchArgs& args) {
       spdlog::info("{}round {:>2}: {:>9} variables{}, searched: {} parts finished in {} nodes, net fixed {} to 1 and "
                    "{} to 0{} ({:.2f} s)",
                    at, r.round, r.variables, parts, r.searched_parts, r.iterations, r.fixed_to_one, r.fixed_to_zero,
-                   r.released > 0 ? fmt::format(", released {} fixings around the rest", r.released) : std::string(),
+                   r.search_proof_released > 0
+                       ? fmt::format(", released {} fixings that the proofs of the rest rest on", r.released)
+                   : r.released > 0 ? fmt::format(", released {} fixings around the rest", r.released)
+                                    : std::string(),
                    r.seconds);
       return;
     }
@@ -479,6 +484,7 @@ int run_match(const MatchArgs& args) {
                       .set("searched_parts", r.searched_parts)
                       .set("released", r.released)
                       .set("certificate_released", r.certificate_released)
+                      .set("search_proof_released", r.search_proof_released)
                       .set("seconds", r.seconds));
     Json report = Json::object();
     auto shape = [](const std::string& file, int input_vertices, const Mesh& mesh) {
@@ -545,6 +551,7 @@ int run_match(const MatchArgs& args) {
                               .set("certificate_release", args.certificate_release)
                               .set("search_below", args.search_below)
                               .set("search_backjump", args.search_backjump)
+                              .set("search_proof_release", args.search_proof_release)
                               .set("converged_first", args.converged_first)
                               .set("exact_pivots_per_column", args.exact_pivots_per_column)
                               .set("exact_part_seconds", args.exact_part_seconds)
@@ -805,6 +812,9 @@ Action add_match_command(CLI::App& app) {
   app.add_flag("--search-backjump,!--no-search-backjump", a->search_backjump,
                "where both values of a search's branch have failed, go back to the deepest decision that the "
                "failures' proofs need, not one level up (default on)");
+  app.add_flag("--search-proof-release,!--no-search-proof-release", a->search_proof_release,
+               "where the search proves a part without a binary solution, release the fixings outside it that its "
+               "proofs rest on, not every fixing within 2, 4, 8 ... LP steps of it (default on)");
   app.add_option("--later-round-iterations", a->later_round_iterations,
                  "LP iterations of a rounding round after the first, at most this many times the first LP's (at "
                  "least 2000; then it fixes from its iterate); 0: no limit")

@@ -2844,3 +2844,41 @@ TEST_CASE("rounding: the search checks a shorter proof on its decisions alone") 
     if (backjump) CHECK(stats.failures >= 2);
   }
 }
+
+TEST_CASE("rounding: a search's proofs release the fixings they rest on, not all near the part") {
+  // odd_cycle_behind_a with b beside it: a + a' = 1, x_i + x_j + a' = 1 (a' costs 10), b + b' = 1
+  // (b' costs 10) and a' + b + s + s2 = 2 (s, s2 cost 1). Round 1 fixes a and b; the x then form
+  // an odd cycle, which the search proves has no binary solution. Its proofs (the rows where
+  // propagation stops) rest on a' = 0, which a's fixing set; b lies within two LP steps of the
+  // cycle (through a') and carries nothing. From the proofs only a goes; from the neighbourhood,
+  // a and b.
+  const LpProblem lp = test::dense_lp({{1, 1, 0, 0, 0, 0, 0, 0, 0},
+                                       {0, 1, 1, 1, 0, 0, 0, 0, 0},
+                                       {0, 1, 0, 1, 1, 0, 0, 0, 0},
+                                       {0, 1, 1, 0, 1, 0, 0, 0, 0},
+                                       {0, 0, 0, 0, 0, 1, 1, 0, 0},
+                                       {0, 1, 0, 0, 0, 1, 0, 1, 1}},
+                                      {1, 1, 1, 1, 1, 2}, {0, 10, 0, 0, 0, 0, 10, 1, 1});
+  const Mesh m = shapes::icosphere(0);
+  const auto id = identity_matching(m);
+  REQUIRE(id.size() >= 9);
+  const ProductSpace space = ProductSpace::from_list(m, m, {id.begin(), id.begin() + 9});
+  RoundingOptions options = search_without_backtracking();
+  int64_t released[2] = {0, 0}, by_proofs[2] = {0, 0};
+  for (const bool proofs : {true, false}) {
+    CAPTURE(proofs);
+    options.search_proof_release = proofs;
+    const RoundingResult r = round_to_graph_surface(space, lp, lp.c, options);
+    CHECK(satisfies_exactly(lp, r.gamma));
+    CHECK(r.energy == 10.0);  // a' (then b = 1, s = s2 = 0)
+    REQUIRE(r.rounds.size() >= 2);
+    CHECK(r.rounds[0].fixed_to_one >= 2);  // a and b
+    CHECK(r.rounds[1].search);
+    released[proofs] = r.rounds[1].released;
+    by_proofs[proofs] = r.rounds[1].search_proof_released;
+  }
+  CHECK(released[1] == 1);
+  CHECK(by_proofs[1] == 1);
+  CHECK(released[0] >= 2);
+  CHECK(by_proofs[0] == 0);
+}

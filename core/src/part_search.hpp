@@ -20,6 +20,16 @@ struct SearchStats {
   int64_t levels_skipped = 0;  // the levels those retreats passed over
 };
 
+// One failed node's proof, where the search ends in `none`: a Farkas vector `d` over the part's
+// rows (sparse: row, value), positive margin on the part's root state with `decisions` (column,
+// value) and their propagation. Each holds with the part's fixings as they stand; all together
+// are the search's proof, and the fixings outside the part that their margins rest on are the
+// ones to release (rounding.cpp).
+struct SearchProof {
+  std::vector<std::pair<int64_t, double>> d;
+  std::vector<std::pair<int64_t, int>> decisions;
+};
+
 // A binary solution of A x = b (one part of a late round's LP), by depth-first search: at each
 // node the exact LP over what is still free; an integral optimum ends it, otherwise it branches
 // on the largest fractional variable, 1 before 0, with propagation after every fixing. Complete:
@@ -35,8 +45,11 @@ struct SearchStats {
 // decision that either failure needed, not to the one above it (conflict-directed backjumping):
 // a part's remainder is a handful of patches, and a dead end in one was otherwise searched again
 // under every combination of the decisions made in the others.
+//
+// With `proofs`, on `none`, every failure's proof, each with the decisions it needs; emptied where
+// one failure had none to give (then the search proved nothing that says where to release).
 SearchEnd search_part(const LpProblem& plp, LpSolver& exact, const SolverParams& params, int64_t max_nodes,
                       std::vector<int8_t>& value, int64_t& nodes, std::optional<LpResult>* root = nullptr,
-                      bool backjump = true, SearchStats* stats = nullptr);
+                      bool backjump = true, SearchStats* stats = nullptr, std::vector<SearchProof>* proofs = nullptr);
 
 }  // namespace shapematch::detail

@@ -145,6 +145,10 @@ struct RoundingOptions {
   // that the failures' proofs needed (their Farkas rays, or the rows propagation stopped at,
   // checked on those decisions alone), not to the one above it. False: back one level at a time.
   bool search_backjump = true;
+  // Where the search proves parts without a binary solution (every failure with a Farkas vector),
+  // release the fixings outside them that those proofs rest on, rather than every fixing within
+  // 2, 4, 8 … LP steps of them (which stays the fallback). False: always the latter.
+  bool search_proof_release = true;
   int max_releases = 12;
   // Where a part's LP has failed after this many trims of the last fixing in a row (each failure
   // sharing a row with the next), release the fixings around it (as above) instead of trimming
@@ -400,6 +404,8 @@ struct RoundingRound {
   bool search = false;         // finished by search (search_below), not by an LP
   int64_t released = 0;        // fixings released around parts without a binary solution (search)
                                // or around a failed part no fixing of the last round touched
+  int64_t search_proof_released = 0;  // fixings released that a search's proofs rest on
+                                      // (RoundingOptions::search_proof_release; also in released)
   int64_t certificate_released = 0;  // fixings released where an infeasibility proof lies
                                      // (RoundingOptions::certificate_release)
 };
