@@ -1801,21 +1801,61 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
   auto release_by_search_proofs = [&](const std::vector<detail::SearchProof>& proofs, int* used) -> int64_t {
     *used = 0;
     if (!options.search_proof_release || history.empty() || proofs.empty()) return 0;
-    std::vector<char> in_rows(lp.cols(), 0);  // the columns of the proofs' rows
-    for (const auto& proof : proofs)
-      for (const auto& [i, v] : proof.d)
-        for (uint32_t k = lp.a.row_ptr[i]; k < lp.a.row_ptr[i + 1]; ++k) in_rows[col_of(lp.a.entry[k])] = 1;
     std::vector<double> d(lp.rows(), 0.0);
     const detail::CertificateBlame blame(lp, d);
+    std::vector<int32_t> owner;           // per column: the decision it came from (an index), −1: none
+    std::vector<int64_t> decision_cols;  // those decisions' columns
+    // The columns assigned before `mark` that the assignment of column j after it (by the
+    // propagation of `decided`) rests on: the earlier assignments of a row that forced it, and
+    // theirs in turn, back to before `mark` (at most a few thousand visited).
+    const auto explain = [&](int64_t j, const std::unordered_map<int64_t, int64_t>& at,
+                             const std::unordered_set<int64_t>& decided, std::vector<int64_t>& outside) {
+      const FixState& st = fixer.state();
+      const auto position = [&](int64_t k) -> int64_t {  // −1: before mark; max: free
+        if (st.value[k] < 0) return std::numeric_limits<int64_t>::max();
+        const auto it = at.find(k);
+        return it == at.end() ? -1 : it->second;
+      };
+      std::vector<int64_t> queue{j};
+      std::unordered_set<int64_t> seen{j};
+      while (!queue.empty() && seen.size() < 4096) {
+        const int64_t k = queue.back();
+        queue.pop_back();
+        if (decided.count(k)) continue;
+        const int64_t pk = position(k);
+        for (uint32_t q = lp.at.row_ptr[k]; q < lp.at.row_ptr[k + 1]; ++q) {
+          const int64_t i = col_of(lp.at.entry[q]);
+          int64_t r = std::llround(lp.b[i]), pos = 0, neg = 0;
+          for (uint32_t e = lp.a.row_ptr[i]; e < lp.a.row_ptr[i + 1]; ++e) {
+            const int64_t c = col_of(lp.a.entry[e]);
+            if (c == k || position(c) > pk) ++(is_negative(lp.a.entry[e]) ? neg : pos);
+            else if (st.value[c] == 1) r -= is_negative(lp.a.entry[e]) ? -1 : 1;
+          }
+          if (r != pos && r != -neg) continue;  // (as Fixer::propagate decides)
+          const bool plus_is_one = r == pos && !(r == -neg && pos == 0);
+          if (((is_negative(lp.at.entry[q]) != plus_is_one) ? 1 : 0) != st.value[k]) continue;
+          for (uint32_t e = lp.a.row_ptr[i]; e < lp.a.row_ptr[i + 1]; ++e) {
+            const int64_t c = col_of(lp.a.entry[e]);
+            const int64_t pc = position(c);
+            if (c == k || pc >= pk) continue;
+            if (pc < 0) outside.push_back(c);
+            else if (seen.insert(c).second) queue.push_back(c);
+          }
+          break;  // one reason is enough
+        }
+      }
+    };
     // The decisions to release, on the fixings as they stand, for the proofs that still hold
-    // (`standing`) and can be broken from outside (`breakable`).
+    // (`standing`) and can be broken from outside (`breakable`). A fixed column of a proof's row
+    // weighs on the decision it came from; one that the proof's own decisions propagated, on each
+    // decision behind the assignments its propagation rested on.
     const auto weigh = [&](int* standing, int* breakable) {
       *standing = *breakable = 0;
-      std::unordered_map<int64_t, int64_t> owner;  // column of the proofs' rows -> the decision it came from
-      int64_t current = -1;
+      owner.assign(lp.cols(), -1);
+      decision_cols.clear();
       fixer.visit_since(history.front().mark, [&](int64_t j, bool fixed) {
-        if (fixed) current = j;
-        if (in_rows[j] && current >= 0) owner[j] = current;
+        if (fixed) decision_cols.push_back(j);
+        if (!decision_cols.empty()) owner[j] = static_cast<int32_t>(decision_cols.size() - 1);
       });
       std::vector<int64_t> chosen;
       for (const auto& proof : proofs) {
@@ -1831,18 +1871,28 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
         for (const auto& a : proof.decisions)
           if (!fixer.fix({a})) break;
         const double margin = blame.margin_over(rows, fixer.state().value, fixer.state().rhs);
-        std::unordered_map<int64_t, double> weight;  // per decision outside the part
+        std::unordered_map<int64_t, double> weight;  // per decision outside the part (its column)
         double total = 0.0;
         if (margin > 1e-9 * largest) {
+          std::unordered_map<int64_t, int64_t> at;  // the assignments since mark: their order
+          fixer.visit_since(mark, [&](int64_t j, bool) { at.emplace(j, static_cast<int64_t>(at.size())); });
+          std::unordered_set<int64_t> decided;
+          for (const auto& a : proof.decisions) decided.insert(a.first);
           std::unordered_set<int64_t> seen;
           for (int64_t i : rows)
             for (uint32_t k = lp.a.row_ptr[i]; k < lp.a.row_ptr[i + 1]; ++k) {
               const int64_t j = col_of(lp.a.entry[k]);
-              const auto it = owner.find(j);
-              if (it == owner.end() || fixer.state().value[j] < 0 || !seen.insert(j).second) continue;
+              if (fixer.state().value[j] < 0 || !seen.insert(j).second) continue;
               const double w = blame.weight(j, fixer.state().value[j]);
-              weight[it->second] += w;
-              total += w;
+              if (!(w > 0.0)) continue;
+              std::vector<int64_t> outside;
+              if (!at.count(j)) outside.push_back(j);
+              else explain(j, at, decided, outside);
+              std::unordered_set<int64_t> behind;
+              for (int64_t c : outside)
+                if (owner[c] >= 0) behind.insert(decision_cols[owner[c]]);
+              for (int64_t o : behind) weight[o] += w;
+              if (!behind.empty()) total += w;
             }
         }
         fixer.undo_to(mark);
