@@ -1840,6 +1840,16 @@ TEST_CASE("rounding: a release reaches further only where the same part fails ag
   r.released({9}, 64);
   CHECK(r.first_depth({9}) == 64);    // no further than 64 to start with
   CHECK(r.first_depth({}) == 2);
+  CHECK(r.same_part({9, 1}));
+  CHECK_FALSE(r.same_part({1}));
+  // A release of the fixings a search's proofs rest on (depth 1): where the same part fails
+  // again, the releases within 2, 4 … steps follow.
+  r.released({3, 1}, 1);
+  CHECK(r.same_part({1}));
+  CHECK(r.first_depth({1}) == 2);
+  r.released({1}, 2);
+  CHECK(r.first_depth({1}) == 4);
+  CHECK_FALSE(detail::ReleaseReach{}.same_part({1}));
 }
 
 TEST_CASE("rounding: fixings a proof blamed are remembered at the state they were made from") {

@@ -23,13 +23,18 @@ public:
 
   // The depth a release around rows holding the columns `cols` starts from.
   int first_depth(const std::vector<int64_t>& cols) const {
-    if (depth_ == 0) return kFirst;
-    for (int64_t j : cols)
-      if (std::binary_search(last_cols_.begin(), last_cols_.end(), j))
-        return std::min(2 * depth_, kLargestFirst);
-    return kFirst;
+    return same_part(cols) ? std::max(kFirst, std::min(2 * depth_, kLargestFirst)) : kFirst;
   }
-  // A release was made around rows holding the columns `cols`, reaching `depth` steps.
+  // Whether rows holding the columns `cols` share one with the last release's (the same part
+  // failing again).
+  bool same_part(const std::vector<int64_t>& cols) const {
+    if (depth_ == 0) return false;
+    for (int64_t j : cols)
+      if (std::binary_search(last_cols_.begin(), last_cols_.end(), j)) return true;
+    return false;
+  }
+  // A release was made around rows holding the columns `cols`, reaching `depth` steps (1: the
+  // fixings a search's proofs rest on, before any release within 2 steps).
   void released(std::vector<int64_t> cols, int depth) {
     std::sort(cols.begin(), cols.end());
     cols.erase(std::unique(cols.begin(), cols.end()), cols.end());

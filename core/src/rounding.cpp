@@ -2021,8 +2021,16 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
     if (!stuck.empty()) {
       info.undone = true;
       int used = 0;
-      if (all_proved) info.released = release_by_search_proofs(stuck_proofs, &used);
+      // First where a part fails (a release by proofs is cheap and local); where the same part
+      // fails again, the releases within 2, 4, 8 … steps follow as before (measured, horse0-horse5
+      // at full resolution: released by proofs each time, the same part failed again 4-9 rounds
+      // later, five times, 8-16 fixings each, until max_releases widened the level).
+      std::vector<int64_t> cols;
+      for (int64_t i : stuck)
+        for (uint32_t k = lp.a.row_ptr[i]; k < lp.a.row_ptr[i + 1]; ++k) cols.push_back(col_of(lp.a.entry[k]));
+      if (all_proved && !reach.same_part(cols)) info.released = release_by_search_proofs(stuck_proofs, &used);
       if (info.released > 0) {
+        reach.released(std::move(cols), 1);
         info.search_proof_released = info.released;
         spdlog::debug("rounding: released {} fixings that {} of the search's {} proofs rest on", info.released, used,
                       stuck_proofs.size());
