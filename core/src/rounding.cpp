@@ -1200,7 +1200,7 @@ detail::SearchEnd detail::search_part(const LpProblem& plp, LpSolver& exact, con
     if (s.status == LpStatus::Infeasible) {
       if (stack.empty()) return SearchEnd::infeasible;
       std::vector<double> d;  // the solver's ray, on plp's rows
-      if (backjump) {
+      if (backjump || proofs) {
         const std::vector<double> y = oriented_certificate(red.lp, s.y);
         if (!y.empty()) {
           d.assign(plp.rows(), 0.0);
@@ -1660,10 +1660,12 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
   // The steps `before` (history as it was; `step_of`: each decision's step there) again without
   // the decisions `out`, from the first step that holds one (fewer fixings propagate to a subset
   // of a consistent state, so each goes through whole).
+  // (`from`: the decisions whose first step to start at, where not `out`'s: putting back what
+  // a release took out starts where it did.)
   const auto rebuild = [&](const std::vector<Step>& before, const std::unordered_map<int64_t, size_t>& step_of,
-                           const std::unordered_set<int64_t>& out) {
+                           const std::unordered_set<int64_t>& out, const std::unordered_set<int64_t>* from = nullptr) {
     size_t first = before.size();
-    for (int64_t j : out)
+    for (int64_t j : from ? *from : out)
       if (const auto it = step_of.find(j); it != step_of.end()) first = std::min(first, it->second);
     if (first == before.size()) first = 0;
     fixer.undo_to(before[first].mark);
@@ -1780,7 +1782,7 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
       weights = detail::trail_weights(
           blame, [&](auto&& visit) { fixer.visit_since(base, visit); }, fixer.state().value, at);
     }
-    rebuild_without({});  // the same steps again
+    rebuild(before, step_of, {}, &out);  // the same steps again
     if (fixer.state().ones != ones_before || fixer.state().zeros != zeros_before)
       throw SolverError("rounding: the fixings made again after a release attempt differ (a bug)");
     spdlog::debug("rounding: no release of up to {} fixings that carry the proof's margin {:.4g} breaks it", out.size(),
@@ -1920,7 +1922,7 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
     // again, the same search and release every 4 rounds).
     std::unordered_set<int64_t> out;
     int standing = 0, breakable = 0;
-    for (int pass = 0; pass < 8; ++pass) {
+    for (int pass = 0; pass < 8 && !history.empty(); ++pass) {
       const std::vector<int64_t> chosen = weigh(&standing, &breakable);
       if (pass == 0) *used = breakable;
       const size_t had = out.size();
@@ -1930,7 +1932,7 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
     }
     if (out.empty()) return 0;
     if (fixer.state().ones == ones_before && fixer.state().zeros == zeros_before) {
-      rebuild(before, step_of, {});  // nothing changed: the same steps again, and the other release
+      rebuild(before, step_of, {}, &out);  // nothing changed: the same steps again, and the other release
       if (fixer.state().ones != ones_before || fixer.state().zeros != zeros_before)
         throw SolverError("rounding: the fixings made again after a release attempt differ (a bug)");
       return 0;
