@@ -51,6 +51,7 @@ struct MatchArgs {
   int64_t search_below = RoundingOptions{}.search_below;
   bool search_backjump = RoundingOptions{}.search_backjump;
   bool search_proof_release = RoundingOptions{}.search_proof_release;
+  int release_reach_cap = RoundingOptions{}.release_reach_cap;
   bool converged_first = RoundingOptions{}.converged_first;
   double exact_pivots_per_column = RoundingOptions{}.exact_pivots_per_column;
   double exact_part_seconds = RoundingOptions{}.exact_part_seconds;
@@ -281,6 +282,7 @@ int run_match(const MatchArgs& args) {
   ro.search_below = args.search_below;
   ro.search_backjump = args.search_backjump;
   ro.search_proof_release = args.search_proof_release;
+  ro.release_reach_cap = args.release_reach_cap;
   ro.stuck_stalled = args.stuck_stalled;
   ro.converged_first = args.converged_first;
   ro.exact_pivots_per_column = args.exact_pivots_per_column;
@@ -552,6 +554,7 @@ int run_match(const MatchArgs& args) {
                               .set("search_below", args.search_below)
                               .set("search_backjump", args.search_backjump)
                               .set("search_proof_release", args.search_proof_release)
+                              .set("release_reach_cap", args.release_reach_cap)
                               .set("converged_first", args.converged_first)
                               .set("exact_pivots_per_column", args.exact_pivots_per_column)
                               .set("exact_part_seconds", args.exact_part_seconds)
@@ -815,6 +818,11 @@ Action add_match_command(CLI::App& app) {
   app.add_flag("--search-proof-release,!--no-search-proof-release", a->search_proof_release,
                "where the search proves a part without a binary solution, release the fixings outside it that its "
                "proofs rest on, not every fixing within 2, 4, 8 ... LP steps of it (default on)");
+  app.add_option("--release-reach-cap", a->release_reach_cap,
+                 "where the same part fails again and the next release around it would reach beyond this many LP "
+                 "steps, call the rounding stuck there (coarse to fine widens around it) instead (0: no cap)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
   app.add_option("--later-round-iterations", a->later_round_iterations,
                  "LP iterations of a rounding round after the first, at most this many times the first LP's (at "
                  "least 2000; then it fixes from its iterate); 0: no limit")

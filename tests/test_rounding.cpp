@@ -2895,3 +2895,42 @@ TEST_CASE("rounding: a search's proofs release the fixings they rest on, not all
   CHECK(released[0] == 3);
   CHECK(by_proofs[0] == 0);
 }
+
+TEST_CASE("rounding: with a release reach cap, the same part failing again is stuck, not released further") {
+  // odd_cycle_behind_a with search only up to 3 variables and the release around parts (not by
+  // proofs): round 2's search finds the odd cycle without a binary solution and releases a
+  // within 2 steps; round 3's LP fixes a again and round 4's search finds the same cycle, whose
+  // next release would reach 4 steps. With the cap at 2 that ends the rounding there, naming the
+  // cycle's rows: an InfeasibleError, or a StuckError where stuck_after is set.
+  const LpProblem lp = odd_cycle_behind_a();
+  const ProductSpace space = five_variables();
+  RoundingOptions options = search_without_backtracking();
+  options.search_below = 3;
+  options.search_proof_release = false;
+  options.release_reach_cap = 2;
+  options.stuck_after = 0.0;
+  std::vector<RoundingRound> seen;
+  try {
+    round_to_graph_surface(space, lp, {0, 10, 0, 0, 0}, options, [&](const RoundingRound& r) { seen.push_back(r); });
+    FAIL("no InfeasibleError");
+  } catch (const StuckError&) {
+    FAIL("a StuckError without stuck_after");
+  } catch (const InfeasibleError& e) {
+    CHECK(std::string(e.what()).find("release-reach-cap") != std::string::npos);
+    CHECK(e.rows() == std::vector<int64_t>{1, 2, 3});
+  }
+  REQUIRE(seen.size() == 3);  // round 4 threw before reporting
+  CHECK(seen[1].released == 1);
+  options.stuck_after = 1e9;  // (no time-based rule fires)
+  CHECK_THROWS_AS(round_to_graph_surface(space, lp, {0, 10, 0, 0, 0}, options), StuckError);
+  // Without the cap, the release reaches 4 steps (nothing more within reach: a again) and the
+  // rounding goes on until max_releases.
+  options.release_reach_cap = 0;
+  options.stuck_after = 0.0;
+  try {
+    round_to_graph_surface(space, lp, {0, 10, 0, 0, 0}, options);
+    FAIL("no InfeasibleError");
+  } catch (const InfeasibleError& e) {
+    CHECK(std::string(e.what()).find("releases") != std::string::npos);
+  }
+}

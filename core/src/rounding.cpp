@@ -1617,7 +1617,23 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
   // With `refute`, the released fixings to 1 join those not tried again while anything else
   // remains (the LP after the release would often pick them again: they came from its optimum;
   // and where two alternatives each fail, refuting only the last released swaps them forever).
-  auto release_around = [&](const std::vector<int64_t>& rows, bool refute) {
+  // Where the same part fails again and the next release would reach beyond release_reach_cap
+  // steps: its rows, and no release (the rounding loop then calls itself stuck).
+  std::vector<int64_t> reach_capped;
+  const auto columns_of = [&](const std::vector<int64_t>& rows) {  // (a part's: does it fail again?)
+    std::vector<int64_t> cols;
+    for (int64_t i : rows)
+      for (uint32_t k = lp.a.row_ptr[i]; k < lp.a.row_ptr[i + 1]; ++k) cols.push_back(col_of(lp.a.entry[k]));
+    return cols;
+  };
+  auto release_around = [&](const std::vector<int64_t>& rows, bool refute) -> int64_t {
+    if (options.release_reach_cap > 0 && !history.empty()) {
+      const std::vector<int64_t> part_cols = columns_of(rows);
+      if (reach.same_part(part_cols) && reach.first_depth(part_cols) > options.release_reach_cap) {
+        reach_capped = rows;
+        return 0;
+      }
+    }
     if (++releases > options.max_releases || history.empty())
       throw InfeasibleError("rounding: no binary solution around a part after " + std::to_string(releases - 1) +
                                 " releases of the fixings near it",
@@ -1625,10 +1641,7 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
     constexpr int kMaxDepth = 1 << 12;
     int64_t all = 0;  // fixings made so far
     for (const Step& st : history) all += static_cast<int64_t>(st.batch.size());
-    std::vector<int64_t> cols;  // the columns of the part's rows: does it fail again?
-    for (int64_t i : rows)
-      for (uint32_t k = lp.a.row_ptr[i]; k < lp.a.row_ptr[i + 1]; ++k)
-        cols.push_back(col_of(lp.a.entry[k]));
+    std::vector<int64_t> cols = columns_of(rows);
     for (int depth = reach.first_depth(cols); depth <= kMaxDepth; depth *= 2) {
       const std::vector<char> near = columns_near(lp, rows, depth);
       std::vector<std::pair<int64_t, int>> kept;
@@ -2027,9 +2040,7 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
       // fails again, the releases within 2, 4, 8 … steps follow as before (measured, horse0-horse5
       // at full resolution: released by proofs each time, the same part failed again 4-9 rounds
       // later, five times, 8-16 fixings each, until max_releases widened the level).
-      std::vector<int64_t> cols;
-      for (int64_t i : stuck)
-        for (uint32_t k = lp.a.row_ptr[i]; k < lp.a.row_ptr[i + 1]; ++k) cols.push_back(col_of(lp.a.entry[k]));
+      std::vector<int64_t> cols = columns_of(stuck);
       if (all_proved && !reach.same_part(cols)) info.released = release_by_search_proofs(stuck_proofs, &used);
       if (info.released > 0) {
         reach.released(std::move(cols), 1);
@@ -2097,6 +2108,14 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
     std::vector<int64_t> ones = decisions(steps);
     return StuckError(what, std::move(rows), std::move(ones), x_full, y_full, std::move(steps));
   };
+  // A part that failed again where the release would reach beyond release_reach_cap: stuck there.
+  const auto throw_if_reach_capped = [&] {
+    if (reach_capped.empty()) return;
+    const std::string what = "rounding: the same part failed again after releases reaching " +
+                             std::to_string(options.release_reach_cap) + " steps around it (--release-reach-cap)";
+    if (options.stuck_after > 0.0) throw stuck(what, std::move(reach_capped));
+    throw InfeasibleError(what, std::move(reach_capped));
+  };
   // The round's iterate over the whole LP, the next round's warm start.
   const auto keep_iterate = [&](const Reduced& red, const JoinedSolve& joined) {
     const LpResult& r = joined.r;
@@ -2153,6 +2172,7 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
       info.constraints = red.lp.rows();
       info.search = true;
       if (search_round(red, info)) {
+        throw_if_reach_capped();
         ++forward;
         if (info.undone) {
           // A release frees far more than the rounds after it fix at once: the stall rule starts
@@ -2457,6 +2477,7 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
                       touched == 0 ? "away from the last fixing" : "again after a trim", failed.size(),
                       proof_rows.size());
         info.released = release_around(around, true);
+        throw_if_reach_capped();
         info.fixed_to_one = fixer.state().ones - ones;
         info.fixed_to_zero = fixer.state().zeros - zeros;
         // A release frees far more than the next rounds fix at once; measured from the low
