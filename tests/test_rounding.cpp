@@ -2922,7 +2922,13 @@ TEST_CASE("rounding: with a release reach cap, the same part failing again is st
   REQUIRE(seen.size() == 3);  // round 4 threw before reporting
   CHECK(seen[1].released == 1);
   options.stuck_after = 1e9;  // (no time-based rule fires)
-  CHECK_THROWS_AS(round_to_graph_surface(space, lp, {0, 10, 0, 0, 0}, options), StuckError);
+  try {
+    round_to_graph_surface(space, lp, {0, 10, 0, 0, 0}, options);
+    FAIL("no StuckError");
+  } catch (const StuckError& e) {
+    CHECK(std::string(e.what()).find("release-reach-cap") != std::string::npos);
+    CHECK(e.rows() == std::vector<int64_t>{1, 2, 3});
+  }
   // Without the cap, the release reaches 4 steps (nothing more within reach: a again) and the
   // rounding goes on until max_releases.
   options.release_reach_cap = 0;
@@ -2931,6 +2937,6 @@ TEST_CASE("rounding: with a release reach cap, the same part failing again is st
     round_to_graph_surface(space, lp, {0, 10, 0, 0, 0}, options);
     FAIL("no InfeasibleError");
   } catch (const InfeasibleError& e) {
-    CHECK(std::string(e.what()).find("releases") != std::string::npos);
+    CHECK(std::string(e.what()).find("releases of the fixings near it") != std::string::npos);
   }
 }

@@ -1642,7 +1642,12 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
     int64_t all = 0;  // fixings made so far
     for (const Step& st : history) all += static_cast<int64_t>(st.batch.size());
     std::vector<int64_t> cols = columns_of(rows);
+    const bool again = reach.same_part(cols);
     for (int depth = reach.first_depth(cols); depth <= kMaxDepth; depth *= 2) {
+      if (again && options.release_reach_cap > 0 && depth > options.release_reach_cap) {  // (nothing nearer)
+        reach_capped = rows;
+        return 0;
+      }
       const std::vector<char> near = columns_near(lp, rows, depth);
       std::vector<std::pair<int64_t, int>> kept;
       for (const Step& st : history)

@@ -150,7 +150,8 @@ struct RoundingOptions {
   // 2, 4, 8 … LP steps of them (which stays the fallback). False: always the latter.
   bool search_proof_release = true;
   // Where the same part fails again and the next release around it would reach beyond this many
-  // LP steps, the rounding is stuck there instead (a StuckError naming the part's rows where
+  // LP steps (where it starts, or where nothing nearer was left to release), the rounding is
+  // stuck there instead (a StuckError naming the part's rows where
   // stuck_after is set, else an InfeasibleError): coarse to fine widens around it. A release
   // that reaches far frees most fixings (measured, TOSCA_r horse0-horse5 at full resolution:
   // 9 588 of about 11 000 within 8 steps, an 8.2 M-variable LP of over an hour on one thread),
