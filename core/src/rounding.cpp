@@ -1682,6 +1682,7 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
   // a release took out starts where it did.)
   const auto rebuild = [&](const std::vector<Step>& before, const std::unordered_map<int64_t, size_t>& step_of,
                            const std::unordered_set<int64_t>& out, const std::unordered_set<int64_t>* from = nullptr) {
+    if (out.empty() && from && from->empty()) return;  // nothing was taken out: the steps are `before`
     size_t first = before.size();
     for (int64_t j : from ? *from : out)
       if (const auto it = step_of.find(j); it != step_of.end()) first = std::min(first, it->second);
