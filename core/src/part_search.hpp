@@ -14,7 +14,7 @@ namespace shapematch::detail {
 enum class SearchEnd { found, none, node_limit, infeasible };
 
 struct SearchStats {
-  int64_t failures = 0;  // nodes that failed (LP infeasible or propagation)
+  int64_t failures = 0;       // nodes that failed (LP infeasible or propagation)
   int64_t short_nogoods = 0;  // failures whose proof holds with fewer than all decisions above
   int64_t jumps = 0;          // retreats that passed over levels the failures did not depend on
   int64_t levels_skipped = 0;  // the levels those retreats passed over
@@ -47,7 +47,8 @@ struct SearchProof {
 // under every combination of the decisions made in the others.
 //
 // With `proofs`, on `none`, every failure's proof, each with the decisions it needs; emptied where
-// one failure had none to give (then the search proved nothing that says where to release).
+// one failure had none to give, or past 256 of them (then the search says nothing about where to
+// release).
 SearchEnd search_part(const LpProblem& plp, LpSolver& exact, const SolverParams& params, int64_t max_nodes,
                       std::vector<int8_t>& value, int64_t& nodes, std::optional<LpResult>* root = nullptr,
                       bool backjump = true, SearchStats* stats = nullptr, std::vector<SearchProof>* proofs = nullptr);
