@@ -1115,13 +1115,10 @@ detail::SearchEnd detail::search_part(const LpProblem& plp, LpSolver& exact, con
     const double noise = 1e-9 * largest;
     const FixState& s = f.state();
     if (!(blame.margin(s.value, s.rhs) > noise)) return keep(all);
-    std::vector<double> weight(all.size(), 0.0);
-    size_t t = stack.front().mark, level = 0;
-    f.visit_since(stack.front().mark, [&](int64_t j, bool) {
-      while (level + 1 < stack.size() && t >= stack[level + 1].mark) ++level;
-      ++t;
-      if (level < all.size()) weight[level] += blame.weight(j, s.value[j]);
-    });
+    std::vector<size_t> starts;  // each level's first position on the trail since the first
+    for (const Branch& b : stack) starts.push_back(b.mark - stack.front().mark);
+    const std::vector<double> weight =
+        trail_weights(blame, [&](auto&& visit) { f.visit_since(stack.front().mark, visit); }, s.value, starts).step;
     std::vector<int32_t> some;
     for (int32_t l = 0; l < top; ++l)
       if (weight[l] > 0.0) some.push_back(l);
@@ -1627,12 +1624,13 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
     return cols;
   };
   auto release_around = [&](const std::vector<int64_t>& rows, bool refute) -> int64_t {
-    if (options.release_reach_cap > 0 && !history.empty()) {
-      const std::vector<int64_t> part_cols = columns_of(rows);
-      if (reach.same_part(part_cols) && reach.first_depth(part_cols) > options.release_reach_cap) {
-        reach_capped = rows;
-        return 0;
-      }
+    std::vector<int64_t> cols = columns_of(rows);
+    const bool again = reach.same_part(cols);
+    // (Before the count: a capped part uses up no release.)
+    if (again && options.release_reach_cap > 0 && !history.empty() &&
+        reach.first_depth(cols) > options.release_reach_cap) {
+      reach_capped = rows;
+      return 0;
     }
     if (++releases > options.max_releases || history.empty())
       throw InfeasibleError("rounding: no binary solution around a part after " + std::to_string(releases - 1) +
@@ -1641,8 +1639,6 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
     constexpr int kMaxDepth = 1 << 12;
     int64_t all = 0;  // fixings made so far
     for (const Step& st : history) all += static_cast<int64_t>(st.batch.size());
-    std::vector<int64_t> cols = columns_of(rows);
-    const bool again = reach.same_part(cols);
     for (int depth = reach.first_depth(cols); depth <= kMaxDepth; depth *= 2) {
       if (again && options.release_reach_cap > 0 && depth > options.release_reach_cap) {  // (nothing nearer)
         reach_capped = rows;
@@ -1923,9 +1919,7 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
         if (total < margin) continue;
         ++*breakable;
         std::vector<std::pair<int64_t, double>> heavy(weight.begin(), weight.end());
-        std::sort(heavy.begin(), heavy.end(), [](const auto& a, const auto& b) {
-          return a.second != b.second ? a.second > b.second : a.first < b.first;
-        });
+        std::sort(heavy.begin(), heavy.end());  // (ties in weight: by column, whatever the map's order)
         for (const int64_t j : detail::heaviest_decisions(std::move(heavy), margin)) chosen.push_back(j);
       }
       return chosen;
