@@ -1102,6 +1102,73 @@ TEST_CASE("coarse to fine: a stuck rounding widens around its failed parts and g
   MESSAGE("ascended: energy ", la.energy, ", gap ", la.gap, ", iterations ", la.iterations, " (", l.iterations, ")");
 }
 
+TEST_CASE("coarse to fine: a stuck rounding gone on from its checkpoint still goes on from its fixings") {
+  // At full resolution a level's end game spans sittings: the rounding that gets stuck was gone on
+  // from a checkpoint, without the first LP's iterate. Its fixings still carry to the widened
+  // space (before the eighty-second session they did not: it started afresh); the widened LP's
+  // bound is then solved for cold.
+  CoarseToFineOptions o = slow_finest_rounding();
+  o.rounding.max_total_rounds = 3;
+  o.rounding.greedy_fallback = 1.0;  // (as in the test above: fixings that the widened space keeps)
+  o.rounding.alternative_thresholds = {};  // (with them a level's rounding is not saved)
+  o.rounding_checkpoint_seconds = 0.0;     // after every round
+  o.price_widenings = 0;
+  o.lookahead_levels = 0;
+  o.stuck_after = 1e-12;
+  o.stuck_carry = true;
+  const auto& [x, y] = fine_fingers();
+  const CoarseToFineMatcher matcher(x, y, o);
+  const int levels = matcher.x_levels().size();
+  std::optional<LevelCheckpoint> after_one;  // the finest level's first rounding, after its round 1
+  const CoarseToFineResult whole = matcher.run({}, nullptr, [&](const LevelCheckpoint& c) {
+    if (!after_one && int(c.levels.size()) == levels - 1 && c.attempt.rounding.rounds == 1)
+      after_one = c;
+  });
+  REQUIRE(after_one);
+  const LevelReport& w = whole.levels.back();
+  REQUIRE(w.stuck_widenings == 1);
+  REQUIRE(w.carried_fixings > 0);
+  // (A rounding gone on from a checkpoint counts its rounds afresh: two more, as the whole run had.)
+  o.rounding.max_total_rounds = 2;
+  const CoarseToFineMatcher again(x, y, o);
+  std::optional<LevelCheckpoint> carried;  // the carried start's rounding, after its round 1
+  const CoarseToFineResult r = again.run({}, &*after_one, [&](const LevelCheckpoint& c) {
+    if (!carried && int(c.levels.size()) == levels - 1 && c.attempt.report.stuck_widenings == 1 &&
+        c.attempt.rounding.rounds >= 1)
+      carried = c;
+  });
+  const LevelReport& l = r.levels.back();
+  CHECK(l.stuck_widenings == 1);
+  CHECK(l.carried_fixings > 0);     // on from the stuck rounding's fixings, not afresh
+  CHECK(l.iterations_bound > 0);    // the widened LP solved for its bound
+  CHECK(l.variables == w.variables);  // the same widened space
+  CHECK(check_graph_surface(r.finest.space, r.rounding.gamma).ok());
+  CHECK(satisfies_exactly(r.finest.lp, r.rounding.gamma));
+  CHECK(std::isfinite(l.lower_bound));
+  CHECK(l.lower_bound <= l.energy + 1e-9);
+  CHECK(l.gap < 0.05);
+  MESSAGE("gone on: carried ", l.carried_fixings, " (whole run ", w.carried_fixings, "), bound ", l.lower_bound,
+          " (whole run ", w.lower_bound, "), energy ", l.energy, " (whole run ", w.energy, "), bound iterations ",
+          l.iterations_bound, " (whole run ", w.iterations_bound, ")");
+  // The carried start is saved as it goes, without a bound of the space (its round 1 bounds only
+  // what the carried fixings leave); gone on from there, the widened LP's bound is solved for at
+  // the end, as in one run.
+  REQUIRE(carried);
+  CHECK(std::isnan(carried->attempt.rounding.lower_bound));
+  CHECK(carried->attempt.rounding.columns == l.variables);
+  const CoarseToFineResult c = again.run({}, &*carried);
+  const LevelReport& lc = c.levels.back();
+  CHECK(lc.variables == l.variables);
+  CHECK(lc.iterations_bound > 0);
+  CHECK(check_graph_surface(c.finest.space, c.rounding.gamma).ok());
+  CHECK(satisfies_exactly(c.finest.lp, c.rounding.gamma));
+  CHECK(std::isfinite(lc.lower_bound));
+  CHECK(lc.lower_bound <= lc.energy + 1e-9);
+  CHECK(lc.lower_bound == doctest::Approx(l.lower_bound).epsilon(1e-3));
+  CHECK(lc.gap < 0.05);
+  MESSAGE("gone on from the carried start: bound ", lc.lower_bound, ", energy ", lc.energy, ", rounds ", lc.rounds);
+}
+
 TEST_CASE("coarse to fine: a stuck rounding starts again from its fixings in the same space before widening") {
   // The pair of the test above, stuck after its 3 rounds: with stuck_restarts, its rounding starts
   // again from its fixings to 1 in the same LP (saved as a checkpoint would be), keeps round 1's

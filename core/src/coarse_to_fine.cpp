@@ -1542,7 +1542,10 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
       }
       // Where the rounding has got, saved as it goes and kept for a restart (not where
       // alternatives would run: a run gone on from fixings runs none).
-      const bool tracking = (attempted || restarts < options_.stuck_restarts) && l > 0 && !carrying &&
+      // (A carried start's too: at full resolution a run goes on from it in another sitting. Its
+      // round 1 bounds only what the carried fixings leave: its checkpoint holds no bound, NaN, and
+      // the widened LP's bound is solved for at its end, as here.)
+      const bool tracking = (attempted || restarts < options_.stuck_restarts) && l > 0 &&
                             (ro.alternative_thresholds.empty() || m.lp.cols() > ro.alternatives_below);
       first_bound = going_on ? going_on->lower_bound : std::numeric_limits<double>::quiet_NaN();
       rounds_so_far = tracking && going_on ? going_on->rounds : 0;  // (0: nothing to restart from)
@@ -1581,7 +1584,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
           last_steps = steps;
           last_cap = r.cap_scale;
           decisions_known = true;
-          if (r.round == 1 && !going_on) first_bound = bound;
+          if (r.round == 1 && !going_on && !carrying) first_bound = bound;
           // At most every rounding_checkpoint_seconds, and (where that is not 0) at most a twentieth
           // of the time on saves: with the warm start below one takes seconds at full resolution
           // (181 MB in 3 s at 29 M variables), where the end game's rounds take seconds each.
@@ -1666,28 +1669,36 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
                                                      first_y = {};
                                                    }
                                                  });
-      if (carrying) {
+      // A carried start gone on from its checkpoint: no bound of the space yet (NaN), as above.
+      const bool bound_after = carrying || (going_on && std::isnan(going_on->lower_bound));
+      if (bound_after) {
         // Round 1 solved only what the carried fixings left: the widened LP's bound is certified
         // from a dual of it, the first LP's mapped over (where new columns price below zero,
         // weakly: measured -1 898 against an energy of 15.6 on a test pair), or from this LP
         // solved again from the first LP's iterate, for as many iterations as that took.
         SolverParams bp = rounding_for(l).lp;
         bp.stop_on_divergence = false;
-        first.apply(m, bp);
+        first.apply(m, bp);  // (nothing where the stuck rounding was gone on from a checkpoint: cold)
         bp.max_iterations = std::min<int64_t>(bp.max_iterations, std::max<int64_t>(first_iterations, 64));
         try {
           const LpResult b = make_solver(ro.solver)->solve(m.lp, bp);
-          spdlog::info("level {}: the widened LP's bound {:.6g} (from the first LP's dual: {:.6g}), {} iterations",
-                       l + 1, b.lower_bound, rr.lower_bound, b.iterations);
+          if (first.empty())
+            spdlog::info("level {}: the widened LP's bound {:.6g} (solved cold: the first LP's iterate was not at "
+                         "hand), {} iterations",
+                         l + 1, b.lower_bound, b.iterations);
+          else
+            spdlog::info("level {}: the widened LP's bound {:.6g} (from the first LP's dual: {:.6g}), {} iterations",
+                         l + 1, b.lower_bound, rr.lower_bound, b.iterations);
           if (std::isfinite(b.lower_bound) && !(b.lower_bound <= rr.lower_bound)) rr.lower_bound = b.lower_bound;
           rep.iterations_bound = b.iterations;
         } catch (const Error& e) {  // the Γ stands; only the bound is the weaker one
-          spdlog::warn("level {}: the widened LP's bound could not be solved for ({}); the first LP's dual gives {:.6g}",
-                       l + 1, e.what(), rr.lower_bound);
+          spdlog::warn("level {}: the widened LP's bound could not be solved for ({}); {} {:.6g}", l + 1, e.what(),
+                       first.empty() ? "without the first LP's dual it stays" : "the first LP's dual gives",
+                       rr.lower_bound);
         }
         rr.gap = relative_gap(rr.energy, rr.lower_bound);
       }
-      if (going_on) {  // the same LP: its round 1's bound stands
+      if (going_on && !bound_after) {  // the same LP: its round 1's bound stands
         rr.lower_bound = going_on->lower_bound;
         rr.gap = relative_gap(rr.energy, rr.lower_bound);
       }
@@ -1744,9 +1755,11 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
         if (widen_at(m, proof, "stuck in rounding")) {
           ++rep.stuck_widenings;
           carried_ones.clear();
-          // Afresh in the widened space (also after a rounding gone on from a checkpoint, whose
-          // first LP is not at hand to certify the widened one).
-          if (!options_.stuck_carry || going_on) continue;
+          // Afresh in the widened space, or on from the stuck rounding's fixings: also after a
+          // rounding gone on from a checkpoint (the usual case at full resolution, whose end game
+          // spans sittings), whose first LP's iterate is not at hand: the widened LP's bound is
+          // then solved for cold, for as many iterations as the cold first LP took.
+          if (!options_.stuck_carry) continue;
           released_x.assign(lx.mesh.num_vertices(), 0);
           for (int f = 0; f < lx.mesh.num_faces(); ++f)
             if (extra[f] > before[f])

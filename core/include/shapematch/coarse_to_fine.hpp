@@ -237,7 +237,8 @@ struct CoarseToFineOptions {
   // 2.0 %); 021-024 likewise (gap 1.0 %): the first completed runs of those pairs.
   double stuck_after = 1.0;
   // With stuck_after: go on from the stuck rounding's fixings to 1 (less those over the faces
-  // widened) instead of starting afresh, the widened LP solved again at the end for its bound.
+  // widened) instead of starting afresh, the widened LP solved again at the end for its bound
+  // (cold where the stuck rounding was gone on from a checkpoint, or the carried attempt is).
   // Off: measured on FAUST_r 020-021, the carried attempt's LPs (2-3 M variables, capped at the
   // first LP's iterations) stayed unconverged, and its rounds failed and were trimmed for
   // 10+ minutes, where a fresh attempt finished in 7 (its first LP included).
@@ -545,7 +546,7 @@ struct LevelAttempt {
     std::vector<int32_t> steps;      // the undo step of each (parallel; version 10; empty: one step)
     int rounds = 0;                  // done, and their LP iterations
     int64_t iterations = 0;
-    double lower_bound = 0.0;        // certified by round 1
+    double lower_bound = 0.0;        // certified by round 1 (NaN for a carried start: none of the space)
     double reference_seconds = 0.0;  // round 1's cold solve (RoundingOptions::reference_*)
     int64_t reference_iterations = 0;
     double cap_scale = 1.0;          // RoundingOptions::start_cap_scale (version 12; before: 1)
