@@ -100,6 +100,7 @@ struct MatchArgs {
   int price_dual_sweeps = CoarseToFineOptions{}.price_dual_sweeps;
   double stuck_after = CoarseToFineOptions{}.stuck_after;
   bool stuck_carry = CoarseToFineOptions{}.stuck_carry;
+  int stuck_carry_margin = CoarseToFineOptions{}.stuck_carry_margin;
   int stuck_restarts = CoarseToFineOptions{}.stuck_restarts;
   double rounding_checkpoint_seconds = CoarseToFineOptions{}.rounding_checkpoint_seconds;
   double lp_checkpoint_seconds = CoarseToFineOptions{}.lp_checkpoint_seconds;
@@ -238,6 +239,7 @@ int run_match(const MatchArgs& args) {
   co.price_dual_sweeps = args.price_dual_sweeps;
   co.stuck_after = args.stuck_after;
   co.stuck_carry = args.stuck_carry;
+  co.stuck_carry_margin = args.stuck_carry_margin;
   co.stuck_restarts = args.stuck_restarts;
   co.rounding_checkpoint_seconds = args.rounding_checkpoint_seconds;
   co.lp_checkpoint_seconds = args.lp_checkpoint_seconds;
@@ -618,6 +620,7 @@ int run_match(const MatchArgs& args) {
                               .set("price_dual_sweeps", args.price_dual_sweeps)
                               .set("stuck_after", args.stuck_after)
                               .set("stuck_carry", args.stuck_carry)
+                              .set("stuck_carry_margin", args.stuck_carry_margin)
                               .set("stuck_restarts", args.stuck_restarts)
                               .set("rounding_checkpoint_seconds", args.rounding_checkpoint_seconds)
                               .set("lp_checkpoint_seconds", args.lp_checkpoint_seconds)
@@ -1071,6 +1074,11 @@ Action add_match_command(CLI::App& app) {
   app.add_flag("--stuck-carry", a->stuck_carry,
                "with --stuck-after: go on from the stuck rounding's fixings in the widened space instead of "
                "afresh (measured slower)");
+  app.add_option("--stuck-carry-margin", a->stuck_carry_margin,
+                 "with --stuck-carry: also drop the stuck rounding's fixings over the X faces within K fine rings "
+                 "of those widened")
+      ->check(CLI::Range(0, 64))
+      ->capture_default_str();
   app.add_option("--stuck-restarts", a->stuck_restarts,
                  "with --stuck-after: the first N times a level's rounding is stuck, start it again in the same "
                  "space from its fixings to 1, its other state afresh, before widening (0: off)")

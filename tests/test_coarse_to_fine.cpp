@@ -1102,6 +1102,45 @@ TEST_CASE("coarse to fine: a stuck rounding widens around its failed parts and g
   MESSAGE("ascended: energy ", la.energy, ", gap ", la.gap, ", iterations ", la.iterations, " (", l.iterations, ")");
 }
 
+TEST_CASE("coarse to fine: a stuck rounding's carried fixings leave a margin around the widened faces") {
+  // Measured on the pair above: carried right up to the widened faces, the attempt keeps the
+  // narrow space's choices next to them (energy 7.146 against 6.926 afresh); one ring of margin
+  // drops all but 2 of the 32 carried fixings and ends at the fresh attempt's energy, two or more
+  // drop them all (the widening took 68 of 120 faces here; at full resolution 243 of 9 996).
+  CoarseToFineOptions o = slow_finest_rounding();
+  o.rounding.max_total_rounds = 3;
+  o.rounding.greedy_fallback = 1.0;  // (as in the test above)
+  o.price_widenings = 0;
+  o.stuck_after = 1e-12;
+  const auto& [x, y] = fine_fingers();
+  const CoarseToFineMatcher afresh(x, y, o);  // (a result refers to its matcher's meshes)
+  const CoarseToFineResult fresh = afresh.run();
+  o.stuck_carry = true;
+  int64_t carried_before = std::numeric_limits<int64_t>::max();
+  std::map<int, LevelReport> at;
+  for (const int margin : {0, 1, 2}) {
+    CAPTURE(margin);
+    o.stuck_carry_margin = margin;
+    const CoarseToFineMatcher matcher(x, y, o);
+    const CoarseToFineResult r = matcher.run();
+    const LevelReport& l = r.levels.back();
+    CHECK(l.stuck_widenings == 1);
+    CHECK(l.variables == fresh.levels.back().variables);  // the same widened space
+    CHECK(l.carried_fixings <= carried_before);          // a wider margin drops more
+    carried_before = l.carried_fixings;
+    CHECK(check_graph_surface(r.finest.space, r.rounding.gamma).ok());
+    CHECK(satisfies_exactly(r.finest.lp, r.rounding.gamma));
+    CHECK(l.lower_bound <= l.energy + 1e-9);
+    at[margin] = l;
+    MESSAGE("margin ", margin, ": carried ", l.carried_fixings, ", energy ", l.energy, " (afresh ",
+            fresh.levels.back().energy, "), rounds ", l.rounds, ", iterations ", l.iterations, " + ",
+            l.iterations_bound, " for the bound");
+  }
+  CHECK(at[0].carried_fixings > at[1].carried_fixings);
+  CHECK(at[0].energy > fresh.levels.back().energy + 1e-3);  // what the margin is for
+  CHECK(at[1].energy == doctest::Approx(fresh.levels.back().energy).epsilon(1e-6));
+}
+
 TEST_CASE("coarse to fine: a stuck rounding gone on from its checkpoint still goes on from its fixings") {
   // At full resolution a level's end game spans sittings: the rounding that gets stuck was gone on
   // from a checkpoint, without the first LP's iterate. Its fixings still carry to the widened

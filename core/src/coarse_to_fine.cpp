@@ -1761,9 +1761,12 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
           // then solved for cold, for as many iterations as the cold first LP took.
           if (!options_.stuck_carry) continue;
           released_x.assign(lx.mesh.num_vertices(), 0);
+          std::vector<int> grown;
           for (int f = 0; f < lx.mesh.num_faces(); ++f)
-            if (extra[f] > before[f])
-              for (int v : lx.mesh.faces[f]) released_x[v] = 1;
+            if (extra[f] > before[f]) grown.push_back(f);
+          if (options_.stuck_carry_margin > 0) grown = detail::faces_near(lx.mesh, grown, options_.stuck_carry_margin);
+          for (int f : grown)
+            for (int v : lx.mesh.faces[f]) released_x[v] = 1;
           for (int64_t j : s->ones()) carried_ones.push_back(CarriedIterate::key(m.space[j]));
           if (!s->x().empty()) last.keep(m, s->x(), s->y());
           continue;

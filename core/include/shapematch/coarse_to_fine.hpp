@@ -243,6 +243,11 @@ struct CoarseToFineOptions {
   // first LP's iterations) stayed unconverged, and its rounds failed and were trimmed for
   // 10+ minutes, where a fresh attempt finished in 7 (its first LP included).
   bool stuck_carry = false;
+  // With stuck_carry: the fixings dropped are those over the X faces just widened and over every
+  // X face within this many fine rings of them (0: the widened faces' alone), so that the carried
+  // attempt re-solves a margin around what failed instead of keeping the narrow space's choices
+  // right up to it.
+  int stuck_carry_margin = 0;
   // With stuck_after: the first this many times a level's rounding is stuck, it starts again in
   // the same space from its fixings to 1 so far, with its own state afresh (its undo history,
   // refuted fixings, cap scale and warm start: round 1 solves what the fixings leave, cold), as a
