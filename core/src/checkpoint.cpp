@@ -27,7 +27,10 @@ constexpr char kMagic[] = "shapematch level checkpoint\n";
 // under way's seconds and watch flag follow its iterations and re-solve flag. 1 to 13 are read
 // too (13 as written by the seventy-eighth session's binaries of 4512e6d-a25eb65; its other
 // intermediate layouts of 13 are refused as cut short or malformed).
-constexpr uint32_t kVersion = 14;
+// 15: the layout of 14; a rounding's lower_bound may be NaN (an attempt gone on from a stuck
+// rounding's fixings, whose round 1 bounds no whole LP), which binaries before it would take for
+// a bound: they refuse the file instead.
+constexpr uint32_t kVersion = 15;
 // More LP iterations than any solve makes (a count past it is a corrupt file, and would overflow).
 constexpr int64_t kMaxIterations = int64_t(1) << 40;
 

@@ -1414,7 +1414,25 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
     bool watched_patiently = false;  // this attempt's first LP (its stop is not a suspicion to re-solve)
     try {
       RoundingOptions ro = rounding_for(l);
-      const bool carrying = l > 0 && !carried_ones.empty();
+      // The stuck rounding's fixings to 1 that go on here (stuck_carry): those off the faces just
+      // widened (and their stuck_carry_margin). Where none is left, this attempt is a fresh one (its
+      // round 1 a first LP, pricing, a bound of its own).
+      std::vector<int64_t> carried_start;
+      if (l > 0 && !carried_ones.empty()) {
+        std::sort(carried_ones.begin(), carried_ones.end());
+        for (int64_t j = 0; j < m.lp.cols(); ++j) {
+          const ProductTriangle t = m.space[j];
+          if (released_x[t.a[0]] || released_x[t.a[1]] || released_x[t.a[2]]) continue;
+          if (std::binary_search(carried_ones.begin(), carried_ones.end(), CarriedIterate::key(t)))
+            carried_start.push_back(j);
+        }
+        if (carried_start.empty()) {
+          spdlog::info("level {}: none of the stuck rounding's {} fixings to 1 lies off the faces widened: afresh",
+                       l + 1, carried_ones.size());
+          carried_ones.clear();
+        }
+      }
+      const bool carrying = !carried_start.empty();
       // The first attempt of a run gone on from inside its first LP starts that LP where it was.
       const bool from_solving = first_attempt && !solving_from.empty() && !carrying && !going_on;
       const bool warm_resolve = (price_warm || (from_solving && solving_resolve)) && !carrying;
@@ -1503,16 +1521,14 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
       if (branching)
         ro.first_iterate = [&](const std::vector<double>& x, const std::vector<double>&, double) { coarsest_x = x; };
       if (carrying) {
-        std::sort(carried_ones.begin(), carried_ones.end());
-        for (int64_t j = 0; j < m.lp.cols(); ++j) {
-          const ProductTriangle t = m.space[j];
-          if (released_x[t.a[0]] || released_x[t.a[1]] || released_x[t.a[2]]) continue;
-          if (std::binary_search(carried_ones.begin(), carried_ones.end(), CarriedIterate::key(t)))
-            ro.start_ones.push_back(j);
-        }
+        ro.start_ones = std::move(carried_start);
         last.apply(m, ro.lp);
+        // Any dual certifies a bound (the rows are equations): the first LP's, or where it is not
+        // at hand (a stuck rounding gone on from a checkpoint) the stuck rounding's last one; the
+        // widened LP solved again at the end does better unless that solve fails.
         SolverParams bound;
-        first.apply(m, bound);
+        if (!first.empty()) first.apply(m, bound);
+        else last.apply(m, bound);
         ro.start_dual = std::move(bound.initial_y);
         ro.reference_seconds = reference_seconds;
         ro.reference_iterations = reference_iterations;
@@ -1684,17 +1700,16 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
           const LpResult b = make_solver(ro.solver)->solve(m.lp, bp);
           if (first.empty())
             spdlog::info("level {}: the widened LP's bound {:.6g} (solved cold: the first LP's iterate was not at "
-                         "hand), {} iterations",
-                         l + 1, b.lower_bound, b.iterations);
+                         "hand; the stuck rounding's last dual gives {:.6g}), {} iterations",
+                         l + 1, b.lower_bound, rr.lower_bound, b.iterations);
           else
             spdlog::info("level {}: the widened LP's bound {:.6g} (from the first LP's dual: {:.6g}), {} iterations",
                          l + 1, b.lower_bound, rr.lower_bound, b.iterations);
           if (std::isfinite(b.lower_bound) && !(b.lower_bound <= rr.lower_bound)) rr.lower_bound = b.lower_bound;
           rep.iterations_bound = b.iterations;
         } catch (const Error& e) {  // the Γ stands; only the bound is the weaker one
-          spdlog::warn("level {}: the widened LP's bound could not be solved for ({}); {} {:.6g}", l + 1, e.what(),
-                       first.empty() ? "without the first LP's dual it stays" : "the first LP's dual gives",
-                       rr.lower_bound);
+          spdlog::warn("level {}: the widened LP's bound could not be solved for ({}); the {} dual gives {:.6g}",
+                       l + 1, e.what(), first.empty() ? "stuck rounding's last" : "first LP's", rr.lower_bound);
         }
         rr.gap = relative_gap(rr.energy, rr.lower_bound);
       }
