@@ -90,13 +90,22 @@ MeshPair load_pair(const PairArgs& args) {
   p.features_seconds = clock.seconds();
   p.x_input_vertices = p.x.num_vertices();
   p.y_input_vertices = p.y.num_vertices();
+  const int x_input_faces = p.x.num_faces(), y_input_faces = p.y.num_faces();
   p.x = decimate(p.x, args.faces > 0 ? args.faces : p.x.num_faces(), &p.x_ids);
   p.y = decimate(p.y, args.faces > 0 ? args.faces : p.y.num_faces(), &p.y_ids);
   if (p.features_x.size() > 0) {
     p.features_x = select_rows(p.features_x, p.x_ids);
     p.features_y = select_rows(p.features_y, p.y_ids);
   }
-  spdlog::info("X: {} ({} faces), Y: {} ({} faces)", p.x.name, p.x.num_faces(), p.y.name, p.y.num_faces());
+  // (The input's face count too where it was decimated: `match` decimates to 100 faces unless
+  // told --faces 0, which a run meant at full resolution easily forgets.)
+  const auto faces = [](const Mesh& m, int input) {
+    return m.num_faces() == input ? fmt::format("{} faces", input)
+                                  : fmt::format("{} faces, decimated from {}", m.num_faces(), input);
+  };
+  spdlog::info("X: {} ({}), Y: {} ({}){}", p.x.name, faces(p.x, x_input_faces), p.y.name, faces(p.y, y_input_faces),
+               p.x.num_faces() == x_input_faces && p.y.num_faces() == y_input_faces ? ""
+                                                                                    : " (--faces 0 keeps the input)");
   return p;
 }
 
