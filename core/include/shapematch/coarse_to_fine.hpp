@@ -259,7 +259,9 @@ struct CoarseToFineOptions {
   // (round 1 alone took 370-870 s there on one core). 0: off: 043-063 with WKS, gone on twice
   // that way, thrashed on (its LPs stay at their cap), and a restart keeps what the narrow space
   // cuts off (the test pair: energy 11.86 against 6.93 after the stuck widening). A restarted
-  // rounding stuck again widens afresh, with or without stuck_carry.
+  // rounding stuck again widens as above (afresh, or with stuck_carry from its fixings: since the
+  // eighty-second session; before, afresh either way); an attempt gone on from a stuck rounding's
+  // carried fixings is not restarted: stuck, it widens.
   int stuck_restarts = 0;
   // After a refined level's first LP (optimal), price the product triangles that one more fine
   // ring on every X face would add against its dual; where some price below zero (by more than
