@@ -1783,6 +1783,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
           for (int f : grown)
             for (int v : lx.mesh.faces[f]) released_x[v] = 1;
           for (int64_t j : s->ones()) carried_ones.push_back(CarriedIterate::key(m.space[j]));
+          last = CarriedIterate{};  // (none of an earlier stuck attempt's)
           if (!s->x().empty()) last.keep(m, s->x(), s->y());
           continue;
         }
