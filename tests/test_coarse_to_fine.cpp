@@ -1206,6 +1206,7 @@ TEST_CASE("coarse to fine: a stuck rounding gone on from its checkpoint still go
   const CoarseToFineResult c = again.run({}, &*carried);
   const LevelReport& lc = c.levels.back();
   CHECK(lc.variables == l.variables);
+  CHECK(lc.carried_fixings == l.carried_fixings);  // (the attempt's count, kept with it)
   CHECK(lc.iterations_bound > 0);
   CHECK(check_graph_surface(c.finest.space, c.rounding.gamma).ok());
   CHECK(satisfies_exactly(c.finest.lp, c.rounding.gamma));

@@ -28,8 +28,9 @@ constexpr char kMagic[] = "shapematch level checkpoint\n";
 // too (13 as written by the seventy-eighth session's binaries of 4512e6d-a25eb65; its other
 // intermediate layouts of 13 are refused as cut short or malformed).
 // 15: the layout of 14; a rounding's lower_bound may be NaN (an attempt gone on from a stuck
-// rounding's fixings, whose round 1 bounds no whole LP), which binaries before it would take for
-// a bound: they refuse the file instead.
+// rounding's fixings, whose round 1 bounds no whole LP), which binaries before 2267cca would take
+// for a bound: they refuse the file instead. (Binaries of 2267cca-fdfdc89 wrote such a NaN as 14
+// and read it as this one does.)
 constexpr uint32_t kVersion = 15;
 // More LP iterations than any solve makes (a count past it is a corrupt file, and would overflow).
 constexpr int64_t kMaxIterations = int64_t(1) << 40;

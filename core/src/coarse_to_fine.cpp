@@ -1433,6 +1433,8 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
         }
       }
       const bool carrying = !carried_start.empty();
+      // (Not an earlier attempt's count: this one's, set below, or a carried start's gone on from.)
+      if (!carrying && !(going_on && std::isnan(going_on->lower_bound))) rep.carried_fixings = 0;
       // The first attempt of a run gone on from inside its first LP starts that LP where it was.
       const bool from_solving = first_attempt && !solving_from.empty() && !carrying && !going_on;
       const bool warm_resolve = (price_warm || (from_solving && solving_resolve)) && !carrying;
@@ -1700,16 +1702,20 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
           const LpResult b = make_solver(ro.solver)->solve(m.lp, bp);
           if (first.empty())
             spdlog::info("level {}: the widened LP's bound {:.6g} (solved cold: the first LP's iterate was not at "
-                         "hand; the stuck rounding's last dual gives {:.6g}), {} iterations",
-                         l + 1, b.lower_bound, rr.lower_bound, b.iterations);
+                         "hand; {} {:.6g}), {} iterations",
+                         l + 1, b.lower_bound, carrying ? "the stuck rounding's last dual gives" : "no dual before it:",
+                         rr.lower_bound, b.iterations);
           else
             spdlog::info("level {}: the widened LP's bound {:.6g} (from the first LP's dual: {:.6g}), {} iterations",
                          l + 1, b.lower_bound, rr.lower_bound, b.iterations);
           if (std::isfinite(b.lower_bound) && !(b.lower_bound <= rr.lower_bound)) rr.lower_bound = b.lower_bound;
           rep.iterations_bound = b.iterations;
         } catch (const Error& e) {  // the Γ stands; only the bound is the weaker one
-          spdlog::warn("level {}: the widened LP's bound could not be solved for ({}); the {} dual gives {:.6g}",
-                       l + 1, e.what(), first.empty() ? "stuck rounding's last" : "first LP's", rr.lower_bound);
+          spdlog::warn("level {}: the widened LP's bound could not be solved for ({}); {} {:.6g}", l + 1, e.what(),
+                       !first.empty() ? "the first LP's dual gives"
+                       : carrying     ? "the stuck rounding's last dual gives"
+                                      : "without a dual it stays",
+                       rr.lower_bound);
         }
         rr.gap = relative_gap(rr.energy, rr.lower_bound);
       }
