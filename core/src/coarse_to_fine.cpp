@@ -1433,8 +1433,10 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
         }
       }
       const bool carrying = !carried_start.empty();
+      // A carried start gone on from its checkpoint: no bound of the space yet (NaN, below).
+      const bool carried_gone_on = going_on && std::isnan(going_on->lower_bound);
       // (Not an earlier attempt's count: this one's, set below, or a carried start's gone on from.)
-      if (!carrying && !(going_on && std::isnan(going_on->lower_bound))) rep.carried_fixings = 0;
+      if (!carrying && !carried_gone_on) rep.carried_fixings = 0;
       // The first attempt of a run gone on from inside its first LP starts that LP where it was.
       const bool from_solving = first_attempt && !solving_from.empty() && !carrying && !going_on;
       const bool warm_resolve = (price_warm || (from_solving && solving_resolve)) && !carrying;
@@ -1687,8 +1689,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
                                                      first_y = {};
                                                    }
                                                  });
-      // A carried start gone on from its checkpoint: no bound of the space yet (NaN), as above.
-      const bool bound_after = carrying || (going_on && std::isnan(going_on->lower_bound));
+      const bool bound_after = carrying || carried_gone_on;
       if (bound_after) {
         // Round 1 solved only what the carried fixings left: the widened LP's bound is certified
         // from a dual of it, the first LP's mapped over (where new columns price below zero,
@@ -1700,14 +1701,12 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
         bp.max_iterations = std::min<int64_t>(bp.max_iterations, std::max<int64_t>(first_iterations, 64));
         try {
           const LpResult b = make_solver(ro.solver)->solve(m.lp, bp);
-          if (first.empty())
-            spdlog::info("level {}: the widened LP's bound {:.6g} (solved cold: the first LP's iterate was not at "
-                         "hand; {} {:.6g}), {} iterations",
-                         l + 1, b.lower_bound, carrying ? "the stuck rounding's last dual gives" : "no dual before it:",
-                         rr.lower_bound, b.iterations);
-          else
-            spdlog::info("level {}: the widened LP's bound {:.6g} (from the first LP's dual: {:.6g}), {} iterations",
-                         l + 1, b.lower_bound, rr.lower_bound, b.iterations);
+          spdlog::info("level {}: the widened LP's bound {:.6g} ({} {:.6g}), {} iterations", l + 1, b.lower_bound,
+                       !first.empty() ? "from the first LP's dual:"
+                       : carrying     ? "solved cold: the first LP's iterate was not at hand; the stuck rounding's "
+                                        "last dual gives"
+                                      : "solved cold: the first LP's iterate was not at hand; no dual before it:",
+                       rr.lower_bound, b.iterations);
           if (std::isfinite(b.lower_bound) && !(b.lower_bound <= rr.lower_bound)) rr.lower_bound = b.lower_bound;
           rep.iterations_bound = b.iterations;
         } catch (const Error& e) {  // the Γ stands; only the bound is the weaker one
