@@ -120,6 +120,8 @@ Action add_checkpoint_command(CLI::App& app) {
           .set("warm_resolve", !a.priced_from.empty() || (!a.solving.empty() && a.solving_resolve))
           // (its first LP under way, from the iterate kept with it: after how many iterations; null: none)
           .set("solving_iterations", a.solving.empty() ? Json() : Json(a.solving_iterations))
+          // (… and its divergence watch's windows in a row of the patient rule; null: none)
+          .set("solving_climbing_windows", a.solving.empty() ? Json() : Json(int64_t(a.solving_watch.climbing)))
           .set("rounding", std::move(rounding));
     };
     Json levels = reports(c.levels);

@@ -1,3 +1,4 @@
+#include "divergence_watch.hpp"
 #include "divergence_rule.hpp"
 #include "key_set.hpp"
 #include "recurring_conflicts.hpp"
@@ -1787,8 +1788,8 @@ TEST_CASE("coarse to fine: a run gone on from an attempt of a level in progress 
     bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
   }
   const size_t at = std::string("shapematch level checkpoint\n").size();
-  REQUIRE(bytes[at] == 15);
-  bytes[at] = 16;  // a later version than this build's
+  REQUIRE(bytes[at] == 16);
+  bytes[at] = 17;  // a later version than this build's
   std::ofstream(file, std::ios::binary) << bytes;
   CHECK_THROWS_AS(load_checkpoint(file), IoError);
   {  // The fifteenth: a carried start's rounding without a bound (NaN); the fourteenth has 15's layout.
@@ -1819,7 +1820,14 @@ TEST_CASE("coarse to fine: a run gone on from an attempt of a level in progress 
   CHECK(v3.attempt.report.widened_faces == a.report.widened_faces);
   CHECK(v3.attempt.report.stuck_restarts == 0);
   CHECK(v3.levels.back().gamma == last.levels.back().gamma);
-  CHECK_THROWS_AS(detail::save_checkpoint_as(file, marked, 16), InvalidInputError);
+  CHECK_THROWS_AS(detail::save_checkpoint_as(file, marked, 17), InvalidInputError);
+}
+
+// The saves of a run made inside the first LP of level `level` (lp_checkpoint_seconds).
+void matcher_run_saves(const CoarseToFineMatcher& matcher, int level, std::vector<LevelCheckpoint>& saves) {
+  matcher.run({}, nullptr, [&](const LevelCheckpoint& c) {
+    if (!c.attempt.empty() && !c.attempt.solving.empty() && c.attempt.report.level == level) saves.push_back(c);
+  });
 }
 
 TEST_CASE("coarse to fine: a run gone on from inside a refined level's first LP starts that LP where it was") {
@@ -1877,6 +1885,36 @@ TEST_CASE("coarse to fine: a run gone on from inside a refined level's first LP 
     CHECK(load_checkpoint(other).attempt.solving_watched == !late.attempt.solving_watched);
   }
   CHECK(loaded.attempt.solving.parts().y == late.attempt.solving.parts().y);
+  // Its divergence watch as it stood (version 16), which the LP gone on from it watches on from.
+  CHECK(loaded.attempt.solving_watch == late.attempt.solving_watch);
+  {  // A save after the watch's first window holds what that window saw (a fresh watch before).
+    CoarseToFineOptions longer = o;
+    longer.rounding.lp.tolerance = 1e-7;  // (a first LP past 512 iterations)
+    std::vector<LevelCheckpoint> saves;
+    matcher_run_saves(finger_matcher(longer), finest, saves);
+    REQUIRE_FALSE(saves.empty());
+    REQUIRE(saves.back().attempt.solving_watched);
+    for (const LevelCheckpoint& c : saves) {
+      const DivergenceWatchState& w = c.attempt.solving_watch;
+      CHECK(w.windows == c.attempt.solving_iterations / detail::DivergenceWatch::kWindow);
+      if (w.windows == 0) CHECK(w == DivergenceWatchState{});
+    }
+    CHECK(saves.back().attempt.solving_watch.windows >= 1);
+    CHECK(saves.back().attempt.solving_watch.bound != 0.0);
+  }
+  {
+    LevelCheckpoint near_stop = late;  // (a made-up state: every field is kept)
+    DivergenceWatchState& w = near_stop.attempt.solving_watch;
+    w = {.windows = 4, .creeping = 3, .climbing = 3, .primal = 0.0, .gap = 0.0, .bound = -1e9, .excess = {0.5, 1.5}};
+    const std::string other = (tmp.path / "near_stop.ckpt").string();
+    save_checkpoint(other, near_stop);
+    CHECK(load_checkpoint(other).attempt.solving_watch == w);
+    detail::save_checkpoint_as(other, near_stop, 15);  // (before 16: a fresh watch)
+    CHECK(load_checkpoint(other).attempt.solving_watch == DivergenceWatchState{});
+    w.climbing = 5;  // (more windows in a row than seen: refused)
+    save_checkpoint(other, near_stop);
+    CHECK_THROWS_AS(load_checkpoint(other), IoError);
+  }
   std::vector<int64_t> rest;
   const CoarseToFineResult r = matcher.run(at_finest(rest), &loaded);  // (no checkpointing: no saves)
   REQUIRE(rest.size() == 1);

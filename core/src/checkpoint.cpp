@@ -31,7 +31,8 @@ constexpr char kMagic[] = "shapematch level checkpoint\n";
 // rounding's fixings, whose round 1 bounds no whole LP), which binaries before 2267cca would take
 // for a bound: they refuse the file instead. (Binaries of 2267cca-fdfdc89 wrote such a NaN as 14
 // and read it as this one does.)
-constexpr uint32_t kVersion = 15;
+// 16: an LP under way's divergence watch (LevelAttempt::solving_watch) follows its watch flag.
+constexpr uint32_t kVersion = 16;
 // More LP iterations than any solve makes (a count past it is a corrupt file, and would overflow).
 constexpr int64_t kMaxIterations = int64_t(1) << 40;
 
@@ -150,6 +151,23 @@ CarriedIterate read_iterate(Reader& r, const std::string& path) {
   }
 }
 
+// An LP under way's divergence watch (version >= 16).
+void write_watch(Writer& w, const DivergenceWatchState& s) {
+  w(s.windows), w(s.creeping), w(s.climbing), w(s.primal), w(s.gap), w(s.bound), w(s.excess[0]), w(s.excess[1]);
+}
+DivergenceWatchState read_watch(Reader& r, const std::string& path) {
+  DivergenceWatchState s;
+  r(s.windows), r(s.creeping), r(s.climbing), r(s.primal), r(s.gap), r(s.bound), r(s.excess[0]), r(s.excess[1]);
+  const bool counts = s.windows >= 0 && s.creeping >= 0 && s.climbing >= 0 && s.creeping <= s.windows &&
+                      s.climbing <= s.windows;
+  // (An infeasible LP's bound may be huge, not infinite: the watch compares what it saw.)
+  if (!counts || !std::isfinite(s.primal) || !std::isfinite(s.gap) || !std::isfinite(s.bound) ||
+      !std::isfinite(s.excess[0]) || !std::isfinite(s.excess[1]))
+    throw IoError(path + ": not a shapematch checkpoint (an LP under way's divergence watch after " +
+                  std::to_string(s.windows) + " windows)");
+  return s;
+}
+
 // A flag, then (where set) the attempt (version >= 2).
 void write_attempt(Writer& w, const LevelAttempt& a, uint32_t version) {
   w(!a.empty());
@@ -183,6 +201,7 @@ void write_attempt(Writer& w, const LevelAttempt& a, uint32_t version) {
     if (version >= 14) w(a.solving_seconds);
     w(a.solving_resolve);
     if (version >= 14) w(a.solving_watched);
+    if (version >= 16) write_watch(w, a.solving_watch);
   }
   if (!a.priced_from.empty() || !a.solving.empty()) w(a.cold_iterations), w(a.cold_seconds);
 }
@@ -223,6 +242,7 @@ void read_attempt(Reader& r, LevelAttempt& a, uint32_t version, const std::strin
     if (version >= 14) r(a.solving_seconds);
     r(a.solving_resolve);
     if (version >= 14) r(a.solving_watched);
+    if (version >= 16) a.solving_watch = read_watch(r, path);
     if (a.solving_iterations < 0 || a.solving_iterations > kMaxIterations || !(a.solving_seconds >= 0.0) ||
         !std::isfinite(a.solving_seconds))
       throw IoError(path + ": not a shapematch checkpoint (an LP under way at " + std::to_string(a.solving_iterations) +

@@ -1174,12 +1174,14 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
   int64_t solving_done = 0;
   double solving_seconds = 0.0;
   bool solving_resolve = false, solving_watched = true;
+  DivergenceWatchState solving_watch;
   if (resume && resume->rounding.empty() && !resume->solving.empty()) {
     solving_from = resume->solving;
     solving_done = resume->solving_iterations;
     solving_seconds = resume->solving_seconds;
     solving_resolve = resume->solving_resolve;
     solving_watched = resume->solving_watched;
+    solving_watch = resume->solving_watch;
     feasible_seen = feasible_seen || solving_resolve;  // (the re-solve's space held an optimum)
     cold_iterations = resume->cold_iterations;
     cold_seconds = resume->cold_seconds;
@@ -1465,6 +1467,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
         ro.resumed_seconds = solving_seconds;
         ro.feasibility_iterations = 0;  // (it had passed its pre-test)
         if (!solving_watched) ro.lp.stop_on_divergence = ro.lp.patient_divergence_watch = false;
+        ro.lp.initial_watch = solving_watch;
       }
       if (warm_resolve) {
         if (!from_solving) {
@@ -1641,6 +1644,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
           a.solving_seconds = s.seconds;
           a.solving_resolve = resolve;
           a.solving_watched = watched;
+          a.solving_watch = s.watch;
           a.cold_iterations = cold_iterations;
           a.cold_seconds = cold_seconds;
           try {

@@ -157,10 +157,13 @@ LpResult PdhgSolver::solve(const LpProblem& problem, const SolverParams& params)
                                         ? params.cold_restart_artificial
                                         : options_.restart_artificial;
   int64_t total = 0, k = 0;
+  const int64_t before = params.initial_x.empty() ? 0 : std::max<int64_t>(params.iterations_before, 0);
   double restart_base = -1.0, previous = std::numeric_limits<double>::infinity();
   // Divergence watch (params.stop_on_divergence); the dual at the start of each window gives
   // the growth returned as the ray.
-  detail::DivergenceWatch watch(params.tolerance, params.patient_divergence_watch);
+  // (Gone on from a snapshot's watch only with its warm start: a cold solve is a new one.)
+  detail::DivergenceWatch watch(params.tolerance, params.patient_divergence_watch,
+                                params.initial_y.empty() ? DivergenceWatchState{} : params.initial_watch);
   int64_t window_end = detail::DivergenceWatch::kWindow;
   // (From a warm start's dual: a bound past params.divergence_bound may stop the first window, its
   // growth a change of a given dual. From a cold start the first window's "growth" would be the
@@ -288,6 +291,7 @@ LpResult PdhgSolver::solve(const LpProblem& problem, const SolverParams& params)
       snap.primal_weight = omega;
       snap.iterations = total;
       snap.seconds = clock.seconds();
+      if (params.stop_on_divergence) snap.watch = watch.state();
       params.snapshot(snap);
       since_snapshot.reset();
       ++snapshots;
@@ -299,7 +303,7 @@ LpResult PdhgSolver::solve(const LpProblem& problem, const SolverParams& params)
       restart_base = fixed_point;
     } else if (fixed_point <= options_.restart_sufficient * restart_base ||
                (fixed_point <= options_.restart_necessary * restart_base && fixed_point > previous) ||
-               k >= restart_artificial * total) {
+               k >= restart_artificial * (total + before)) {
       const auto [dx2, dy2] = backend->restart();
       const double dx = std::sqrt(dx2), dy = std::sqrt(dy2);
       if (dx > 1e-10 && dy > 1e-10) {

@@ -2232,6 +2232,7 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
     if (!after_fixing && round == 1) {  // (gone on from a snapshot: what is left of round 1's limits)
       params.max_iterations = std::max<int64_t>(params.max_iterations - options.resumed_iterations, 1);
       params.time_limit -= options.resumed_seconds;
+      params.iterations_before = options.resumed_iterations;  // (its restarts as they would have been)
     }
     // An iterate of red.lp over the whole LP: fixed variables at their values, rows it lacks at 0.
     auto full_x = [&](const std::vector<double>& reduced) {
@@ -2263,6 +2264,7 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
         whole.primal_weight = s.primal_weight;
         whole.iterations = snapshot_iterations + s.iterations;
         whole.seconds = snapshot_seconds + s.seconds;
+        whole.watch = s.watch;
         options.first_snapshot(whole, params.stop_on_divergence);
       };
       if (options.feasibility_iterations > 0 && options.solver.rfind("pdhg", 0) == 0) {
@@ -2310,6 +2312,8 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
           params.time_limit -= p.seconds;
           snapshot_iterations += p.iterations;
           snapshot_seconds += p.seconds;
+          params.initial_watch = {};  // (a new solve, as it is uninterrupted)
+          params.iterations_before = 0;
           joined.r = solver->solve(red.lp, params);
           joined.r.iterations += p.iterations;
           joined.r.seconds += p.seconds;

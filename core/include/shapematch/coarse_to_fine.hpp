@@ -538,6 +538,9 @@ struct LevelAttempt {
   double solving_seconds = 0.0;
   bool solving_resolve = false;
   bool solving_watched = true;
+  // Its divergence watch at the last window before `solving` was taken, which the LP gone on from
+  // there watches on from (version 16; before, its windows started over).
+  DivergenceWatchState solving_watch;
   LevelReport report;            // its counts so far (widenings, widened faces, …); no Γ
   // Where the attempt's rounding had got, saved after its rounds (at most every few seconds): a
   // run gone on from it builds the same LP, fixes `ones` before its round 1 and keeps round 1's
