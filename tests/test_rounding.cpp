@@ -2940,3 +2940,37 @@ TEST_CASE("rounding: with a release reach cap, the same part failing again is st
     CHECK(std::string(e.what()).find("releases of the fixings near it") != std::string::npos);
   }
 }
+
+TEST_CASE("rounding: a first LP stopped as diverging blames its stalled residual's rows too where asked") {
+  // A divergence bound under the optimum stops round 1's LP at its second window (the watch's
+  // bound stop: LpStatus::Diverging, an iterate short of feasible). Its rows are the dual growth's;
+  // with blame_residual also the rows its iterate leaves furthest from b: a superset.
+  const MatchingLp& m = dolphins_30();
+  RoundingOptions o;
+  o.solver = "pdhg-cpu";
+  o.feasibility_iterations = 0;
+  o.lp.tolerance = 1e-9;  // (not optimal before the stop)
+  o.lp.stop_on_divergence = true;
+  o.lp.divergence_bound = 0.0;
+  const auto rows_blamed = [&](bool residual) {
+    RoundingOptions b = o;
+    b.blame_residual = residual;
+    try {
+      round_to_graph_surface(m.space, m.lp, m.energy, b);
+    } catch (const InfeasibleError& e) {
+      CHECK_FALSE(e.certified());
+      std::vector<int64_t> rows = e.rows();
+      std::sort(rows.begin(), rows.end());
+      return rows;
+    }
+    FAIL("round 1's LP did not stop as diverging");
+    return std::vector<int64_t>{};
+  };
+  const std::vector<int64_t> growth = rows_blamed(false), both = rows_blamed(true);
+  MESSAGE("rows blamed: " << growth.size() << " by the dual growth, " << both.size() << " with the residual's");
+  REQUIRE_FALSE(growth.empty());
+  CHECK(std::includes(both.begin(), both.end(), growth.begin(), growth.end()));
+  CHECK(both.size() > growth.size());
+  CHECK(std::adjacent_find(both.begin(), both.end()) == both.end());  // (each once)
+  CHECK(both.back() < m.lp.rows());
+}

@@ -18,6 +18,7 @@
 #include <cmath>
 #include <deque>
 #include <exception>
+#include <iterator>
 #include <limits>
 #include <map>
 #include <numeric>
@@ -323,6 +324,30 @@ std::vector<int64_t> carrying_rows(const std::vector<double>& y) {
   if (!(largest > 0.0)) return out;
   for (size_t i = 0; i < y.size(); ++i)
     if (std::abs(y[i]) >= 0.1 * largest) out.push_back(static_cast<int64_t>(i));
+  return out;
+}
+
+// The rows a primal iterate `x` of `lp` leaves furthest from b: |Ax − b| at least a tenth of the
+// largest (RoundingOptions::blame_residual), mapped to the full LP by `rows`, sorted. Logged with
+// the largest and the relative residual (debug).
+std::vector<int64_t> residual_rows(const LpProblem& lp, const std::vector<double>& x, const std::vector<int64_t>& rows) {
+  std::vector<int64_t> out;
+  if (x.size() != size_t(lp.cols())) return out;
+  std::vector<double> ax(lp.rows());
+  spmv(lp.a, x.data(), ax.data());
+  double largest = 0.0, sum2 = 0.0, b2 = 0.0;
+  for (int64_t i = 0; i < lp.rows(); ++i) {
+    ax[i] = std::abs(ax[i] - lp.b[i]);
+    largest = std::max(largest, ax[i]);
+    sum2 += ax[i] * ax[i];
+    b2 += lp.b[i] * lp.b[i];
+  }
+  if (!(largest > 0.0)) return out;
+  for (int64_t i = 0; i < lp.rows(); ++i)
+    if (ax[i] >= 0.1 * largest && i < static_cast<int64_t>(rows.size())) out.push_back(rows[i]);
+  std::sort(out.begin(), out.end());
+  spdlog::debug("stalled iterate: |Ax − b| at most {:.3g} ({:.3g} relative), {} of {} rows within a tenth of it", largest,
+                std::sqrt(sum2) / (1.0 + std::sqrt(b2)), out.size(), lp.rows());
   return out;
 }
 
@@ -2411,11 +2436,20 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
       result.first_lp.lower_bound += lp.objective_scale * red.fixed_cost;
     }
 
-    if (r.status == LpStatus::Diverging)  // only asked for in round 1 (above)
+    if (r.status == LpStatus::Diverging) {  // only asked for in round 1 (above)
+      std::vector<int64_t> rows = certificate_rows(r.y, red.rows);
+      const std::vector<int64_t> stalled = residual_rows(red.lp, r.x, red.rows);
+      if (options.blame_residual) {
+        std::vector<int64_t> both;
+        std::sort(rows.begin(), rows.end());
+        std::set_union(rows.begin(), rows.end(), stalled.begin(), stalled.end(), std::back_inserter(both));
+        rows = std::move(both);
+      }
       throw InfeasibleError(r.lower_bound + lp.objective_scale * red.fixed_cost > options.lp.divergence_bound
                                 ? "rounding: the matching LP's optimum lies above its divergence bound (PDHG)"
                                 : "rounding: the matching LP is probably infeasible (PDHG diverging)",
-                            certificate_rows(r.y, red.rows), false);
+                            std::move(rows), false);
+    }
     // A later round (or part of one) at its cap whose certified bound lies well above its own
     // objective behaves like an infeasible LP (its dual grows along a Farkas ray; the proof takes
     // longer than the cap). Fixing from such an iterate made every LP after it infeasible (full

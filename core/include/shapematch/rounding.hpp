@@ -69,6 +69,14 @@ struct RoundingOptions {
   // capped LP whose certified bound is over 50 % above its objective is undone as infeasible.
   double later_round_iterations = 2.0;
   int64_t later_round_min_iterations = 2000;
+  // Where round 1's LP stops as diverging (SolverParams::stop_on_divergence), the rows its stalled
+  // primal iterate leaves furthest from b (|Ax − b| over a tenth of the largest) are blamed too,
+  // beside the dual growth's: a creeping LP's growth is no ray yet (its Farkas rate negative) and
+  // spreads over thousands of rows, while a residual that stalls through widenings sits where the
+  // space cannot close. Measured why (TOSCA_r dog3-dog8 at full resolution): its finest first LPs
+  // stalled at 3.65-3.7e-3 at 9.6, 12.7 and 14.4 M variables, through widenings of 1 583 faces
+  // on such growths. The rows are logged either way (debug).
+  bool blame_residual = false;
   // Later rounds' first-order parts start from the primal weight ω that the last solve of their
   // columns ended with (the geometric mean over the part's columns), instead of lp's own
   // (initial_primal_weight; PDHG's start at 1 where that is 0). Those rounds start from the last
