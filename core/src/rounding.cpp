@@ -18,7 +18,6 @@
 #include <cmath>
 #include <deque>
 #include <exception>
-#include <iterator>
 #include <limits>
 #include <map>
 #include <numeric>
@@ -2439,12 +2438,15 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
     if (r.status == LpStatus::Diverging) {  // only asked for in round 1 (above)
       std::vector<int64_t> rows = certificate_rows(r.y, red.rows);
       const std::vector<int64_t> stalled = residual_rows(red.lp, r.x, red.rows);
-      if (options.blame_residual) {
-        std::vector<int64_t> both;
-        std::sort(rows.begin(), rows.end());
-        std::set_union(rows.begin(), rows.end(), stalled.begin(), stalled.end(), std::back_inserter(both));
-        rows = std::move(both);
-      }
+      std::vector<int64_t> both = rows;
+      std::sort(both.begin(), both.end());
+      const size_t growth = both.size();
+      both.insert(both.end(), stalled.begin(), stalled.end());
+      std::inplace_merge(both.begin(), both.begin() + growth, both.end());
+      both.erase(std::unique(both.begin(), both.end()), both.end());
+      spdlog::debug("rounding: {} of the stalled iterate's {} rows lie outside the dual growth's {}{}",
+                    both.size() - growth, stalled.size(), growth, options.blame_residual ? " (blamed too)" : "");
+      if (options.blame_residual) rows = std::move(both);
       throw InfeasibleError(r.lower_bound + lp.objective_scale * red.fixed_cost > options.lp.divergence_bound
                                 ? "rounding: the matching LP's optimum lies above its divergence bound (PDHG)"
                                 : "rounding: the matching LP is probably infeasible (PDHG diverging)",
