@@ -1626,6 +1626,9 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
   SolverParams base_params = options.lp;
   base_params.initial_x.clear();
   base_params.initial_y.clear();
+  // (Round 1's resumed solve only, below: they belong to the LP under way that was saved.)
+  base_params.initial_watch = {};
+  base_params.iterations_before = 0;
   // Releases every fixing within reach of `rows` (columns_near, 2 steps, 4, 8 … where the same
   // part fails again (ReleaseReach), further until one is in reach) and propagates the rest again
   // from the state before the first round: where a part has no binary solution, the fault lies in
@@ -2256,7 +2259,9 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
     if (!after_fixing && round == 1) {  // (gone on from a snapshot: what is left of round 1's limits)
       params.max_iterations = std::max<int64_t>(params.max_iterations - options.resumed_iterations, 1);
       params.time_limit -= options.resumed_seconds;
-      params.iterations_before = options.resumed_iterations;  // (its restarts as they would have been)
+      // Its restarts and divergence watch about as they would have been (SolverParams says how far).
+      params.iterations_before = options.resumed_iterations;
+      params.initial_watch = options.lp.initial_watch;
     }
     // An iterate of red.lp over the whole LP: fixed variables at their values, rows it lacks at 0.
     auto full_x = [&](const std::vector<double>& reduced) {
@@ -2646,7 +2651,10 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
   }
   for (int64_t j : result.gamma) result.energy += energy[j];
   if (result.rounds.empty()) {  // propagation alone decided everything (tiny problems)
-    result.first_lp = solver->solve(lp, options.lp);
+    SolverParams whole = options.lp;
+    whole.initial_watch = {};
+    whole.iterations_before = 0;
+    result.first_lp = solver->solve(lp, whole);
   }
   if (options.start_ones.empty()) result.lower_bound = result.first_lp.lower_bound;
   else if (options.start_dual.size() == size_t(lp.rows())) result.lower_bound = certified_lower_bound(lp, options.start_dual);
@@ -2690,6 +2698,8 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
     alt.first_snapshot = {};
     alt.round_snapshot = {};
     alt.resumed_iterations = 0;  // (its round 1 is that optimum's)
+    alt.lp.initial_watch = {};
+    alt.lp.iterations_before = 0;
     alt.resumed_seconds = 0.0;
     alt.first_max_iterations = 0;
     alt.feasibility_iterations = 0;  // (round 1 was optimal)

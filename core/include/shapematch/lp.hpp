@@ -40,7 +40,9 @@ enum class LpStatus {
 const char* to_string(LpStatus status);
 
 // PDHG's divergence watch as it stood at a window's end (detail::DivergenceWatch), so that a solve
-// started again from a snapshot watches on where it was rather than from its first window.
+// started again from a snapshot watches on from there rather than from its first window (about:
+// its next window ends 512 iterations after the snapshot, so it spans up to 1 023 of the
+// uninterrupted solve's, its dual growth measured from the snapshot's dual).
 // Measured (TOSCA_r dog3-dog8 at full resolution, level 6's 12.7 M-variable first LP): a run gone
 // on from its checkpoint after 7 232 iterations, four windows into the patient watch's eight, started
 // them over: 2 560 iterations more on one thread before it could stop.
@@ -87,7 +89,8 @@ struct SolverParams {
   DivergenceWatchState initial_watch;
   // With a warm start that goes on from a snapshot of this LP: the iterations it had made. PDHG's
   // artificial restart (after a fraction of all the iterations so far) counts them, so that the
-  // solve restarts as the uninterrupted one would have rather than as a cold start does, at every
+  // solve restarts about as the uninterrupted one would have (the snapshot is a restart point: the
+  // count since the last restart starts there) rather than as a cold start does, at every
   // residual check at first, each restart moving ω. Measured (TOSCA_r dog3-dog8 at full
   // resolution, level 6's 12.7 M-variable first LP gone on after 7 232 iterations at ω 24.3): ω
   // went 69, 303, 1 420, 5 430 in the first 832 iterations, 72 500 by 1 984.
