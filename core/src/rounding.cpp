@@ -2259,9 +2259,10 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
     if (!after_fixing && round == 1) {  // (gone on from a snapshot: what is left of round 1's limits)
       params.max_iterations = std::max<int64_t>(params.max_iterations - options.resumed_iterations, 1);
       params.time_limit -= options.resumed_seconds;
-      // Its restarts and divergence watch about as they would have been (SolverParams says how far).
+      // Its restarts and divergence watch about as they would have been (SolverParams says how far);
+      // a round 1 that is not gone on from a snapshot (an alternative's among them) watches afresh.
       params.iterations_before = options.resumed_iterations;
-      params.initial_watch = options.lp.initial_watch;
+      if (options.resumed_iterations > 0) params.initial_watch = options.lp.initial_watch;
     }
     // An iterate of red.lp over the whole LP: fixed variables at their values, rows it lacks at 0.
     auto full_x = [&](const std::vector<double>& reduced) {
@@ -2698,8 +2699,6 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
     alt.first_snapshot = {};
     alt.round_snapshot = {};
     alt.resumed_iterations = 0;  // (its round 1 is that optimum's)
-    alt.lp.initial_watch = {};
-    alt.lp.iterations_before = 0;
     alt.resumed_seconds = 0.0;
     alt.first_max_iterations = 0;
     alt.feasibility_iterations = 0;  // (round 1 was optimal)
