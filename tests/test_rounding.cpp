@@ -9,6 +9,7 @@
 #include "part_search.hpp"
 #include "release_reach.hpp"
 #include "solve_in_parts.hpp"
+#include "stalled_rows.hpp"
 #include "test_helpers.hpp"
 
 #include <doctest/doctest.h>
@@ -2973,4 +2974,43 @@ TEST_CASE("rounding: a first LP stopped as diverging blames its stalled residual
   CHECK(std::includes(both.begin(), both.end(), growth.begin(), growth.end()));  // (the growth's kept)
   CHECK(std::adjacent_find(both.begin(), both.end()) == both.end());  // (each once)
   CHECK(both.back() < m.lp.rows());
+}
+
+TEST_CASE("rounding: every row of the matching LP is placed on its face or on its product edge") {
+  // The stalled rows' debug log names them by row_place: a π row's face must be the face every
+  // one of its columns covers, and a closedness row's two product vertices an edge of every one
+  // of its columns.
+  const MatchingLp& m = dolphins_30();
+  int64_t pi_x = 0, pi_y = 0, edges = 0;
+  for (int64_t row = 0; row < m.lp.rows(); ++row) {
+    const detail::RowPlace p = detail::row_place(m.space, m.lp, row);
+    const uint32_t begin = m.lp.a.row_ptr[row], end = m.lp.a.row_ptr[row + 1];
+    REQUIRE(end > begin);
+    if (row < m.closedness_rows) {
+      REQUIRE(p.kind == detail::RowPlace::closedness);
+      if (end - begin < 2) continue;  // (one column: its three vertices are shared by it alone)
+      REQUIRE(p.edge.size() == 2);
+      ++edges;
+      for (uint32_t k = begin; k < end; ++k) {
+        const ProductTriangle t = m.space[col_of(m.lp.a.entry[k])];
+        bool side = false;
+        for (int i = 0; i < 3; ++i) {
+          const std::set<std::pair<int, int>> e{{t.a[i], t.b[i]}, {t.a[(i + 1) % 3], t.b[(i + 1) % 3]}};
+          side = side || e == std::set<std::pair<int, int>>(p.edge.begin(), p.edge.end());
+        }
+        CHECK(side);
+      }
+    } else {
+      const bool x = row < m.closedness_rows + m.space.x().num_faces();
+      REQUIRE(p.kind == (x ? detail::RowPlace::pi_x : detail::RowPlace::pi_y));
+      ++(x ? pi_x : pi_y);
+      for (uint32_t k = begin; k < end; ++k) {
+        const ProductTriangle t = m.space[col_of(m.lp.a.entry[k])];
+        CHECK((x ? t.fa : t.fb) == p.face);
+      }
+    }
+  }
+  CHECK(pi_x == m.space.x().num_faces());
+  CHECK(pi_y == m.space.y().num_faces());
+  CHECK(edges > m.closedness_rows / 2);
 }

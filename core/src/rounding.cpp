@@ -6,6 +6,7 @@
 #include "certificate_blame.hpp"
 #include "part_search.hpp"
 #include "solve_in_parts.hpp"
+#include "stalled_rows.hpp"
 
 #include "shapematch/errors.hpp"
 #include "shapematch/geometry.hpp"
@@ -348,6 +349,76 @@ std::vector<int64_t> residual_rows(const LpProblem& lp, const std::vector<double
   spdlog::debug("stalled iterate: |Ax − b| at most {:.3g} ({:.3g} relative), {} of {} rows within a tenth of it", largest,
                 std::sqrt(sum2) / (1.0 + std::sqrt(b2)), out.size(), lp.rows());
   return out;
+}
+
+// The smallest angle of a triangle (degrees) and its area over the mesh's mean face area: a
+// degenerate face is one place an LP can be infeasible only locally.
+std::string face_shape(const Mesh& m, int f) {
+  auto area = [&](int g) {
+    const auto& t = m.faces[g];
+    return 0.5 * (m.vertices[t[1]] - m.vertices[t[0]]).cross(m.vertices[t[2]] - m.vertices[t[0]]).norm();
+  };
+  double total = 0.0;
+  for (int g = 0; g < m.num_faces(); ++g) total += area(g);
+  const auto& t = m.faces[f];
+  double smallest = 180.0;
+  for (int i = 0; i < 3; ++i) {
+    const Eigen::Vector3d u = m.vertices[t[(i + 1) % 3]] - m.vertices[t[i]];
+    const Eigen::Vector3d v = m.vertices[t[(i + 2) % 3]] - m.vertices[t[i]];
+    smallest = std::min(smallest, std::atan2(u.cross(v).norm(), u.dot(v)) * 180.0 / M_PI);
+  }
+  return fmt::format("min angle {:.1f}°, area {:.2f}× mean", smallest, area(f) * m.num_faces() / total);
+}
+
+// Debug log of the rows `residual_rows` names (at most 12): their kind (closedness of a product
+// edge, π_X or π_Y of a face), Ax against b and their largest columns, with the shapes of the
+// faces there, so a stall can be told from a degenerate face or a cut-off neighbourhood.
+void describe_stalled_rows(const ProductSpace& space, const LpProblem& full, const Reduced& red,
+                           const std::vector<double>& x, const std::vector<int64_t>& stalled) {
+  if (!spdlog::should_log(spdlog::level::debug) || x.size() != size_t(red.lp.cols())) return;
+  const Mesh& X = space.x();
+  const Mesh& Y = space.y();
+  std::vector<double> ax(red.lp.rows());
+  spmv(red.lp.a, x.data(), ax.data());
+  auto tuple = [](const std::array<int, 3>& v) { return fmt::format("({},{},{})", v[0], v[1], v[2]); };
+  size_t shown = 0;
+  for (int64_t row : stalled) {
+    if (++shown > 12) break;
+    const auto at = std::lower_bound(red.rows.begin(), red.rows.end(), row);
+    if (at == red.rows.end() || *at != row) continue;
+    const int64_t i = at - red.rows.begin();
+    const detail::RowPlace place = detail::row_place(space, full, row);
+    std::string kind;
+    if (place.kind == detail::RowPlace::pi_y)
+      kind = fmt::format("π_Y of Y face {} ({})", place.face, face_shape(Y, place.face));
+    else if (place.kind == detail::RowPlace::pi_x)
+      kind = fmt::format("π_X of X face {} ({})", place.face, face_shape(X, place.face));
+    else {
+      kind = "closedness of";
+      for (const auto& [u, w] : place.edge) kind += fmt::format(" ({},{})", u, w);
+    }
+    // Its columns, largest first.
+    std::vector<std::pair<double, int64_t>> cols;
+    for (uint32_t k = red.lp.a.row_ptr[i]; k < red.lp.a.row_ptr[i + 1]; ++k) {
+      const int64_t j = col_of(red.lp.a.entry[k]);
+      cols.emplace_back(x[j], red.cols[j]);
+    }
+    std::sort(cols.begin(), cols.end(), std::greater<>());
+    std::string list;
+    std::set<int> fx, fy;
+    for (size_t k = 0; k < cols.size(); ++k) {
+      const ProductTriangle t = space[cols[k].second];
+      if (k < 6) list += fmt::format(" {}→{} {:.3f};", tuple(t.a), tuple(t.b), cols[k].first);
+      if (t.fa >= 0) fx.insert(t.fa);
+      if (t.fb >= 0) fy.insert(t.fb);
+    }
+    spdlog::debug("stalled row {} ({}): Ax {:.4f}, b {}, {} columns:{}", row, kind, ax[i], red.lp.b[i], cols.size(),
+                  list);
+    std::string shapes;
+    for (int f : fx) shapes += fmt::format(" X{} {};", f, face_shape(X, f));
+    for (int f : fy) shapes += fmt::format(" Y{} {};", f, face_shape(Y, f));
+    if (!shapes.empty() && fx.size() + fy.size() <= 16) spdlog::debug("  its columns' faces:{}", shapes);
+  }
 }
 
 // `lp` solved cold with every cost 0 (set aside and put back after): a feasibility problem,
@@ -2444,6 +2515,7 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
     if (r.status == LpStatus::Diverging) {  // only asked for in round 1 (above)
       std::vector<int64_t> rows = certificate_rows(r.y, red.rows);
       const std::vector<int64_t> stalled = residual_rows(red.lp, r.x, red.rows);
+      describe_stalled_rows(space, lp, red, r.x, stalled);
       std::vector<int64_t> both = rows;
       std::sort(both.begin(), both.end());
       const size_t growth = both.size();
