@@ -101,6 +101,7 @@ struct MatchArgs {
   double stuck_after = CoarseToFineOptions{}.stuck_after;
   bool stuck_carry = CoarseToFineOptions{}.stuck_carry;
   bool blame_residual = RoundingOptions{}.blame_residual;
+  int64_t local_proof = RoundingOptions{}.local_proof_columns;
   int stuck_carry_margin = CoarseToFineOptions{}.stuck_carry_margin;
   int stuck_restarts = CoarseToFineOptions{}.stuck_restarts;
   double rounding_checkpoint_seconds = CoarseToFineOptions{}.rounding_checkpoint_seconds;
@@ -273,6 +274,7 @@ int run_match(const MatchArgs& args) {
   ro.alternatives_below = args.alternatives_below;
   ro.max_rounds = args.max_rounds;
   ro.blame_residual = args.blame_residual;
+  ro.local_proof_columns = args.local_proof;
   ro.later_round_iterations = args.later_round_iterations;
   ro.carry_weights = args.carry_round_weights;
   ro.fractional_batch = args.fractional_batch;
@@ -623,6 +625,7 @@ int run_match(const MatchArgs& args) {
                               .set("stuck_after", args.stuck_after)
                               .set("stuck_carry", args.stuck_carry)
                               .set("blame_residual", args.blame_residual)
+                              .set("local_proof", args.local_proof)
                               .set("stuck_carry_margin", args.stuck_carry_margin)
                               .set("stuck_restarts", args.stuck_restarts)
                               .set("rounding_checkpoint_seconds", args.rounding_checkpoint_seconds)
@@ -1077,6 +1080,11 @@ Action add_match_command(CLI::App& app) {
   app.add_flag("--blame-residual", a->blame_residual,
                "where a refined level's first LP stops as diverging, widen also around the rows its stalled "
                "iterate leaves furthest from b, not only those its dual grew on");
+  app.add_option("--local-proof", a->local_proof,
+                 "where a refined level's first LP stops as diverging, look for an exact proof of infeasibility (Clp) "
+                 "on the rows within a few steps of its stalled residual, up to N columns (0: off)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
   app.add_flag("--stuck-carry", a->stuck_carry,
                "with --stuck-after: go on from the stuck rounding's fixings in the widened space instead of "
                "afresh (measured slower)");

@@ -10,6 +10,7 @@
 #include "release_reach.hpp"
 #include "solve_in_parts.hpp"
 #include "stalled_rows.hpp"
+#include "local_proof.hpp"
 #include "test_helpers.hpp"
 
 #include <doctest/doctest.h>
@@ -3013,4 +3014,44 @@ TEST_CASE("rounding: every row of the matching LP is placed on its face or on it
   CHECK(pi_x == m.space.x().num_faces());
   CHECK(pi_y == m.space.y().num_faces());
   CHECK(edges > m.closedness_rows / 2);
+}
+
+TEST_CASE("rounding: a local proof of infeasibility is found where the clash lies, as far out as it lies") {
+  // A chain x_i + x_{i+1} = 1 (rows 0-10) is feasible; row 11, x5 + x6 = 0, clashes with row 5.
+  // From row 2, the clash is three steps out (row 2 → x2..x3 → rows 1-3 → x1..x4 → rows 0-4 →
+  // x0..x5 → rows 5 and 11).
+  std::vector<std::vector<int>> a(12, std::vector<int>(12, 0));
+  for (int i = 0; i < 11; ++i) a[i][i] = a[i][i + 1] = 1;
+  a[11][5] = a[11][6] = 1;
+  std::vector<double> b(12, 1.0);
+  b[11] = 0.0;
+  const LpProblem clash = test::dense_lp(a, b, std::vector<double>(12, 1.0));
+  auto clp = make_solver("clp-dual");
+  const detail::LocalProof p = detail::local_infeasibility(clash, {2}, 8, 1000, *clp);
+  REQUIRE(p.proved);
+  CHECK(p.depth == 3);
+  CHECK(p.support == std::vector<int64_t>{5, 11});
+  // Its ray, zero elsewhere, proves the whole LP infeasible.
+  std::vector<double> d(clash.rows(), 0.0);
+  for (size_t k = 0; k < p.support.size(); ++k) d[p.support[k]] = p.ray[k];
+  CHECK(farkas_rate(clash, d) > 0.0);
+  // Capped at 5 columns: the relaxations of depths 0 and 1 (2 and 4 columns) alone, no proof.
+  const detail::LocalProof capped = detail::local_infeasibility(clash, {2}, 8, 5, *clp);
+  CHECK_FALSE(capped.proved);
+  CHECK(capped.depth == 1);
+  CHECK(capped.cols == 4);
+  // Without row 11 the chain is feasible: no proof, however far out.
+  a.pop_back();
+  b.pop_back();
+  const LpProblem chain = test::dense_lp(a, b, std::vector<double>(12, 1.0));
+  const detail::LocalProof none = detail::local_infeasibility(chain, {2}, 20, 1000, *clp);
+  CHECK_FALSE(none.proved);
+  CHECK(none.rows == chain.rows());  // (it went out to the whole LP)
+  // Nor on a feasible matching LP, from a π_Y row and a closedness row two steps out.
+  const MatchingLp& m = dolphins_30();
+  const detail::LocalProof matching =
+      detail::local_infeasibility(m.lp, {0, m.lp.rows() - 1}, 2, 1'000'000, *clp);
+  CHECK_FALSE(matching.proved);
+  CHECK(matching.depth == 2);
+  CHECK(matching.cols > 0);
 }

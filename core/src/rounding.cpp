@@ -6,6 +6,7 @@
 #include "certificate_blame.hpp"
 #include "part_search.hpp"
 #include "solve_in_parts.hpp"
+#include "local_proof.hpp"
 #include "stalled_rows.hpp"
 
 #include "shapematch/errors.hpp"
@@ -2525,6 +2526,29 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
       spdlog::debug("rounding: {} of the stalled iterate's {} rows lie outside the dual growth's {}{}",
                     both.size() - growth, stalled.size(), growth, options.blame_residual ? " (blamed too)" : "");
       if (options.blame_residual) rows = std::move(both);
+      if (options.local_proof_columns > 0 && !stalled.empty()) {
+        Stopwatch local_clock;
+        if (!exact_solver) exact_solver = make_solver("clp-dual");
+        std::vector<int64_t> seeds;  // (the stalled rows in the reduced LP's numbering)
+        for (int64_t row : stalled) {
+          const auto at = std::lower_bound(red.rows.begin(), red.rows.end(), row);
+          if (at != red.rows.end() && *at == row) seeds.push_back(at - red.rows.begin());
+        }
+        const detail::LocalProof proof = detail::local_infeasibility(
+            red.lp, std::move(seeds), options.local_proof_depth, options.local_proof_columns, *exact_solver);
+        spdlog::debug("rounding: {} infeasibility near the stalled rows: {} steps out, {} rows and {} columns ({:.2f} s)",
+                      proof.proved ? "proved" : "no proof of", proof.depth, proof.rows, proof.cols,
+                      local_clock.seconds());
+        if (proof.proved) {
+          std::vector<int64_t> support;
+          for (int64_t i : proof.support) support.push_back(red.rows[i]);
+          spdlog::debug("rounding: its Farkas ray needs {} rows", support.size());
+          throw InfeasibleError(fmt::format("rounding: the matching LP is infeasible (Clp, {} rows within {} steps of "
+                                            "its stalled residual)",
+                                            proof.rows, proof.depth),
+                                std::move(support), true);
+        }
+      }
       throw InfeasibleError(r.lower_bound + lp.objective_scale * red.fixed_cost > options.lp.divergence_bound
                                 ? "rounding: the matching LP's optimum lies above its divergence bound (PDHG)"
                                 : "rounding: the matching LP is probably infeasible (PDHG diverging)",

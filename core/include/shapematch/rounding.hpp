@@ -77,6 +77,13 @@ struct RoundingOptions {
   // stalled at 3.65-3.7e-3 at 9.6, 12.7 and 14.4 M variables, through widenings of 1 583 faces
   // on such growths. The rows are logged either way (debug).
   bool blame_residual = false;
+  // Where round 1's LP stops as diverging, look for an exact proof of infeasibility (Clp) near
+  // the rows its stalled primal iterate leaves furthest from b: the LP cut down to the rows within
+  // 0, 1, 2 … steps of them (a relaxation, so a Farkas ray there proves the whole LP infeasible),
+  // while it has at most this many columns (0: off). A proof replaces the guess: the error is
+  // certified and names the ray's rows alone. None found is logged (debug) and changes nothing.
+  int64_t local_proof_columns = 0;
+  int local_proof_depth = 8;
   // Later rounds' first-order parts start from the primal weight ω that the last solve of their
   // columns ended with (the geometric mean over the part's columns), instead of lp's own
   // (initial_primal_weight; PDHG's start at 1 where that is 0). Those rounds start from the last
