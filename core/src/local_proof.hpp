@@ -57,17 +57,18 @@ inline LpProblem relaxation_on_rows(const LpProblem& lp, const std::vector<int64
 }
 
 // Looks for a proof around `seeds` (rows of `lp`), depth 0, 1, … up to `max_depth`, while the
-// relaxation has at most `max_cols` columns. `exact` must be an exact solver (Clp) that returns
+// relaxation has at most `max_cols` columns and the solves have taken under `max_seconds`. `exact` must be an exact solver (Clp) that returns
 // a Farkas ray in `y` for an infeasible LP; a ray that does not check out (farkas_rate ≤ 0 either
 // way round) proves nothing.
 inline LocalProof local_infeasibility(const LpProblem& lp, std::vector<int64_t> seeds, int max_depth,
-                                      int64_t max_cols, LpSolver& exact) {
+                                      int64_t max_cols, LpSolver& exact, double max_seconds = 600.0) {
   LocalProof p;
   std::sort(seeds.begin(), seeds.end());
   seeds.erase(std::unique(seeds.begin(), seeds.end()), seeds.end());
   seeds.erase(std::remove_if(seeds.begin(), seeds.end(), [&](int64_t r) { return r < 0 || r >= lp.rows(); }),
               seeds.end());
   std::vector<int64_t> keep = std::move(seeds), cols;
+  double spent = 0.0;
   for (int depth = 0; depth <= max_depth && !keep.empty(); ++depth) {
     if (depth > 0) {  // one step out: every row of the columns the last relaxation had
       std::vector<char> in(lp.rows(), 0);
@@ -87,7 +88,10 @@ inline LocalProof local_infeasibility(const LpProblem& lp, std::vector<int64_t> 
     p.cols = static_cast<int64_t>(cols.size());
     SolverParams params;
     params.threads = 1;
+    params.time_limit = max_seconds - spent;
+    if (!(params.time_limit > 0.0)) break;
     const LpResult r = exact.solve(relaxed, params);
+    spent += r.seconds;
     if (r.status != LpStatus::Infeasible) {
       if (r.status == LpStatus::Optimal) continue;
       break;  // (the exact solver gave up: nothing more to learn further out)

@@ -2535,7 +2535,8 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
           if (at != red.rows.end() && *at == row) seeds.push_back(at - red.rows.begin());
         }
         const detail::LocalProof proof = detail::local_infeasibility(
-            red.lp, std::move(seeds), options.local_proof_depth, options.local_proof_columns, *exact_solver);
+            red.lp, std::move(seeds), options.local_proof_depth, options.local_proof_columns, *exact_solver,
+            options.local_proof_seconds);
         spdlog::debug("rounding: {} infeasibility near the stalled rows: {} steps out, {} rows and {} columns ({:.2f} s)",
                       proof.proved ? "proved" : "no proof of", proof.depth, proof.rows, proof.cols,
                       local_clock.seconds());

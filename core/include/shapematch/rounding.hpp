@@ -84,6 +84,7 @@ struct RoundingOptions {
   // certified and names the ray's rows alone. None found is logged (debug) and changes nothing.
   int64_t local_proof_columns = 0;
   int local_proof_depth = 8;
+  double local_proof_seconds = 600.0;  // Clp's time on them in all
   // Later rounds' first-order parts start from the primal weight ω that the last solve of their
   // columns ended with (the geometric mean over the part's columns), instead of lp's own
   // (initial_primal_weight; PDHG's start at 1 where that is 0). Those rounds start from the last
