@@ -3055,3 +3055,51 @@ TEST_CASE("rounding: a local proof of infeasibility is found where the clash lie
   CHECK(matching.depth == 2);
   CHECK(matching.cols > 0);
 }
+
+TEST_CASE("rounding: a local proof certifies a matching LP's clash that propagation cannot see, and changes nothing on a feasible LP") {
+  const MatchingLp& m = dolphins_30();
+  RoundingOptions o;
+  o.solver = "pdhg-cpu";
+  o.feasibility_iterations = 0;
+  o.lp.tolerance = 1e-9;
+  o.lp.stop_on_divergence = true;
+  o.lp.divergence_bound = 0.0;  // (stops round 1's LP as diverging at its second window: see above)
+  const auto error_of = [&](int64_t columns) {
+    RoundingOptions b = o;
+    b.local_proof_columns = columns;
+    try {
+      round_to_graph_surface(m.space, m.lp, m.energy, b);
+    } catch (const InfeasibleError& e) {
+      std::vector<int64_t> rows = e.rows();
+      std::sort(rows.begin(), rows.end());
+      return std::make_pair(e.certified(), rows);
+    }
+    FAIL("round 1's LP did not stop");
+    return std::make_pair(false, std::vector<int64_t>{});
+  };
+  // Feasible: no proof near the stalled rows, the same guess.
+  const auto plain = error_of(0), tried = error_of(1'000'000);
+  CHECK_FALSE(plain.first);
+  CHECK_FALSE(tried.first);
+  CHECK(tried.second == plain.second);
+  // One closedness row asked for a net flux of 1: ∂∂ = 0 makes that impossible (a ray: a
+  // potential 1 at one end of the product edge, on the edges there), while every row keeps two
+  // free entries or more, so propagation sees nothing. (PDHG certifies this one itself within its
+  // first window, so the rounding's own path to the proof is not reached here.)
+  LpProblem clash = m.lp;
+  clash.b[0] = 1.0;
+  auto clp = make_solver("clp-dual");
+  const detail::LocalProof p = detail::local_infeasibility(clash, {0}, 8, 1'000'000, *clp);
+  REQUIRE(p.proved);
+  MESSAGE("proved " << p.depth << " steps out, on " << p.rows << " rows and " << p.cols << " columns; the ray needs "
+                    << p.support.size() << " rows");
+  CHECK(p.rows < clash.rows());  // (local: the 30-face pair's relaxation has every column)
+  CHECK(std::binary_search(p.support.begin(), p.support.end(), int64_t{0}));
+  CHECK(p.support.back() < m.closedness_rows);  // (closedness rows alone)
+  std::vector<double> d(clash.rows(), 0.0);
+  for (size_t k = 0; k < p.support.size(); ++k) d[p.support[k]] = p.ray[k];
+  CHECK(farkas_rate(clash, d) > 0.0);
+  d.assign(m.lp.rows(), 0.0);  // (and it is no ray of the feasible LP)
+  for (size_t k = 0; k < p.support.size(); ++k) d[p.support[k]] = p.ray[k];
+  CHECK_FALSE(farkas_rate(m.lp, d) > 0.0);
+}

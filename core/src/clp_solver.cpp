@@ -44,6 +44,7 @@ LpResult ClpSolver::solve(const LpProblem& problem, const SolverParams& params) 
   ClpSolve options;
   if (method_ == Method::DualSimplex) {
     options.setSolveType(ClpSolve::useDual);
+    if (params.farkas_ray) options.setPresolveType(ClpSolve::presolveOff);
   } else {
     options.setSolveType(ClpSolve::useBarrier);  // with crossover to an exact vertex
   }

@@ -88,6 +88,7 @@ inline LocalProof local_infeasibility(const LpProblem& lp, std::vector<int64_t> 
     p.cols = static_cast<int64_t>(cols.size());
     SolverParams params;
     params.threads = 1;
+    params.farkas_ray = true;
     params.time_limit = max_seconds - spent;
     if (!(params.time_limit > 0.0)) break;
     const LpResult r = exact.solve(relaxed, params);

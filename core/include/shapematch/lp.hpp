@@ -76,6 +76,9 @@ struct SolverParams {
   // certificate of infeasibility takes long to emerge (a 10 k-face reduced matching LP: its dual
   // bound rose by about 1.4 every 64 iterations, and the proof came after 10 minutes).
   bool stop_on_divergence = false;
+  // Exact solvers: solve without presolve, so that an infeasible LP comes with its Farkas ray
+  // (Clp's presolve finds some infeasibilities itself and then keeps none).
+  bool farkas_ray = false;
   // With stop_on_divergence: only the slowest climb stops it, held twice as long
   // (detail::DivergenceWatch, patient). For an LP whose earlier suspicions came to nothing.
   bool patient_divergence_watch = false;
