@@ -6,11 +6,11 @@
 #include "certificate_blame.hpp"
 #include "failed_from.hpp"
 #include "failing_again.hpp"
+#include "local_proof.hpp"
 #include "part_search.hpp"
 #include "release_reach.hpp"
 #include "solve_in_parts.hpp"
 #include "stalled_rows.hpp"
-#include "local_proof.hpp"
 #include "test_helpers.hpp"
 
 #include <doctest/doctest.h>
@@ -3035,6 +3035,15 @@ TEST_CASE("rounding: a local proof of infeasibility is found where the clash lie
   std::vector<double> d(clash.rows(), 0.0);
   for (size_t k = 0; k < p.support.size(); ++k) d[p.support[k]] = p.ray[k];
   CHECK(farkas_rate(clash, d) > 0.0);
+  // The same LP as a reduced one whose row i is row 10 + 3i of a larger LP: seeds and support in
+  // that numbering, a seed it lacks left out.
+  std::vector<int64_t> rows(12);
+  for (int i = 0; i < 12; ++i) rows[i] = 10 + 3 * i;
+  const detail::LocalProof within = detail::local_infeasibility_within(clash, rows, {11, 16}, 8, 1000, *clp);
+  REQUIRE(within.proved);
+  CHECK(within.depth == 3);
+  CHECK(within.support == std::vector<int64_t>{25, 43});
+  CHECK_FALSE(detail::local_infeasibility_within(clash, rows, {11}, 8, 1000, *clp).proved);  // (no seed)
   // Capped at 5 columns: the relaxations of depths 0 and 1 (2 and 4 columns) alone, no proof.
   const detail::LocalProof capped = detail::local_infeasibility(clash, {2}, 8, 5, *clp);
   CHECK_FALSE(capped.proved);

@@ -352,15 +352,13 @@ std::vector<int64_t> residual_rows(const LpProblem& lp, const std::vector<double
   return out;
 }
 
-// The smallest angle of a triangle (degrees) and its area over the mesh's mean face area: a
-// degenerate face is one place an LP can be infeasible only locally.
-std::string face_shape(const Mesh& m, int f) {
-  auto area = [&](int g) {
-    const auto& t = m.faces[g];
-    return 0.5 * (m.vertices[t[1]] - m.vertices[t[0]]).cross(m.vertices[t[2]] - m.vertices[t[0]]).norm();
-  };
-  double total = 0.0;
-  for (int g = 0; g < m.num_faces(); ++g) total += area(g);
+// The smallest angle of a triangle (degrees) and its area over `mean` (the mesh's mean face
+// area): a degenerate face is one place an LP can be infeasible only locally.
+double face_area(const Mesh& m, int f) {
+  const auto& t = m.faces[f];
+  return 0.5 * (m.vertices[t[1]] - m.vertices[t[0]]).cross(m.vertices[t[2]] - m.vertices[t[0]]).norm();
+}
+std::string face_shape(const Mesh& m, int f, double mean) {
   const auto& t = m.faces[f];
   double smallest = 180.0;
   for (int i = 0; i < 3; ++i) {
@@ -368,7 +366,7 @@ std::string face_shape(const Mesh& m, int f) {
     const Eigen::Vector3d v = m.vertices[t[(i + 2) % 3]] - m.vertices[t[i]];
     smallest = std::min(smallest, std::atan2(u.cross(v).norm(), u.dot(v)) * 180.0 / M_PI);
   }
-  return fmt::format("min angle {:.1f}°, area {:.2f}× mean", smallest, area(f) * m.num_faces() / total);
+  return fmt::format("min angle {:.1f}°, area {:.2f}× mean", smallest, face_area(m, f) / mean);
 }
 
 // Debug log of the rows `residual_rows` names (at most 12): their kind (closedness of a product
@@ -382,18 +380,23 @@ void describe_stalled_rows(const ProductSpace& space, const LpProblem& full, con
   std::vector<double> ax(red.lp.rows());
   spmv(red.lp.a, x.data(), ax.data());
   auto tuple = [](const std::array<int, 3>& v) { return fmt::format("({},{},{})", v[0], v[1], v[2]); };
-  size_t shown = 0;
-  for (int64_t row : stalled) {
-    if (++shown > 12) break;
+  const auto mean_area = [](const Mesh& m) {
+    double total = 0.0;
+    for (int f = 0; f < m.num_faces(); ++f) total += face_area(m, f);
+    return total / m.num_faces();
+  };
+  const double mean_x = mean_area(X), mean_y = mean_area(Y);
+  for (size_t n = 0; n < stalled.size() && n < 12; ++n) {
+    const int64_t row = stalled[n];
     const auto at = std::lower_bound(red.rows.begin(), red.rows.end(), row);
     if (at == red.rows.end() || *at != row) continue;
     const int64_t i = at - red.rows.begin();
     const detail::RowPlace place = detail::row_place(space, full, row);
     std::string kind;
     if (place.kind == detail::RowPlace::pi_y)
-      kind = fmt::format("π_Y of Y face {} ({})", place.face, face_shape(Y, place.face));
+      kind = fmt::format("π_Y of Y face {} ({})", place.face, face_shape(Y, place.face, mean_y));
     else if (place.kind == detail::RowPlace::pi_x)
-      kind = fmt::format("π_X of X face {} ({})", place.face, face_shape(X, place.face));
+      kind = fmt::format("π_X of X face {} ({})", place.face, face_shape(X, place.face, mean_x));
     else {
       kind = "closedness of";
       for (const auto& [u, w] : place.edge) kind += fmt::format(" ({},{})", u, w);
@@ -415,10 +418,11 @@ void describe_stalled_rows(const ProductSpace& space, const LpProblem& full, con
     }
     spdlog::debug("stalled row {} ({}): Ax {:.4f}, b {}, {} columns:{}", row, kind, ax[i], red.lp.b[i], cols.size(),
                   list);
+    if ((fx.empty() && fy.empty()) || fx.size() + fy.size() > 16) continue;  // (a π row's: hundreds)
     std::string shapes;
-    for (int f : fx) shapes += fmt::format(" X{} {};", f, face_shape(X, f));
-    for (int f : fy) shapes += fmt::format(" Y{} {};", f, face_shape(Y, f));
-    if (!shapes.empty() && fx.size() + fy.size() <= 16) spdlog::debug("  its columns' faces:{}", shapes);
+    for (int f : fx) shapes += fmt::format(" X{} {};", f, face_shape(X, f, mean_x));
+    for (int f : fy) shapes += fmt::format(" Y{} {};", f, face_shape(Y, f, mean_y));
+    spdlog::debug("  its columns' faces:{}", shapes);
   }
 }
 
@@ -2529,25 +2533,19 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
       if (options.local_proof_columns > 0 && !stalled.empty()) {
         Stopwatch local_clock;
         if (!exact_solver) exact_solver = make_solver("clp-dual");
-        std::vector<int64_t> seeds;  // (the stalled rows in the reduced LP's numbering)
-        for (int64_t row : stalled) {
-          const auto at = std::lower_bound(red.rows.begin(), red.rows.end(), row);
-          if (at != red.rows.end() && *at == row) seeds.push_back(at - red.rows.begin());
-        }
-        const detail::LocalProof proof = detail::local_infeasibility(
-            red.lp, std::move(seeds), options.local_proof_depth, options.local_proof_columns, *exact_solver,
-            options.local_proof_seconds);
-        spdlog::debug("rounding: {} infeasibility near the stalled rows: {} steps out, {} rows and {} columns ({:.2f} s)",
+        const detail::LocalProof proof =
+            detail::local_infeasibility_within(red.lp, red.rows, stalled, options.local_proof_depth,
+                                               options.local_proof_columns, *exact_solver, options.local_proof_seconds);
+        spdlog::debug("rounding: {} infeasibility near the stalled rows: {} steps out, {} rows and {} columns "
+                      "({:.2f} s)",
                       proof.proved ? "proved" : "no proof of", proof.depth, proof.rows, proof.cols,
                       local_clock.seconds());
         if (proof.proved) {
-          std::vector<int64_t> support;
-          for (int64_t i : proof.support) support.push_back(red.rows[i]);
-          spdlog::debug("rounding: its Farkas ray needs {} rows", support.size());
+          spdlog::debug("rounding: its Farkas ray needs {} rows", proof.support.size());
           throw InfeasibleError(fmt::format("rounding: the matching LP is infeasible (Clp, {} rows within {} steps of "
                                             "its stalled residual)",
                                             proof.rows, proof.depth),
-                                std::move(support), true);
+                                proof.support, true);
         }
       }
       throw InfeasibleError(r.lower_bound + lp.objective_scale * red.fixed_cost > options.lp.divergence_bound
