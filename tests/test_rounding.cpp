@@ -3112,3 +3112,65 @@ TEST_CASE("rounding: a local proof certifies a matching LP's clash that propagat
   for (size_t k = 0; k < p.support.size(); ++k) d[p.support[k]] = p.ray[k];
   CHECK_FALSE(farkas_rate(m.lp, d) > 0.0);
 }
+
+TEST_CASE("rounding: a relaxation with face rows' far columns merged keeps a feasible point feasible") {
+  // The identity matching of a mesh with itself is feasible; on any rows, its point restricted to
+  // the columns kept, each slack the rest of its row, must satisfy the relaxation (a relaxation).
+  static const Mesh x = decimate(shapes::dolphin(0, 5), 30);
+  const MatchingLp m = build_matching_lp(x, compute_geometry(x), x, compute_geometry(x));
+  std::vector<double> point(m.lp.cols(), 0.0);
+  for (const ProductTriangle& t : identity_matching(x)) point[m.space.index_in_full(t)] = 1.0;
+  std::vector<int64_t> all(m.lp.cols());
+  std::iota(all.begin(), all.end(), int64_t{0});
+  std::mt19937 rng(7);
+  int64_t merged = 0;
+  for (int trial = 0; trial < 12; ++trial) {
+    CAPTURE(trial);
+    std::vector<int64_t> keep;
+    if (trial % 2 == 0) {
+      keep = detail::rows_over_x_faces(m.space, m.lp, all, detail::faces_near(x, {trial}, 1 + trial % 3));
+    } else {
+      for (int64_t r = 0; r < m.lp.rows(); ++r)
+        if (rng() % 10 == 0) keep.push_back(r);
+    }
+    const detail::Relaxation rel = detail::relaxation_on_rows(m.lp, keep, true);
+    std::vector<double> p(rel.lp.cols(), 0.0);
+    for (size_t k = 0; k < rel.cols.size(); ++k) p[k] = point[rel.cols[k]];
+    std::vector<double> ax(rel.lp.rows(), 0.0);
+    spmv(rel.lp.a, p.data(), ax.data());
+    for (size_t s = 0; s < rel.slack_rows.size(); ++s) {  // (slack: what its row still needs)
+      const int64_t i = rel.slack_rows[s];
+      p[rel.cols.size() + s] = rel.lp.b[i] - ax[i];
+      CHECK(p[rel.cols.size() + s] >= -1e-12);
+      CHECK(p[rel.cols.size() + s] <= 1.0 + 1e-12);
+    }
+    spmv(rel.lp.a, p.data(), ax.data());
+    for (int64_t i = 0; i < rel.lp.rows(); ++i) CHECK(ax[i] == doctest::Approx(rel.lp.b[i]));
+    merged += static_cast<int64_t>(rel.slack_rows.size());
+  }
+  CHECK(merged > 0);  // (the merging was exercised)
+}
+
+TEST_CASE("rounding: a local proof over an X region certifies a matching LP's clash with its far columns merged") {
+  // dolphins_30 with one closedness row's flux set to 1 (see above), proved over the X faces
+  // around that row: a relaxation of fewer rows and columns than the plain growth's.
+  const MatchingLp& m = dolphins_30();
+  LpProblem clash = m.lp;
+  clash.b[0] = 1.0;
+  std::vector<int64_t> all(m.lp.cols());
+  std::iota(all.begin(), all.end(), int64_t{0});
+  const std::vector<int> seeds = detail::x_faces_of_rows(m.space, clash, all, {}, {0});
+  REQUIRE_FALSE(seeds.empty());
+  const auto region_rows = [&](int rings) {
+    return detail::rows_over_x_faces(m.space, clash, all, detail::faces_near(m.space.x(), seeds, 1 + rings));
+  };
+  auto clp = make_solver("clp-dual");
+  const detail::LocalProof p = detail::local_infeasibility_on(clash, region_rows, 8, 1'000'000, *clp, 600.0, true);
+  REQUIRE(p.proved);
+  MESSAGE("proved " << p.depth << " rings out, on " << p.rows << " rows and " << p.cols << " columns of "
+                    << clash.rows() << " and " << clash.cols());
+  CHECK(std::binary_search(p.support.begin(), p.support.end(), int64_t{0}));
+  CHECK(p.cols < clash.cols());
+  // The feasible LP: no proof over the same regions.
+  CHECK_FALSE(detail::local_infeasibility_on(m.lp, region_rows, 8, 1'000'000, *clp, 600.0, true).proved);
+}

@@ -1,11 +1,10 @@
 #pragma once
 // An exact proof that an LP is infeasible, looked for near a few rows (RoundingOptions::
-// local_proof): the rows within `depth` steps of them (a step: from a row to its columns, from a
-// column to its rows), every column those rows touch, and no other row. That is a relaxation of
-// the LP (rows dropped, columns kept in [0, 1]), so Clp's Farkas ray on it proves the whole LP
-// infeasible too, with the rows it needs. A first-order solve that stalls short of feasible in a
-// few rows (TOSCA_r dog3-dog8 at full resolution: 7 of 3.3 M rows) leaves that question open;
-// where the clash is local, this answers it in seconds and names the rows exactly. Kept apart
+// local_proof_columns): some of its rows, every column they touch, and no other row. That is a
+// relaxation of the LP (rows dropped, columns kept in [0, 1]), so Clp's Farkas ray on it proves
+// the whole LP infeasible too, with the rows it needs. A first-order solve that stalls short of
+// feasible in a few rows (TOSCA_r dog3-dog8 at full resolution: 7 of 3.5 M rows) leaves that
+// question open; where the clash is local, this answers it and names the rows exactly. Kept apart
 // from the rounding loop so that it is tested on its own.
 #include "shapematch/lp.hpp"
 #include "shapematch/sparse.hpp"
@@ -19,46 +18,89 @@ namespace shapematch::detail {
 
 struct LocalProof {
   bool proved = false;
-  int depth = -1;               // of the last relaxation solved (-1: none)
-  int64_t rows = 0, cols = 0;   // its size
-  std::vector<int64_t> support; // proved: the rows of `lp` the ray needs, increasing
-  std::vector<double> ray;      // its value on each (zero elsewhere: a ray of `lp` itself)
+  int depth = -1;                // of the last relaxation solved (-1: none)
+  int64_t rows = 0, cols = 0;    // its size
+  std::vector<int64_t> support;  // proved: the rows of `lp` the ray needs, increasing
+  std::vector<double> ray;       // its value on each: a ray of the relaxation (of `lp` itself, zero
+                                 // elsewhere, where nothing was merged)
 };
 
-// The columns of `lp` that its rows `keep` touch, increasing.
-inline std::vector<int64_t> columns_of_rows(const LpProblem& lp, const std::vector<int64_t>& keep) {
-  std::vector<char> touched(lp.cols(), 0);
-  for (int64_t r : keep)
-    for (uint32_t k = lp.a.row_ptr[r]; k < lp.a.row_ptr[r + 1]; ++k) touched[col_of(lp.a.entry[k])] = 1;
-  std::vector<int64_t> cols;
-  for (int64_t j = 0; j < lp.cols(); ++j)
-    if (touched[j]) cols.push_back(j);
-  return cols;
+// A relaxation of `lp` on its rows `keep` (increasing): every column they touch, costs 0 (a
+// feasibility problem), b and bounds kept; except that where `merge`, the columns of a partition
+// row (every entry +1, b = 1: a face's projection row) that no other kept row has become one slack
+// column of that row. Still a relaxation: their sum lies in [0, 1] in any feasible x, as the
+// slack does. A face's row has thousands of columns, most of them far from the rows kept; merged,
+// the relaxation grows with the rows kept, not with every column a kept face row reaches.
+struct Relaxation {
+  LpProblem lp;
+  std::vector<int64_t> cols;        // lp's columns kept one by one (its first columns), increasing
+  std::vector<int64_t> slack_rows;  // then one slack column per such row (its index in `keep`)
+};
+
+inline bool is_partition_row(const LpProblem& lp, int64_t r) {
+  if (lp.b[r] != 1.0) return false;
+  for (uint32_t k = lp.a.row_ptr[r]; k < lp.a.row_ptr[r + 1]; ++k)
+    if (lp.a.entry[k] & SignedCsr::kNegative) return false;
+  return true;
 }
 
-// The relaxation of `lp` to its rows `keep` (increasing) and the columns they touch, `cols`
-// (columns_of_rows): costs 0 (a feasibility problem), b and bounds kept.
-inline LpProblem relaxation_on_rows(const LpProblem& lp, const std::vector<int64_t>& keep,
-                                    const std::vector<int64_t>& cols) {
+// The plan of a relaxation: its columns and slacks, `lp` left empty (its size known before it is
+// built).
+inline Relaxation plan_relaxation(const LpProblem& lp, const std::vector<int64_t>& keep, bool merge) {
+  Relaxation out;
+  std::vector<uint8_t> count(lp.cols(), 0);  // kept rows per column, up to 2
+  for (int64_t r : keep)
+    for (uint32_t k = lp.a.row_ptr[r]; k < lp.a.row_ptr[r + 1]; ++k) {
+      uint8_t& c = count[col_of(lp.a.entry[k])];
+      if (c < 2) ++c;
+    }
+  std::vector<char> one_by_one(lp.cols(), 0);
+  for (size_t i = 0; i < keep.size(); ++i) {
+    const int64_t r = keep[i];
+    const bool partition = merge && is_partition_row(lp, r);
+    bool slack = false;
+    for (uint32_t k = lp.a.row_ptr[r]; k < lp.a.row_ptr[r + 1]; ++k) {
+      const uint32_t j = col_of(lp.a.entry[k]);
+      if (partition && count[j] == 1) slack = true;
+      else one_by_one[j] = 1;
+    }
+    if (slack) out.slack_rows.push_back(static_cast<int64_t>(i));
+  }
+  for (int64_t j = 0; j < lp.cols(); ++j)
+    if (one_by_one[j]) out.cols.push_back(j);
+  return out;
+}
+
+// Builds a planned relaxation into plan.lp.
+inline void build_relaxation(const LpProblem& lp, const std::vector<int64_t>& keep, Relaxation& plan) {
   std::vector<int64_t> row_new(lp.rows(), -1);
   for (size_t i = 0; i < keep.size(); ++i) row_new[keep[i]] = static_cast<int64_t>(i);
-  LpProblem out;
-  out.at.rows = static_cast<int64_t>(cols.size());
-  out.at.cols = static_cast<int64_t>(keep.size());
-  out.at.row_ptr.assign(1, 0);
-  for (int64_t j : cols) {
+  LpProblem& rl = plan.lp;
+  rl.at.rows = static_cast<int64_t>(plan.cols.size() + plan.slack_rows.size());
+  rl.at.cols = static_cast<int64_t>(keep.size());
+  rl.at.row_ptr.assign(1, 0);
+  for (int64_t j : plan.cols) {
     for (uint32_t k = lp.at.row_ptr[j]; k < lp.at.row_ptr[j + 1]; ++k) {
       const uint32_t e = lp.at.entry[k];
       const int64_t r = row_new[col_of(e)];
-      if (r >= 0) out.at.entry.push_back(static_cast<uint32_t>(r) | (e & SignedCsr::kNegative));
+      if (r >= 0) rl.at.entry.push_back(static_cast<uint32_t>(r) | (e & SignedCsr::kNegative));
     }
-    out.at.row_ptr.push_back(static_cast<uint32_t>(out.at.entry.size()));
+    rl.at.row_ptr.push_back(static_cast<uint32_t>(rl.at.entry.size()));
   }
-  out.a = transpose(out.at);
-  out.b.resize(keep.size());
-  for (size_t i = 0; i < keep.size(); ++i) out.b[i] = lp.b[keep[i]];
-  out.c.assign(cols.size(), 0.0);
-  return out;
+  for (int64_t i : plan.slack_rows) {
+    rl.at.entry.push_back(static_cast<uint32_t>(i));
+    rl.at.row_ptr.push_back(static_cast<uint32_t>(rl.at.entry.size()));
+  }
+  rl.a = transpose(rl.at);
+  rl.b.resize(keep.size());
+  for (size_t i = 0; i < keep.size(); ++i) rl.b[i] = lp.b[keep[i]];
+  rl.c.assign(rl.at.rows, 0.0);
+}
+
+inline Relaxation relaxation_on_rows(const LpProblem& lp, const std::vector<int64_t>& keep, bool merge) {
+  Relaxation r = plan_relaxation(lp, keep, merge);
+  build_relaxation(lp, keep, r);
+  return r;
 }
 
 // A ray d proves infeasibility only with a margin above rounding: its Farkas rate over the scale
@@ -69,74 +111,90 @@ inline bool proves_infeasible(const LpProblem& lp, const std::vector<double>& d)
   return farkas_rate(lp, d) > 1e-9 * scale;
 }
 
-// Looks for a proof around `seeds` (rows of `lp`), depth 0, 1, … up to `max_depth`, while the
-// relaxation has at most `max_cols` columns and the solves have taken under `max_seconds`.
-// `exact` must be an exact solver (Clp) that returns a Farkas ray in `y` for an infeasible LP
-// (SolverParams::farkas_ray); a ray that does not check out on `lp` itself (proves_infeasible,
-// either way round) proves nothing.
-inline LocalProof local_infeasibility(const LpProblem& lp, std::vector<int64_t> seeds, int max_depth,
-                                      int64_t max_cols, LpSolver& exact, double max_seconds = 600.0) {
-  LocalProof p;
-  std::sort(seeds.begin(), seeds.end());
-  seeds.erase(std::unique(seeds.begin(), seeds.end()), seeds.end());
-  seeds.erase(std::remove_if(seeds.begin(), seeds.end(), [&](int64_t r) { return r < 0 || r >= lp.rows(); }),
-              seeds.end());
-  std::vector<int64_t> keep = std::move(seeds), cols;
-  double spent = 0.0;
-  for (int depth = 0; depth <= max_depth && !keep.empty(); ++depth) {
-    if (depth > 0) {  // one step out: every row of the columns the last relaxation had
-      std::vector<char> in(lp.rows(), 0);
-      for (int64_t r : keep) in[r] = 1;
-      for (int64_t j : cols)
-        for (uint32_t k = lp.at.row_ptr[j]; k < lp.at.row_ptr[j + 1]; ++k) in[col_of(lp.at.entry[k])] = 1;
-      const size_t before = keep.size();
-      keep.clear();
-      for (int64_t r = 0; r < lp.rows(); ++r)
-        if (in[r]) keep.push_back(r);
-      if (keep.size() == before) break;  // (the whole component, solved already)
+// The rows of `lp` one step out from `keep` (increasing): every row of the columns they touch.
+inline std::vector<int64_t> rows_one_step_out(const LpProblem& lp, const std::vector<int64_t>& keep) {
+  std::vector<char> in(lp.rows(), 0);
+  for (int64_t r : keep) {
+    in[r] = 1;
+    for (uint32_t k = lp.a.row_ptr[r]; k < lp.a.row_ptr[r + 1]; ++k) {
+      const uint32_t j = col_of(lp.a.entry[k]);
+      for (uint32_t q = lp.at.row_ptr[j]; q < lp.at.row_ptr[j + 1]; ++q) in[col_of(lp.at.entry[q])] = 1;
     }
-    cols = columns_of_rows(lp, keep);
-    if (static_cast<int64_t>(cols.size()) > max_cols) break;  // (before building it)
-    const LpProblem relaxed = relaxation_on_rows(lp, keep, cols);
+  }
+  std::vector<int64_t> out;
+  for (int64_t r = 0; r < lp.rows(); ++r)
+    if (in[r]) out.push_back(r);
+  return out;
+}
+
+// Looks for a proof on the rows `rows_at(0)`, `rows_at(1)`, … (each increasing and growing; empty
+// or no larger: nothing further) up to `max_depth`, while the relaxation has at most `max_cols`
+// columns and the solves have taken under `max_seconds`. `exact` must be an exact solver (Clp)
+// that returns a Farkas ray in `y` for an infeasible LP (SolverParams::farkas_ray); a ray that
+// does not check out on the relaxation (proves_infeasible, either way round) proves nothing.
+template <class RowsAt>
+LocalProof local_infeasibility_on(const LpProblem& lp, RowsAt&& rows_at, int max_depth, int64_t max_cols,
+                                  LpSolver& exact, double max_seconds, bool merge) {
+  LocalProof p;
+  double spent = 0.0;
+  size_t last = 0;
+  for (int depth = 0; depth <= max_depth; ++depth) {
+    const std::vector<int64_t> keep = rows_at(depth);
+    if (keep.size() <= last) break;
+    last = keep.size();
+    Relaxation relaxed = plan_relaxation(lp, keep, merge);
+    const int64_t cols = static_cast<int64_t>(relaxed.cols.size() + relaxed.slack_rows.size());
+    if (cols > max_cols) break;  // (before building it)
+    build_relaxation(lp, keep, relaxed);
     p.depth = depth;
     p.rows = static_cast<int64_t>(keep.size());
-    p.cols = static_cast<int64_t>(cols.size());
+    p.cols = cols;
     SolverParams params;
     params.threads = 1;
     params.farkas_ray = true;
     params.time_limit = max_seconds - spent;
     if (!(params.time_limit > 0.0)) break;
-    const LpResult r = exact.solve(relaxed, params);
+    const LpResult r = exact.solve(relaxed.lp, params);
     spent += r.seconds;
     if (r.status == LpStatus::Optimal) continue;
     if (r.status != LpStatus::Infeasible || r.y.size() != keep.size()) break;  // (gave up, or no ray)
-    // The ray on lp's rows, zero off the relaxation; its tiniest entries dropped where it still
-    // proves infeasibility without them.
-    const auto on_lp = [&](double sign, double cut) {
-      std::vector<double> d(lp.rows(), 0.0);
-      for (size_t i = 0; i < keep.size(); ++i)
-        if (std::abs(r.y[i]) > cut) d[keep[i]] = sign * r.y[i];
-      return d;
-    };
+    // Its tiniest entries dropped where it still proves infeasibility without them.
     double largest = 0.0;
     for (double v : r.y) largest = std::max(largest, std::abs(v));
     std::vector<double> d;
     for (double sign : {1.0, -1.0})
       for (double cut : {1e-9 * largest, 0.0})
         if (d.empty()) {
-          std::vector<double> t = on_lp(sign, cut);
-          if (proves_infeasible(lp, t)) d = std::move(t);
+          std::vector<double> t(r.y.size());
+          for (size_t i = 0; i < t.size(); ++i) t[i] = std::abs(r.y[i]) > cut ? sign * r.y[i] : 0.0;
+          if (proves_infeasible(relaxed.lp, t)) d = std::move(t);
         }
     if (d.empty()) break;
-    for (int64_t i = 0; i < lp.rows(); ++i)
+    for (size_t i = 0; i < d.size(); ++i)
       if (d[i] != 0.0) {
-        p.support.push_back(i);
+        p.support.push_back(keep[i]);
         p.ray.push_back(d[i]);
       }
     p.proved = true;
     return p;
   }
   return p;
+}
+
+// local_infeasibility_on the rows within 0, 1, 2 … steps of `seeds` (rows_one_step_out), nothing
+// merged: the ray, zero elsewhere, is a ray of `lp` itself.
+inline LocalProof local_infeasibility(const LpProblem& lp, std::vector<int64_t> seeds, int max_depth,
+                                      int64_t max_cols, LpSolver& exact, double max_seconds = 600.0) {
+  std::sort(seeds.begin(), seeds.end());
+  seeds.erase(std::unique(seeds.begin(), seeds.end()), seeds.end());
+  seeds.erase(std::remove_if(seeds.begin(), seeds.end(), [&](int64_t r) { return r < 0 || r >= lp.rows(); }),
+              seeds.end());
+  std::vector<int64_t> keep = std::move(seeds);
+  const auto rows_at = [&](int depth) {
+    if (depth > 0) keep = rows_one_step_out(lp, keep);
+    return keep;
+  };
+  return local_infeasibility_on(lp, rows_at, max_depth, max_cols, exact, max_seconds, false);
 }
 
 // local_infeasibility on a reduced LP (`reduced`, whose row i is row rows[i] of a larger LP,

@@ -2533,17 +2533,31 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
       if (options.local_proof_columns > 0 && !stalled.empty()) {
         Stopwatch local_clock;
         if (!exact_solver) exact_solver = make_solver("clp-dual");
-        const detail::LocalProof proof =
-            detail::local_infeasibility_within(red.lp, red.rows, stalled, options.local_proof_depth,
-                                               options.local_proof_columns, *exact_solver, options.local_proof_seconds);
-        spdlog::debug("rounding: {} infeasibility near the stalled rows: {} steps out, {} rows and {} columns "
+        // The X region around the stalled rows, 0, 1, 2 … rings out: its rows, face rows' far
+        // columns merged (local_proof.hpp; rows one step out reach a million columns at once).
+        std::vector<int64_t> seeds;  // (in the reduced LP's numbering)
+        for (int64_t row : stalled) {
+          const auto at = std::lower_bound(red.rows.begin(), red.rows.end(), row);
+          if (at != red.rows.end() && *at == row) seeds.push_back(at - red.rows.begin());
+        }
+        const std::vector<int> seed_faces = detail::x_faces_of_rows(space, red.lp, red.cols, r.x, seeds);
+        const auto region_rows = [&](int rings) {
+          return seed_faces.empty() ? std::vector<int64_t>{}
+                                    : detail::rows_over_x_faces(space, red.lp, red.cols,
+                                                                detail::faces_near(space.x(), seed_faces, 1 + rings));
+        };
+        detail::LocalProof proof =
+            detail::local_infeasibility_on(red.lp, region_rows, options.local_proof_depth,
+                                           options.local_proof_columns, *exact_solver, options.local_proof_seconds, true);
+        for (int64_t& i : proof.support) i = red.rows[i];
+        spdlog::debug("rounding: {} infeasibility near the stalled rows ({} X faces): {} rings out, {} rows and {} columns "
                       "({:.2f} s)",
-                      proof.proved ? "proved" : "no proof of", proof.depth, proof.rows, proof.cols,
+                      proof.proved ? "proved" : "no proof of", seed_faces.size(), proof.depth, proof.rows, proof.cols,
                       local_clock.seconds());
         if (proof.proved) {
           spdlog::debug("rounding: its Farkas ray needs {} rows", proof.support.size());
-          throw InfeasibleError(fmt::format("rounding: the matching LP is infeasible (Clp, {} rows within {} steps of "
-                                            "its stalled residual)",
+          throw InfeasibleError(fmt::format("rounding: the matching LP is infeasible (Clp, on {} rows over the X faces "
+                                            "within {} rings of its stalled residual)",
                                             proof.rows, proof.depth),
                                 proof.support, true);
         }

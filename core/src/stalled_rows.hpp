@@ -4,6 +4,7 @@
 #include "shapematch/lp.hpp"
 #include "shapematch/product_space.hpp"
 #include "shapematch/sparse.hpp"
+#include "suspicion_margin.hpp"
 
 #include <cstdint>
 #include <iterator>
@@ -47,6 +48,45 @@ inline RowPlace row_place(const ProductSpace& space, const LpProblem& lp, int64_
   }
   p.edge.assign(common.begin(), common.end());
   return p;
+}
+
+// The X faces where the rows `rows` of `lp` lie: a π_X row's face, and the X faces of the columns
+// of any other row that carry at least `at_least` of `x` (columns j of `lp` are space[cols[j]]).
+inline std::vector<int> x_faces_of_rows(const ProductSpace& space, const LpProblem& lp, const std::vector<int64_t>& cols,
+                                        const std::vector<double>& x, const std::vector<int64_t>& rows,
+                                        double at_least = 0.01) {
+  std::set<int> faces;
+  for (int64_t r : rows)
+    for (uint32_t k = lp.a.row_ptr[r]; k < lp.a.row_ptr[r + 1]; ++k) {
+      const uint32_t j = col_of(lp.a.entry[k]);
+      const ProductTriangle t = space[cols[j]];
+      if (t.fa >= 0 && (x.size() != cols.size() || x[j] >= at_least)) faces.insert(t.fa);
+    }
+  return {faces.begin(), faces.end()};
+}
+
+// The rows of `lp` that a column over the X faces `faces` has (its X part a face of them, or an
+// edge or vertex of one), increasing: an X region's rows, for a local proof (local_proof.hpp) that
+// grows with the region rather than with every column its rows reach.
+inline std::vector<int64_t> rows_over_x_faces(const ProductSpace& space, const LpProblem& lp,
+                                              const std::vector<int64_t>& cols, const std::vector<int>& faces) {
+  const Mesh& X = space.x();
+  std::vector<char> face_in(X.num_faces(), 0), vertex_in(X.num_vertices(), 0);
+  for (int f : faces) {
+    face_in[f] = 1;
+    for (int v : X.faces[f]) vertex_in[v] = 1;
+  }
+  std::vector<char> in(lp.rows(), 0);
+  for (int64_t j = 0; j < lp.cols(); ++j) {
+    const ProductTriangle t = space[cols[j]];
+    const bool over = t.fa >= 0 ? face_in[t.fa] != 0 : vertex_in[t.a[0]] && vertex_in[t.a[1]] && vertex_in[t.a[2]];
+    if (!over) continue;
+    for (uint32_t k = lp.at.row_ptr[j]; k < lp.at.row_ptr[j + 1]; ++k) in[col_of(lp.at.entry[k])] = 1;
+  }
+  std::vector<int64_t> out;
+  for (int64_t r = 0; r < lp.rows(); ++r)
+    if (in[r]) out.push_back(r);
+  return out;
 }
 
 }  // namespace shapematch::detail
