@@ -78,10 +78,11 @@ struct RoundingOptions {
   // on such growths. The rows are logged either way (debug).
   bool blame_residual = false;
   // Where round 1's LP stops as diverging, look for an exact proof of infeasibility (Clp) near
-  // the rows its stalled primal iterate leaves furthest from b: the LP cut down to the rows within
-  // 0, 1, 2 … steps of them (a relaxation, so a Farkas ray there proves the whole LP infeasible),
-  // while it has at most this many columns (0: off). A proof replaces the guess: the error is
-  // certified and names the ray's rows alone. None found is logged (debug) and changes nothing.
+  // the rows its stalled primal iterate leaves furthest from b: the LP cut down to the rows of the
+  // columns over the X faces within 0, 1, 2 … rings of theirs, a face row's far columns merged (a
+  // relaxation, so a Farkas ray there proves the whole LP infeasible), while it has at most this
+  // many columns (0: off). A proof replaces the guess: the error is certified and names the ray's
+  // rows alone. None found is logged (debug) and changes nothing.
   int64_t local_proof_columns = 0;
   int local_proof_depth = 8;
   double local_proof_seconds = 600.0;  // Clp's time on them in all
