@@ -3171,6 +3171,37 @@ TEST_CASE("rounding: a local proof over an X region certifies a matching LP's cl
                     << clash.rows() << " and " << clash.cols());
   CHECK(std::binary_search(p.support.begin(), p.support.end(), int64_t{0}));
   CHECK(p.cols < clash.cols());
+  CHECK_FALSE(detail::relaxation_on_rows(clash, region_rows(p.depth), true).slack_rows.empty());  // (merged)
   // The feasible LP: no proof over the same regions.
   CHECK_FALSE(detail::local_infeasibility_on(m.lp, region_rows, 8, 1'000'000, *clp, 600.0, true).proved);
+}
+
+TEST_CASE("rounding: the X faces of stalled rows: where their iterate lies, else all their columns'") {
+  const MatchingLp& m = dolphins_30();
+  std::vector<int64_t> all(m.lp.cols());
+  std::iota(all.begin(), all.end(), int64_t{0});
+  const int64_t pi_x = m.closedness_rows + 3, pi_y = m.closedness_rows + m.space.x().num_faces() + 5;
+  std::vector<double> x(m.lp.cols(), 0.0);
+  // A π_X row names its face, whatever the iterate.
+  CHECK(detail::x_faces_of_rows(m.space, m.lp, all, x, {pi_x}) == std::vector<int>{3});
+  // A π_Y row with nothing on it names the X faces of all its columns; with one column carrying
+  // the iterate, that column's (a triangle's face, or the faces on a vertex or edge's vertices).
+  const std::vector<int> every = detail::x_faces_of_rows(m.space, m.lp, all, x, {pi_y});
+  CHECK(every.size() == size_t(m.space.x().num_faces()));  // (the full space covers Y face 5 from every X face)
+  for (uint32_t k = m.lp.a.row_ptr[pi_y]; k < m.lp.a.row_ptr[pi_y + 1]; ++k) {
+    const int64_t j = col_of(m.lp.a.entry[k]);
+    const ProductTriangle t = m.space[j];
+    x[j] = 1.0;
+    const std::vector<int> one = detail::x_faces_of_rows(m.space, m.lp, all, x, {pi_y});
+    x[j] = 0.0;
+    if (t.fa >= 0) {
+      CHECK(one == std::vector<int>{t.fa});
+    } else {
+      CHECK(one.size() > 1);
+      for (int f : one) {
+        const auto& face = m.space.x().faces[f];
+        CHECK(std::find_first_of(face.begin(), face.end(), t.a.begin(), t.a.end()) != face.end());
+      }
+    }
+  }
 }

@@ -8,6 +8,7 @@
 // from the rounding loop so that it is tested on its own.
 #include "shapematch/lp.hpp"
 #include "shapematch/sparse.hpp"
+#include "shapematch/system.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -21,8 +22,10 @@ struct LocalProof {
   int depth = -1;                // of the last relaxation solved (-1: none)
   int64_t rows = 0, cols = 0;    // its size
   std::vector<int64_t> support;  // proved: the rows of `lp` the ray needs, increasing
-  std::vector<double> ray;       // its value on each: a ray of the relaxation (of `lp` itself, zero
-                                 // elsewhere, where nothing was merged)
+  // Its value on each: a ray of the relaxation. Where nothing was merged it is one of `lp` itself
+  // (zero elsewhere); where a merged row has a positive value it is not (each merged column counts
+  // once in `lp`, the slack once in all), though the support's rows are infeasible all the same.
+  std::vector<double> ray;
 };
 
 // A relaxation of `lp` on its rows `keep` (increasing): every column they touch, costs 0 (a
@@ -127,35 +130,35 @@ inline std::vector<int64_t> rows_one_step_out(const LpProblem& lp, const std::ve
   return out;
 }
 
-// Looks for a proof on the rows `rows_at(0)`, `rows_at(1)`, … (each increasing and growing; empty
-// or no larger: nothing further) up to `max_depth`, while the relaxation has at most `max_cols`
-// columns and the solves have taken under `max_seconds`. `exact` must be an exact solver (Clp)
+// Looks for a proof on the rows `rows_at(0)`, `rows_at(1)`, … (each increasing, none smaller than
+// the last; empty: nothing further; no larger: skipped) up to `max_depth`, while the relaxation
+// has at most `max_cols` columns and under `max_seconds` have gone (building included). `exact` must be an exact solver (Clp)
 // that returns a Farkas ray in `y` for an infeasible LP (SolverParams::farkas_ray); a ray that
 // does not check out on the relaxation (proves_infeasible, either way round) proves nothing.
 template <class RowsAt>
 LocalProof local_infeasibility_on(const LpProblem& lp, RowsAt&& rows_at, int max_depth, int64_t max_cols,
                                   LpSolver& exact, double max_seconds, bool merge) {
   LocalProof p;
-  double spent = 0.0;
+  const Stopwatch clock;
   size_t last = 0;
-  for (int depth = 0; depth <= max_depth; ++depth) {
+  for (int depth = 0; depth <= max_depth && clock.seconds() < max_seconds; ++depth) {
     const std::vector<int64_t> keep = rows_at(depth);
-    if (keep.size() <= last) break;
+    if (keep.empty()) break;
+    if (keep.size() <= last) continue;  // (solved already; a region's next ring may add rows)
     last = keep.size();
     Relaxation relaxed = plan_relaxation(lp, keep, merge);
     const int64_t cols = static_cast<int64_t>(relaxed.cols.size() + relaxed.slack_rows.size());
     if (cols > max_cols) break;  // (before building it)
     build_relaxation(lp, keep, relaxed);
-    p.depth = depth;
-    p.rows = static_cast<int64_t>(keep.size());
-    p.cols = cols;
     SolverParams params;
     params.threads = 1;
     params.farkas_ray = true;
-    params.time_limit = max_seconds - spent;
+    params.time_limit = max_seconds - clock.seconds();
     if (!(params.time_limit > 0.0)) break;
+    p.depth = depth;
+    p.rows = static_cast<int64_t>(keep.size());
+    p.cols = cols;
     const LpResult r = exact.solve(relaxed.lp, params);
-    spent += r.seconds;
     if (r.status == LpStatus::Optimal) continue;
     if (r.status != LpStatus::Infeasible || r.y.size() != keep.size()) break;  // (gave up, or no ray)
     // Its tiniest entries dropped where it still proves infeasibility without them.

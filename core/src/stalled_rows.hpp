@@ -50,18 +50,40 @@ inline RowPlace row_place(const ProductSpace& space, const LpProblem& lp, int64_
   return p;
 }
 
-// The X faces where the rows `rows` of `lp` lie: a π_X row's face, and the X faces of the columns
-// of any other row that carry at least `at_least` of `x` (columns j of `lp` are space[cols[j]]).
+// The X faces where the rows `rows` of `lp` lie: those of the columns of each row that carry at
+// least `at_least` of `x`, or of all its columns where none does (or `x` is not given); columns
+// j of `lp` are space[cols[j]], and a column whose X part is an edge or a vertex names the faces
+// on its vertices.
 inline std::vector<int> x_faces_of_rows(const ProductSpace& space, const LpProblem& lp, const std::vector<int64_t>& cols,
                                         const std::vector<double>& x, const std::vector<int64_t>& rows,
                                         double at_least = 0.01) {
+  const Mesh& X = space.x();
+  std::vector<std::vector<int>> around;  // faces per X vertex, built where first needed
   std::set<int> faces;
-  for (int64_t r : rows)
+  const auto add = [&](const ProductTriangle& t) {
+    if (t.fa >= 0) {
+      faces.insert(t.fa);
+      return;
+    }
+    if (around.empty()) {
+      around.resize(X.num_vertices());
+      for (int f = 0; f < X.num_faces(); ++f)
+        for (int v : X.faces[f]) around[v].push_back(f);
+    }
+    for (int v : t.a) faces.insert(around[v].begin(), around[v].end());
+  };
+  const bool given = x.size() == cols.size();
+  for (int64_t r : rows) {
+    bool any = false;
     for (uint32_t k = lp.a.row_ptr[r]; k < lp.a.row_ptr[r + 1]; ++k) {
       const uint32_t j = col_of(lp.a.entry[k]);
-      const ProductTriangle t = space[cols[j]];
-      if (t.fa >= 0 && (x.size() != cols.size() || x[j] >= at_least)) faces.insert(t.fa);
+      if (given && x[j] < at_least) continue;
+      add(space[cols[j]]);
+      any = true;
     }
+    if (!any)
+      for (uint32_t k = lp.a.row_ptr[r]; k < lp.a.row_ptr[r + 1]; ++k) add(space[cols[col_of(lp.a.entry[k])]]);
+  }
   return {faces.begin(), faces.end()};
 }
 
