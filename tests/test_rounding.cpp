@@ -3030,6 +3030,7 @@ TEST_CASE("rounding: a local proof of infeasibility is found where the clash lie
   const detail::LocalProof p = detail::local_infeasibility(clash, {2}, 8, 1000, *clp);
   REQUIRE(p.proved);
   CHECK(p.depth == 3);
+  CHECK(std::string(p.ended) == "proved");
   CHECK(p.support == std::vector<int64_t>{5, 11});
   // Its ray, zero elsewhere, proves the whole LP infeasible.
   std::vector<double> d(clash.rows(), 0.0);
@@ -3047,6 +3048,7 @@ TEST_CASE("rounding: a local proof of infeasibility is found where the clash lie
   // Capped at 5 columns: the relaxations of depths 0 and 1 (2 and 4 columns) alone, no proof.
   const detail::LocalProof capped = detail::local_infeasibility(clash, {2}, 8, 5, *clp);
   CHECK_FALSE(capped.proved);
+  CHECK(std::string(capped.ended) == "column cap");
   CHECK(capped.depth == 1);
   CHECK(capped.cols == 4);
   // Without row 11 the chain is feasible: no proof, however far out.
@@ -3055,6 +3057,9 @@ TEST_CASE("rounding: a local proof of infeasibility is found where the clash lie
   const LpProblem chain = test::dense_lp(a, b, std::vector<double>(12, 1.0));
   const detail::LocalProof none = detail::local_infeasibility(chain, {2}, 20, 1000, *clp);
   CHECK_FALSE(none.proved);
+  CHECK(std::string(none.ended) == "feasible");
+  // Out of time before the first solve: said so.
+  CHECK(std::string(detail::local_infeasibility(clash, {2}, 8, 1000, *clp, 0.0).ended) == "time limit");
   CHECK(none.rows == chain.rows());  // (it went out to the whole LP)
   // Nor on a feasible matching LP, from a π_Y row and a closedness row two steps out.
   const MatchingLp& m = dolphins_30();

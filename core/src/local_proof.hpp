@@ -19,6 +19,10 @@ namespace shapematch::detail {
 
 struct LocalProof {
   bool proved = false;
+  // How the search ended: "proved", "feasible" (every relaxation up to the depth, or the whole
+  // component), "column cap", "time limit", "no ray" (Clp's infeasible without one that checks
+  // out) or "solver" (Clp stopped otherwise); "no rows" where there was nothing to solve.
+  const char* ended = "no rows";
   int depth = -1;                // of the last relaxation solved (-1: none)
   int64_t rows = 0, cols = 0;    // its size
   std::vector<int64_t> support;  // proved: the rows of `lp` the ray needs, increasing
@@ -141,26 +145,42 @@ LocalProof local_infeasibility_on(const LpProblem& lp, RowsAt&& rows_at, int max
   LocalProof p;
   const Stopwatch clock;
   size_t last = 0;
-  for (int depth = 0; depth <= max_depth && clock.seconds() < max_seconds; ++depth) {
+  for (int depth = 0; depth <= max_depth; ++depth) {
+    if (clock.seconds() >= max_seconds) {
+      p.ended = "time limit";
+      break;
+    }
     const std::vector<int64_t> keep = rows_at(depth);
     if (keep.empty()) break;
     if (keep.size() <= last) continue;  // (solved already; a region's next ring may add rows)
     last = keep.size();
     Relaxation relaxed = plan_relaxation(lp, keep, merge);
     const int64_t cols = static_cast<int64_t>(relaxed.cols.size() + relaxed.slack_rows.size());
-    if (cols > max_cols) break;  // (before building it)
+    if (cols > max_cols) {  // (before building it)
+      p.ended = "column cap";
+      break;
+    }
     build_relaxation(lp, keep, relaxed);
     SolverParams params;
     params.threads = 1;
     params.farkas_ray = true;
     params.time_limit = max_seconds - clock.seconds();
-    if (!(params.time_limit > 0.0)) break;
+    if (!(params.time_limit > 0.0)) {
+      p.ended = "time limit";
+      break;
+    }
     p.depth = depth;
     p.rows = static_cast<int64_t>(keep.size());
     p.cols = cols;
     const LpResult r = exact.solve(relaxed.lp, params);
-    if (r.status == LpStatus::Optimal) continue;
-    if (r.status != LpStatus::Infeasible || r.y.size() != keep.size()) break;  // (gave up, or no ray)
+    if (r.status == LpStatus::Optimal) {
+      p.ended = "feasible";
+      continue;
+    }
+    if (r.status != LpStatus::Infeasible || r.y.size() != keep.size()) {
+      p.ended = r.status == LpStatus::TimeLimit ? "time limit" : r.status == LpStatus::Infeasible ? "no ray" : "solver";
+      break;
+    }
     // Its tiniest entries dropped where it still proves infeasibility without them.
     double largest = 0.0;
     for (double v : r.y) largest = std::max(largest, std::abs(v));
@@ -172,13 +192,17 @@ LocalProof local_infeasibility_on(const LpProblem& lp, RowsAt&& rows_at, int max
           for (size_t i = 0; i < t.size(); ++i) t[i] = std::abs(r.y[i]) > cut ? sign * r.y[i] : 0.0;
           if (proves_infeasible(relaxed.lp, t)) d = std::move(t);
         }
-    if (d.empty()) break;
+    if (d.empty()) {
+      p.ended = "no ray";
+      break;
+    }
     for (size_t i = 0; i < d.size(); ++i)
       if (d[i] != 0.0) {
         p.support.push_back(keep[i]);
         p.ray.push_back(d[i]);
       }
     p.proved = true;
+    p.ended = "proved";
     return p;
   }
   return p;

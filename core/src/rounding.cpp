@@ -2550,10 +2550,9 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
             detail::local_infeasibility_on(red.lp, region_rows, options.local_proof_depth,
                                            options.local_proof_columns, *exact_solver, options.local_proof_seconds, true);
         for (int64_t& i : proof.support) i = red.rows[i];
-        spdlog::debug("rounding: {} infeasibility near the stalled rows ({} X faces): {} rings out, {} rows and {} columns "
-                      "({:.2f} s)",
-                      proof.proved ? "proved" : "no proof of", seed_faces.size(), proof.depth, proof.rows, proof.cols,
-                      local_clock.seconds());
+        spdlog::debug("rounding: local proof near the stalled rows ({} X faces): {}; last solved {} rings out, {} rows and "
+                      "{} columns ({:.2f} s)",
+                      seed_faces.size(), proof.ended, proof.depth, proof.rows, proof.cols, local_clock.seconds());
         if (proof.proved) {
           spdlog::debug("rounding: its Farkas ray needs {} rows", proof.support.size());
           throw InfeasibleError(fmt::format("rounding: the matching LP is infeasible (Clp, on {} rows over the X faces "
