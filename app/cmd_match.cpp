@@ -102,6 +102,7 @@ struct MatchArgs {
   bool stuck_carry = CoarseToFineOptions{}.stuck_carry;
   bool blame_residual = RoundingOptions{}.blame_residual;
   int64_t local_proof = RoundingOptions{}.local_proof_columns;
+  std::string local_proof_solver = RoundingOptions{}.local_proof_solver;
   int stuck_carry_margin = CoarseToFineOptions{}.stuck_carry_margin;
   int stuck_restarts = CoarseToFineOptions{}.stuck_restarts;
   double rounding_checkpoint_seconds = CoarseToFineOptions{}.rounding_checkpoint_seconds;
@@ -275,6 +276,7 @@ int run_match(const MatchArgs& args) {
   ro.max_rounds = args.max_rounds;
   ro.blame_residual = args.blame_residual;
   ro.local_proof_columns = args.local_proof;
+  ro.local_proof_solver = args.local_proof_solver;
   ro.later_round_iterations = args.later_round_iterations;
   ro.carry_weights = args.carry_round_weights;
   ro.fractional_batch = args.fractional_batch;
@@ -626,6 +628,7 @@ int run_match(const MatchArgs& args) {
                               .set("stuck_carry", args.stuck_carry)
                               .set("blame_residual", args.blame_residual)
                               .set("local_proof", args.local_proof)
+                              .set("local_proof_solver", args.local_proof_solver)
                               .set("stuck_carry_margin", args.stuck_carry_margin)
                               .set("stuck_restarts", args.stuck_restarts)
                               .set("rounding_checkpoint_seconds", args.rounding_checkpoint_seconds)
@@ -1084,6 +1087,11 @@ Action add_match_command(CLI::App& app) {
                  "where a refined level's first LP stops as diverging, look for an exact proof of infeasibility (Clp) "
                  "on the rows within a few steps of its stalled residual, up to N columns (0: off)")
       ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  app.add_option("--local-proof-solver", a->local_proof_solver,
+                 "with --local-proof: clp-dual (a Farkas ray from the simplex) or pdhg-cpu (its dual at zero cost, "
+                 "checked as a ray)")
+      ->check(CLI::IsMember({"clp-dual", "pdhg-cpu"}))
       ->capture_default_str();
   app.add_flag("--stuck-carry", a->stuck_carry,
                "with --stuck-after: go on from the stuck rounding's fixings in the widened space instead of "

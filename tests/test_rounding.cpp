@@ -3036,6 +3036,16 @@ TEST_CASE("rounding: a local proof of infeasibility is found where the clash lie
   std::vector<double> d(clash.rows(), 0.0);
   for (size_t k = 0; k < p.support.size(); ++k) d[p.support[k]] = p.ray[k];
   CHECK(farkas_rate(clash, d) > 0.0);
+  // With PDHG at zero cost its dual is the ray (checked): it may lean on more rows, but not fewer.
+  auto pdhg = make_solver("pdhg-cpu");
+  const detail::LocalProof first_order = detail::local_infeasibility(clash, {2}, 8, 1000, *pdhg);
+  REQUIRE(first_order.proved);
+  CHECK(first_order.depth == 3);
+  CHECK(std::binary_search(first_order.support.begin(), first_order.support.end(), int64_t{5}));
+  CHECK(std::binary_search(first_order.support.begin(), first_order.support.end(), int64_t{11}));
+  d.assign(clash.rows(), 0.0);
+  for (size_t k = 0; k < first_order.support.size(); ++k) d[first_order.support[k]] = first_order.ray[k];
+  CHECK(farkas_rate(clash, d) > 0.0);
   // The same LP as a reduced one whose row i is row 10 + 3i of a larger LP: seeds and support in
   // that numbering, a seed it lacks left out.
   std::vector<int64_t> rows(12);
@@ -3058,6 +3068,7 @@ TEST_CASE("rounding: a local proof of infeasibility is found where the clash lie
   const detail::LocalProof none = detail::local_infeasibility(chain, {2}, 20, 1000, *clp);
   CHECK_FALSE(none.proved);
   CHECK(std::string(none.ended) == "feasible");
+  CHECK_FALSE(detail::local_infeasibility(chain, {2}, 20, 1000, *pdhg).proved);
   // Out of time before the first solve: said so.
   CHECK(std::string(detail::local_infeasibility(clash, {2}, 8, 1000, *clp, 0.0).ended) == "time limit");
   CHECK(none.rows == chain.rows());  // (it went out to the whole LP)
@@ -3177,6 +3188,9 @@ TEST_CASE("rounding: a local proof over an X region certifies a matching LP's cl
   CHECK(std::binary_search(p.support.begin(), p.support.end(), int64_t{0}));
   CHECK(p.cols < clash.cols());
   CHECK_FALSE(detail::relaxation_on_rows(clash, region_rows(p.depth), true).slack_rows.empty());  // (merged)
+  // So too with PDHG's dual at zero cost as the ray.
+  auto pdhg = make_solver("pdhg-cpu");
+  CHECK(detail::local_infeasibility_on(clash, region_rows, 8, 1'000'000, *pdhg, 600.0, true).proved);
   // The feasible LP: no proof over the same regions.
   CHECK_FALSE(detail::local_infeasibility_on(m.lp, region_rows, 8, 1'000'000, *clp, 600.0, true).proved);
 }

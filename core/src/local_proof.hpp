@@ -136,9 +136,12 @@ inline std::vector<int64_t> rows_one_step_out(const LpProblem& lp, const std::ve
 
 // Looks for a proof on the rows `rows_at(0)`, `rows_at(1)`, … (each increasing, none smaller than
 // the last; empty: nothing further; no larger: skipped) up to `max_depth`, while the relaxation
-// has at most `max_cols` columns and under `max_seconds` have gone (building included). `exact` must be an exact solver (Clp)
-// that returns a Farkas ray in `y` for an infeasible LP (SolverParams::farkas_ray); a ray that
-// does not check out on the relaxation (proves_infeasible, either way round) proves nothing.
+// has at most `max_cols` columns and under `max_seconds` have gone (building included).
+// `exact`: Clp, which returns a Farkas ray in `y` for an infeasible LP (SolverParams::farkas_ray),
+// or a first-order solver, whose dual at its stop is tried as one (at zero cost an infeasible
+// LP's dual grows along a ray); either way a ray that does not check out on the relaxation
+// (proves_infeasible, either way round) proves nothing, and a first-order "optimal" is feasible
+// only to its tolerance.
 template <class RowsAt>
 LocalProof local_infeasibility_on(const LpProblem& lp, RowsAt&& rows_at, int max_depth, int64_t max_cols,
                                   LpSolver& exact, double max_seconds, bool merge) {
@@ -165,6 +168,7 @@ LocalProof local_infeasibility_on(const LpProblem& lp, RowsAt&& rows_at, int max
     params.threads = 1;
     params.farkas_ray = true;
     params.time_limit = max_seconds - clock.seconds();
+    params.tolerance = 1e-6;  // (first-order solvers: a relaxation feasible to 1e-4 may not be)
     if (!(params.time_limit > 0.0)) {
       p.ended = "time limit";
       break;
@@ -177,7 +181,9 @@ LocalProof local_infeasibility_on(const LpProblem& lp, RowsAt&& rows_at, int max
       p.ended = "feasible";
       continue;
     }
-    if (r.status != LpStatus::Infeasible || r.y.size() != keep.size()) {
+    // A first-order solver's dual at its cap is tried as a ray too: at zero cost an infeasible
+    // LP's dual grows along one (the check below decides).
+    if (r.y.size() != keep.size()) {
       p.ended = r.status == LpStatus::TimeLimit ? "time limit" : r.status == LpStatus::Infeasible ? "no ray" : "solver";
       break;
     }
@@ -193,7 +199,7 @@ LocalProof local_infeasibility_on(const LpProblem& lp, RowsAt&& rows_at, int max
           if (proves_infeasible(relaxed.lp, t)) d = std::move(t);
         }
     if (d.empty()) {
-      p.ended = "no ray";
+      p.ended = r.status == LpStatus::Infeasible ? "no ray" : r.status == LpStatus::TimeLimit ? "time limit" : "solver";
       break;
     }
     for (size_t i = 0; i < d.size(); ++i)

@@ -2532,7 +2532,7 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
       if (options.blame_residual) rows = std::move(both);
       if (options.local_proof_columns > 0 && !stalled.empty()) {
         Stopwatch local_clock;
-        if (!exact_solver) exact_solver = make_solver("clp-dual");
+        const std::unique_ptr<LpSolver> local_solver = make_solver(options.local_proof_solver);
         // The X region around the stalled rows, 0, 1, 2 … rings out: its rows, face rows' far
         // columns merged (local_proof.hpp; rows one step out reach a million columns at once).
         std::vector<int64_t> seeds;  // (in the reduced LP's numbering)
@@ -2548,7 +2548,7 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
         };
         detail::LocalProof proof =
             detail::local_infeasibility_on(red.lp, region_rows, options.local_proof_depth,
-                                           options.local_proof_columns, *exact_solver, options.local_proof_seconds, true);
+                                           options.local_proof_columns, *local_solver, options.local_proof_seconds, true);
         for (int64_t& i : proof.support) i = red.rows[i];
         spdlog::debug("rounding: local proof near the stalled rows ({} X faces): {}; last solved {} rings out, {} rows and "
                       "{} columns ({:.2f} s)",

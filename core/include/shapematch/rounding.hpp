@@ -85,7 +85,10 @@ struct RoundingOptions {
   // rows alone. None found is logged (debug) and changes nothing.
   int64_t local_proof_columns = 0;
   int local_proof_depth = 8;
-  double local_proof_seconds = 600.0;  // Clp's time on them in all
+  double local_proof_seconds = 600.0;  // in all
+  // Its solver: Clp's dual simplex, or a first-order one whose dual is checked as a ray (Clp ran
+  // into the time cap on dog3-dog8's first region, 76 811 rows and 287 251 columns).
+  std::string local_proof_solver = "clp-dual";
   // Later rounds' first-order parts start from the primal weight ω that the last solve of their
   // columns ended with (the geometric mean over the part's columns), instead of lp's own
   // (initial_primal_weight; PDHG's start at 1 where that is 0). Those rounds start from the last
