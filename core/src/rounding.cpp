@@ -2555,9 +2555,9 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
                       seed_faces.size(), proof.ended, proof.depth, proof.rows, proof.cols, local_clock.seconds());
         if (proof.proved) {
           spdlog::debug("rounding: its Farkas ray needs {} rows", proof.support.size());
-          throw InfeasibleError(fmt::format("rounding: the matching LP is infeasible (Clp, on {} rows over the X faces "
-                                            "within {} rings of its stalled residual)",
-                                            proof.rows, proof.depth),
+          throw InfeasibleError(fmt::format("rounding: the matching LP is infeasible ({}'s ray on {} rows over the X "
+                                            "faces within {} rings of its stalled residual)",
+                                            options.local_proof_solver, proof.rows, proof.depth),
                                 proof.support, true);
         }
       }
