@@ -1084,13 +1084,13 @@ Action add_match_command(CLI::App& app) {
                "where a refined level's first LP stops as diverging, widen also around the rows its stalled "
                "iterate leaves furthest from b, not only those its dual grew on");
   app.add_option("--local-proof", a->local_proof,
-                 "where a refined level's first LP stops as diverging, look for an exact proof of infeasibility (Clp) "
-                 "on the rows within a few steps of its stalled residual, up to N columns (0: off)")
+                 "where a refined level's first LP stops as diverging, look for a proof of infeasibility on a "
+                 "relaxation over the X faces around its stalled residual, up to N columns (0: off)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   app.add_option("--local-proof-solver", a->local_proof_solver,
-                 "with --local-proof: clp-dual (a Farkas ray from the simplex) or pdhg-cpu (its dual at zero cost, "
-                 "checked as a ray)")
+                 "with --local-proof: pdhg-cpu (its dual at zero cost, checked as a Farkas ray) or clp-dual (the "
+                 "simplex's ray; ran into its time cap at full resolution)")
       ->check(CLI::IsMember({"clp-dual", "pdhg-cpu"}))
       ->capture_default_str();
   app.add_flag("--stuck-carry", a->stuck_carry,
