@@ -667,6 +667,7 @@ int run_match(const MatchArgs& args) {
                       .set("price_widenings", l.price_widenings)
                       .set("propagation_widenings", l.propagation_widenings)
                       .set("recurring_widenings", l.recurring_widenings)
+                      .set("proof_rechecks", l.proof_rechecks)
                       .set("inherited_faces", l.inherited_faces)
                       .set("carried_fixings", l.carried_fixings)
                       .set("iterations_bound", l.iterations_bound)

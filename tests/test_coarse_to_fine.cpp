@@ -1721,6 +1721,23 @@ TEST_CASE("coarse to fine: a run gone on from an attempt of a level in progress 
     CHECK(load_checkpoint(other).attempt.zero_cost_margin_given);
     CHECK(load_checkpoint(other).attempt.extra == a.extra);
   }
+  {  // (A local proof's region to check again, and the checks made, version 17, not version 16.)
+    LevelCheckpoint given = last;
+    given.attempt.proof_faces = {3, 1, 4};
+    given.attempt.proof_rings = 2;
+    given.attempt.report.proof_rechecks = 5;
+    const std::string other = (tmp.path / "region.ckpt").string();
+    save_checkpoint(other, given);
+    const LevelCheckpoint back = load_checkpoint(other);
+    CHECK(back.attempt.proof_faces == given.attempt.proof_faces);
+    CHECK(back.attempt.proof_rings == 2);
+    CHECK(back.attempt.report.proof_rechecks == 5);
+    CHECK(back.attempt.extra == a.extra);
+    detail::save_checkpoint_as(other, given, 16);
+    CHECK(load_checkpoint(other).attempt.proof_faces.empty());
+    CHECK(load_checkpoint(other).attempt.report.proof_rechecks == 0);
+    CHECK(load_checkpoint(other).attempt.extra == a.extra);
+  }
   int more = 0;
   const CoarseToFineResult r = matcher.run({}, &loaded, [&](const LevelCheckpoint& c) { more += !c.attempt.empty(); });
   CHECK(more == 0);  // the whole run's last attempt was the one that finished
@@ -1732,6 +1749,28 @@ TEST_CASE("coarse to fine: a run gone on from an attempt of a level in progress 
   CHECK(finest.energy == doctest::Approx(whole.levels.back().energy).epsilon(1e-12));
   CHECK(finest.gamma == whole.levels.back().gamma);
   CHECK(check_graph_surface(r.finest.space, r.rounding.gamma).ok());
+
+  // With a local proof's region to check again (feasible in this LP: a relaxation of it), the
+  // check is made once and the run goes on as without it; with local proofs off, it is not
+  // proved either (no relaxation fits a cap of 0 columns). Faces past the level's: none made.
+  {
+    CoarseToFineOptions po = o;
+    po.rounding.local_proof_columns = 1'000'000;
+    const CoarseToFineMatcher proving = finger_matcher(po);
+    LevelCheckpoint region = last;
+    region.attempt.proof_faces = {0, 1};
+    region.attempt.proof_rings = 1;
+    const CoarseToFineResult checked = proving.run({}, &region);
+    REQUIRE(checked.levels.size() == whole.levels.size());
+    CHECK(checked.levels.back().proof_rechecks == 1);
+    CHECK(checked.levels.back().local_widenings == finest.local_widenings);
+    CHECK(checked.levels.back().gamma == finest.gamma);
+    const CoarseToFineResult off = matcher.run({}, &region);
+    CHECK(off.levels.back().proof_rechecks == 1);
+    CHECK(off.levels.back().gamma == finest.gamma);
+    region.attempt.proof_faces = {0, matcher.x_levels().levels.back().mesh.num_faces()};
+    CHECK(matcher.run({}, &region).levels.back().proof_rechecks == 0);
+  }
 
   // Without its attempt, the same checkpoint widens again from the coarser Γ.
   LevelCheckpoint before = last;
@@ -1788,8 +1827,8 @@ TEST_CASE("coarse to fine: a run gone on from an attempt of a level in progress 
     bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
   }
   const size_t at = std::string("shapematch level checkpoint\n").size();
-  REQUIRE(bytes[at] == 16);
-  bytes[at] = 17;  // a later version than this build's
+  REQUIRE(bytes[at] == 17);
+  bytes[at] = 18;  // a later version than this build's
   std::ofstream(file, std::ios::binary) << bytes;
   CHECK_THROWS_AS(load_checkpoint(file), IoError);
   {  // The fifteenth: a carried start's rounding without a bound (NaN); the fourteenth has 15's layout.
@@ -1820,7 +1859,7 @@ TEST_CASE("coarse to fine: a run gone on from an attempt of a level in progress 
   CHECK(v3.attempt.report.widened_faces == a.report.widened_faces);
   CHECK(v3.attempt.report.stuck_restarts == 0);
   CHECK(v3.levels.back().gamma == last.levels.back().gamma);
-  CHECK_THROWS_AS(detail::save_checkpoint_as(file, marked, 17), InvalidInputError);
+  CHECK_THROWS_AS(detail::save_checkpoint_as(file, marked, 18), InvalidInputError);
 }
 
 // The saves of a run made inside the first LP of level `level` (lp_checkpoint_seconds).

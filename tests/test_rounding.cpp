@@ -3193,6 +3193,21 @@ TEST_CASE("rounding: a local proof over an X region certifies a matching LP's cl
   CHECK(detail::local_infeasibility_on(clash, region_rows, 8, 1'000'000, *pdhg, 600.0, true).proved);
   // The feasible LP: no proof over the same regions.
   CHECK_FALSE(detail::local_infeasibility_on(m.lp, region_rows, 8, 1'000'000, *clp, 600.0, true).proved);
+  // One region alone, as coarse to fine checks a proof's again (columns numbered as the space's:
+  // no `cols`): the same rows and proof as at the depth found, none on the feasible LP or past its
+  // column cap.
+  CHECK(detail::rows_over_x_faces(m.space, clash, {}, detail::faces_near(m.space.x(), seeds, 1 + p.depth)) ==
+        region_rows(p.depth));
+  const detail::LocalProof again =
+      detail::proof_over_x_region(m.space, clash, {}, seeds, p.depth, 1'000'000, *clp, 600.0);
+  CHECK(again.proved);
+  CHECK(again.rows == p.rows);
+  CHECK(again.support == p.support);
+  const detail::LocalProof feasible = detail::proof_over_x_region(m.space, m.lp, {}, seeds, p.depth, 1'000'000, *clp, 600.0);
+  CHECK_FALSE(feasible.proved);
+  CHECK(std::string(feasible.ended) == "feasible");
+  CHECK(std::string(detail::proof_over_x_region(m.space, clash, {}, seeds, p.depth, 5, *clp, 600.0).ended) ==
+        "column cap");
 }
 
 TEST_CASE("rounding: the X faces of stalled rows: where their iterate lies, else all their columns'") {

@@ -4,6 +4,7 @@
 #include "shapematch/errors.hpp"
 #include "shapematch/files.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <fstream>
@@ -32,7 +33,8 @@ constexpr char kMagic[] = "shapematch level checkpoint\n";
 // for a bound: they refuse the file instead. (Binaries of 2267cca-fdfdc89 wrote such a NaN as 14
 // and read it as this one does.)
 // 16: an LP under way's divergence watch (LevelAttempt::solving_watch) follows its watch flag.
-constexpr uint32_t kVersion = 16;
+// 17: LevelReport::proof_rechecks; an attempt's last local proof region (proof_faces, proof_rings).
+constexpr uint32_t kVersion = 17;
 // More LP iterations than any solve makes (a count past it is a corrupt file, and would overflow).
 constexpr int64_t kMaxIterations = int64_t(1) << 40;
 
@@ -49,6 +51,7 @@ void each_field(R& r, F&& f, uint32_t version) {
   f(r.second_start_kept), f(r.lookahead_other_energy), f(r.lookahead_switched);
   if (version >= 7) f(r.lookahead_other_bound), f(r.lookahead_other_stuck);
   if (version >= 8) f(r.branch_roundings), f(r.branch_energy), f(r.branch_kept);
+  if (version >= 17) f(r.proof_rechecks);
 }
 // (It misses a new int or bool that fits in padding: LevelReport's comment asks for this list too.)
 static_assert(sizeof(LevelReport) == 248 + sizeof(std::vector<ProductTriangle>),
@@ -176,6 +179,7 @@ void write_attempt(Writer& w, const LevelAttempt& a, uint32_t version) {
   w(a.suspicions), w(a.trusted);
   if (version >= 9) w(a.zero_cost_margin_given);
   if (version >= 11) w(a.suspicion_margins);
+  if (version >= 17) w.array(a.proof_faces), w(a.proof_rings);
   each_field(a.report, w, version);
   w.array(a.extra);
   if (version < 3) return;
@@ -213,6 +217,7 @@ void read_attempt(Reader& r, LevelAttempt& a, uint32_t version, const std::strin
   r(a.suspicions), r(a.trusted);
   if (version >= 9) r(a.zero_cost_margin_given);
   if (version >= 11) r(a.suspicion_margins);
+  if (version >= 17) r.array(a.proof_faces), r(a.proof_rings);
   each_field(a.report, r, version);
   r.array(a.extra);
   LevelAttempt::Rounding& g = a.rounding;
@@ -231,6 +236,9 @@ void read_attempt(Reader& r, LevelAttempt& a, uint32_t version, const std::strin
                     ")");
   }
   if (a.ring < 0) throw IoError(path + ": not a shapematch checkpoint (an attempt at ring " + std::to_string(a.ring) + ")");
+  if (a.proof_rings < 0 || std::any_of(a.proof_faces.begin(), a.proof_faces.end(), [](int f) { return f < 0; }))
+    throw IoError(path + ": not a shapematch checkpoint (a local proof's region " + std::to_string(a.proof_rings) +
+                  " rings around negative faces)");
   if (version < 13) return;
   bool priced = false, solving = false;
   r(priced);

@@ -5,6 +5,7 @@
 #include "shapematch/system.hpp"
 
 #include "divergence_rule.hpp"
+#include "local_proof.hpp"
 #include "key_set.hpp"
 #include "parallel.hpp"
 #include "recurring_conflicts.hpp"
@@ -1106,6 +1107,13 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
                    lx.mesh.num_faces());
   }
   std::vector<int> last_widened;
+  // The region of the last local proof (LocalInfeasible) widened at: checked again in the next
+  // attempt's LP before it is solved (recheck_proof below).
+  struct ProofRegion {
+    std::vector<int> faces;
+    int rings = 0;
+  };
+  std::optional<ProofRegion> proof_region;
   int local = 0;
   int ring = base_ring;
   detail::SuspicionCount suspicions(options_.max_suspected_widenings);
@@ -1130,6 +1138,10 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
     suspicions.restore(resume->suspicions, resume->trusted);
     zero_cost_margin_given = resume->zero_cost_margin_given;
     suspicion_margins = resume->suspicion_margins;
+    // (Faces past this level's are another run's: left out, its LP is solved.)
+    const std::vector<int>& pf = resume->proof_faces;
+    if (!pf.empty() && std::all_of(pf.begin(), pf.end(), [&](int f) { return f < lx.mesh.num_faces(); }))
+      proof_region = ProofRegion{pf, resume->proof_rings};
     spdlog::info("level {}: going on from its checkpointed attempt: ring {}, {} faces with extra rings{}", l + 1, ring,
                  std::count_if(extra.begin(), extra.end(), [](int e) { return e > 0; }),
                  resume->rounding.empty() ? std::string()
@@ -1305,6 +1317,10 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
     a.trusted = suspicions.trusted();
     a.zero_cost_margin_given = zero_cost_margin_given;
     a.suspicion_margins = suspicion_margins;
+    if (proof_region) {
+      a.proof_faces = proof_region->faces;
+      a.proof_rings = proof_region->rings;
+    }
     if (price_warm) {  // (the re-solve after a pricing, about to start)
       a.priced_from = priced_from;
       a.cold_iterations = cold_iterations;
@@ -1411,6 +1427,32 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
       if (options_.widen_around > 0 && !around_done && local + propagated > 0) {
         around_done = true;
         if (widen_around(options_.widen_around, "infeasible nearby (pre-emptively)")) continue;
+      }
+    }
+    // The last local proof's region, again in this widened LP: where it is still infeasible, widen
+    // there again now rather than after a first LP that stalls the same way (at full resolution
+    // an hour each: TOSCA_r dog3-dog8 stalled in the same 7 rows after three widenings). A
+    // relaxation found feasible says nothing about the rest of the LP: on to it.
+    if (proof_region && l > 0 && !going_on) {
+      const ProofRegion region = *std::exchange(proof_region, std::nullopt);
+      const RoundingOptions ro = rounding_for(l);
+      Stopwatch checking;
+      const std::unique_ptr<LpSolver> solver = make_solver(ro.local_proof_solver);
+      const detail::LocalProof proof =
+          detail::proof_over_x_region(m.space, m.lp, {}, region.faces, region.rings,
+                                      ro.local_proof_columns, *solver, ro.local_proof_seconds);
+      spdlog::info("level {}: the last local proof's region ({} X faces, {} rings out: {} rows, {} columns) checked "
+                   "again before its LP: {} ({:.2f} s)",
+                   l + 1, region.faces.size(), region.rings, proof.rows, proof.cols,
+                   proof.proved ? "still infeasible" : proof.ended, checking.seconds());
+      ++rep.proof_rechecks;
+      if (proof.proved) {
+        ProofPlace place(m);
+        for (int64_t i : proof.support) place.add(m, i);
+        if (widen_at(m, place, "infeasible (its last proof's region, checked again)")) {
+          proof_region = region;
+          continue;
+        }
       }
     }
     bool watched_patiently = false;  // this attempt's first LP (its stop is not a suspicion to re-solve)
@@ -1804,6 +1846,8 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
         // A proof restores the watch.
         if (e.certified()) {
           suspicions.proof();
+          if (const auto* li = dynamic_cast<const LocalInfeasible*>(&e))
+            proof_region = ProofRegion{li->x_faces(), li->rings()};
           // The pre-test's proof stands in for the suspicion the watch would have raised on this
           // LP: the same margin, once per ring (zero_cost_proof_rings says why).
           if (dynamic_cast<const ZeroCostInfeasible*>(&e) && !zero_cost_margin_given &&

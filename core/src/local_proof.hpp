@@ -9,6 +9,7 @@
 #include "shapematch/lp.hpp"
 #include "shapematch/sparse.hpp"
 #include "shapematch/system.hpp"
+#include "stalled_rows.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -244,6 +245,18 @@ inline LocalProof local_infeasibility_within(const LpProblem& reduced, const std
   LocalProof p = local_infeasibility(reduced, std::move(local), max_depth, max_cols, exact, max_seconds);
   for (int64_t& i : p.support) i = rows[i];
   return p;
+}
+
+// local_infeasibility_on one X region alone: the rows of the columns over the X faces within
+// `rings` rings of `faces` (rows_over_x_faces; `cols` as there), far columns merged. How coarse to
+// fine checks a proof's region again in a widened LP before solving that.
+inline LocalProof proof_over_x_region(const ProductSpace& space, const LpProblem& lp, const std::vector<int64_t>& cols,
+                                      const std::vector<int>& faces, int rings, int64_t max_cols, LpSolver& solver,
+                                      double max_seconds) {
+  const std::vector<int64_t> rows =
+      faces.empty() ? std::vector<int64_t>{} : rows_over_x_faces(space, lp, cols, faces_near(space.x(), faces, 1 + rings));
+  return local_infeasibility_on(
+      lp, [&](int depth) { return depth == 0 ? rows : std::vector<int64_t>{}; }, 0, max_cols, solver, max_seconds, true);
 }
 
 }  // namespace shapematch::detail

@@ -2555,10 +2555,10 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
                       seed_faces.size(), proof.ended, proof.depth, proof.rows, proof.cols, local_clock.seconds());
         if (proof.proved) {
           spdlog::debug("rounding: its Farkas ray needs {} rows", proof.support.size());
-          throw InfeasibleError(fmt::format("rounding: the matching LP is infeasible ({}'s ray on {} rows over the X "
+          throw LocalInfeasible(fmt::format("rounding: the matching LP is infeasible ({}'s ray on {} rows over the X "
                                             "faces within {} rings of its stalled residual)",
                                             options.local_proof_solver, proof.rows, proof.depth),
-                                proof.support, true);
+                                proof.support, seed_faces, proof.depth);
         }
       }
       throw InfeasibleError(r.lower_bound + lp.objective_scale * red.fixed_cost > options.lp.divergence_bound

@@ -89,7 +89,8 @@ inline std::vector<int> x_faces_of_rows(const ProductSpace& space, const LpProbl
 
 // The rows of `lp` that a column over the X faces `faces` has (its X part a face of them, or an
 // edge or vertex of one), increasing: an X region's rows, for a local proof (local_proof.hpp) that
-// grows with the region rather than with every column its rows reach.
+// grows with the region rather than with every column its rows reach. `cols`: lp's columns in
+// `space` (empty: the same numbering).
 inline std::vector<int64_t> rows_over_x_faces(const ProductSpace& space, const LpProblem& lp,
                                               const std::vector<int64_t>& cols, const std::vector<int>& faces) {
   const Mesh& X = space.x();
@@ -100,7 +101,7 @@ inline std::vector<int64_t> rows_over_x_faces(const ProductSpace& space, const L
   }
   std::vector<char> in(lp.rows(), 0);
   for (int64_t j = 0; j < lp.cols(); ++j) {
-    const ProductTriangle t = space[cols[j]];
+    const ProductTriangle t = space[cols.empty() ? j : cols[j]];
     const bool over = t.fa >= 0 ? face_in[t.fa] != 0 : vertex_in[t.a[0]] && vertex_in[t.a[1]] && vertex_in[t.a[2]];
     if (!over) continue;
     for (uint32_t k = lp.at.row_ptr[j]; k < lp.at.row_ptr[j + 1]; ++k) in[col_of(lp.at.entry[k])] = 1;

@@ -459,6 +459,9 @@ struct LevelReport {
   int price_widenings = 0;     // of the local widenings, those where pricing found columns below zero
   int propagation_widenings = 0;  // of the local widenings, those where propagation found the contradiction
   int recurring_widenings = 0;    // of those, where it came back in the same π row (recurring_margin)
+  // Times the region of a local proof (LocalInfeasible) was checked again in the widened LP before
+  // solving it; where still infeasible it widened there again at once (a local widening too).
+  int proof_rechecks = 0;
   int64_t inherited_faces = 0; // fine X faces that started with extra rings (inherit_widening)
   int64_t carried_fixings = 0; // fixings to 1 the last of those went on from
   int64_t iterations_bound = 0;  // of the LP solved again for the bound after one
@@ -518,6 +521,10 @@ struct LevelAttempt {
   bool zero_cost_margin_given = false;
   // The suspicion_rings margins given at this ring (version 11; before, none counted).
   int suspicion_margins = 0;
+  // The X faces and rings of the last local proof widened at (LocalInfeasible), which this
+  // attempt checks again before its LP (version 17; before, none: its LP was solved). Empty: none.
+  std::vector<int> proof_faces;
+  int proof_rings = 0;
   // Where the attempt is the re-solve after a pricing widened the space: the iterate it starts
   // from (the priced LP's), and the cold first LP's iterations and seconds, which cap it and scale
   // its rounding (version 13; before, a run gone on from here solved it cold: TOSCA_r

@@ -480,6 +480,22 @@ public:
   using InfeasibleError::InfeasibleError;
 };
 
+// Round 1's LP proved infeasible by a local proof near its stalled rows (RoundingOptions::
+// local_proof_columns): the X faces the proof grew from and how many rings out it was found, so
+// coarse to fine can check the same region again in a widened LP before solving it (a
+// full-resolution first LP takes an hour to stall again where a widening did not help).
+class LocalInfeasible : public InfeasibleError {
+public:
+  LocalInfeasible(const std::string& what, std::vector<int64_t> rows, std::vector<int> x_faces, int rings)
+      : InfeasibleError(what, std::move(rows), true), x_faces_(std::move(x_faces)), rings_(rings) {}
+  const std::vector<int>& x_faces() const { return x_faces_; }
+  int rings() const { return rings_; }
+
+private:
+  std::vector<int> x_faces_;
+  int rings_ = 0;
+};
+
 // Calls `progress(round)` after each round (for a progress line); may be empty.
 RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem& lp, const std::vector<double>& energy,
                                       const RoundingOptions& options = {},
