@@ -1733,6 +1733,14 @@ TEST_CASE("coarse to fine: a run gone on from an attempt of a level in progress 
     CHECK(back.attempt.proof_rings == 2);
     CHECK(back.attempt.report.proof_rechecks == 5);
     CHECK(back.attempt.extra == a.extra);
+    given.attempt.proof_rings = 65;  // (more than a proof grows: refused, as a negative face is)
+    save_checkpoint(other, given);
+    CHECK_THROWS_AS(load_checkpoint(other), IoError);
+    given.attempt.proof_rings = 2;
+    given.attempt.proof_faces = {3, -1};
+    save_checkpoint(other, given);
+    CHECK_THROWS_AS(load_checkpoint(other), IoError);
+    given.attempt.proof_faces = {3, 1, 4};
     detail::save_checkpoint_as(other, given, 16);
     CHECK(load_checkpoint(other).attempt.proof_faces.empty());
     CHECK(load_checkpoint(other).attempt.report.proof_rechecks == 0);
@@ -1766,10 +1774,35 @@ TEST_CASE("coarse to fine: a run gone on from an attempt of a level in progress 
     CHECK(checked.levels.back().local_widenings == finest.local_widenings);
     CHECK(checked.levels.back().gamma == finest.gamma);
     const CoarseToFineResult off = matcher.run({}, &region);
-    CHECK(off.levels.back().proof_rechecks == 1);
+    CHECK(off.levels.back().proof_rechecks == 0);
     CHECK(off.levels.back().gamma == finest.gamma);
-    region.attempt.proof_faces = {0, matcher.x_levels().levels.back().mesh.num_faces()};
-    CHECK(matcher.run({}, &region).levels.back().proof_rechecks == 0);
+    region.attempt.proof_faces = {0, proving.x_levels().levels.back().mesh.num_faces()};
+    CHECK(proving.run({}, &region).levels.back().proof_rechecks == 0);
+
+    // The finest level's first attempt, whose LP propagation proves infeasible, with propagation's
+    // widenings spent: its region (every X face) proved infeasible again before the LP, widened
+    // there (every face one ring), checked again until it is not, and only then solved.
+    po.max_propagation_widenings = 0;
+    const CoarseToFineMatcher spent = finger_matcher(po);
+    const auto first = std::find_if(attempts.begin(), attempts.end(), [&](const LevelCheckpoint& c) {
+      return c.levels.size() == size_t(levels - 1);
+    });
+    REQUIRE(first != attempts.end());
+    LevelCheckpoint all = *first;
+    REQUIRE(all.attempt.local == 0);  // (after a propagation widening: the first attempt is not saved)
+    const LevelReport& before = all.attempt.report;
+    const int faces = spent.x_levels().levels.back().mesh.num_faces();
+    all.attempt.proof_faces.resize(faces);
+    std::iota(all.attempt.proof_faces.begin(), all.attempt.proof_faces.end(), 0);
+    const CoarseToFineResult rechecked = spent.run({}, &all);
+    const LevelReport& fin = rechecked.levels.back();
+    MESSAGE("rechecks " << fin.proof_rechecks << ", local widenings " << fin.local_widenings << ", widened faces "
+                        << fin.widened_faces << ", energy " << fin.energy << " (" << finest.energy << ")");
+    CHECK(fin.proof_rechecks >= 2);
+    CHECK(fin.local_widenings - before.local_widenings == fin.proof_rechecks - 1);
+    CHECK(fin.widened_faces - before.widened_faces == int64_t(faces) * (fin.proof_rechecks - 1));
+    CHECK(fin.propagation_widenings == before.propagation_widenings);
+    CHECK(check_graph_surface(rechecked.finest.space, rechecked.rounding.gamma).ok());
   }
 
   // Without its attempt, the same checkpoint widens again from the coarser Γ.

@@ -35,6 +35,8 @@ constexpr char kMagic[] = "shapematch level checkpoint\n";
 // 16: an LP under way's divergence watch (LevelAttempt::solving_watch) follows its watch flag.
 // 17: LevelReport::proof_rechecks; an attempt's last local proof region (proof_faces, proof_rings).
 constexpr uint32_t kVersion = 17;
+// More rings than a local proof's region grows (RoundingOptions::local_proof_depth).
+constexpr int kMaxProofRings = 64;
 // More LP iterations than any solve makes (a count past it is a corrupt file, and would overflow).
 constexpr int64_t kMaxIterations = int64_t(1) << 40;
 
@@ -236,9 +238,12 @@ void read_attempt(Reader& r, LevelAttempt& a, uint32_t version, const std::strin
                     ")");
   }
   if (a.ring < 0) throw IoError(path + ": not a shapematch checkpoint (an attempt at ring " + std::to_string(a.ring) + ")");
-  if (a.proof_rings < 0 || std::any_of(a.proof_faces.begin(), a.proof_faces.end(), [](int f) { return f < 0; }))
+  // (A local proof grows at most local_proof_depth rings: 8 by default.)
+  if (a.proof_rings < 0 || a.proof_rings > kMaxProofRings)
     throw IoError(path + ": not a shapematch checkpoint (a local proof's region " + std::to_string(a.proof_rings) +
-                  " rings around negative faces)");
+                  " rings out)");
+  if (std::any_of(a.proof_faces.begin(), a.proof_faces.end(), [](int f) { return f < 0; }))
+    throw IoError(path + ": not a shapematch checkpoint (a local proof's region on a negative face)");
   if (version < 13) return;
   bool priced = false, solving = false;
   r(priced);

@@ -1138,7 +1138,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
     suspicions.restore(resume->suspicions, resume->trusted);
     zero_cost_margin_given = resume->zero_cost_margin_given;
     suspicion_margins = resume->suspicion_margins;
-    // (Faces past this level's are another run's: left out, its LP is solved.)
+    // (A region with faces past this level's is another run's: left out, its LP is solved.)
     const std::vector<int>& pf = resume->proof_faces;
     if (!pf.empty() && std::all_of(pf.begin(), pf.end(), [&](int f) { return f < lx.mesh.num_faces(); }))
       proof_region = ProofRegion{pf, resume->proof_rings};
@@ -1296,6 +1296,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
     before.resize(lx.mesh.num_faces(), 0);
     if (!widen_locally(faces, "infeasible where its first LP stalled", options_.max_ring + kMaxRingBeyond))
       return false;
+    last_widened.clear();  // (widen_at's next place is not one it widened again)
     for (int f : faces)
       if (f < lx.mesh.num_faces() && ring + extra[f] > options_.max_ring && extra[f] > before[f]) {
         ++rep.margin_widenings;  // (past max_ring)
@@ -1447,35 +1448,35 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
         if (widen_around(options_.widen_around, "infeasible nearby (pre-emptively)")) continue;
       }
     }
-    // The last local proof's region, again in this widened LP: where it is still infeasible, widen
-    // there again now rather than after a first LP that stalls the same way (at full resolution
-    // an hour each: TOSCA_r dog3-dog8 stalled in the same 7 rows after three widenings). A
-    // relaxation found feasible says nothing about the rest of the LP: on to it.
-    if (proof_region && l > 0 && !going_on) {
-      const ProofRegion region = *std::exchange(proof_region, std::nullopt);
-      const RoundingOptions ro = rounding_for(l);
-      Stopwatch checking;
-      const std::unique_ptr<LpSolver> solver = make_solver(ro.local_proof_solver);
-      const detail::LocalProof proof =
-          detail::proof_over_x_region(m.space, m.lp, {}, region.faces, region.rings,
-                                      ro.local_proof_columns, *solver, ro.local_proof_seconds);
-      spdlog::info("level {}: the last local proof's region ({} X faces, {} rings out: {} rows, {} columns) checked "
-                   "again before its LP: {} ({:.2f} s)",
-                   l + 1, region.faces.size(), region.rings, proof.rows, proof.cols,
-                   proof.proved ? "still infeasible" : proof.ended, checking.seconds());
-      ++rep.proof_rechecks;
-      if (proof.proved) {
-        ProofPlace place(m);
-        for (int64_t i : proof.support) place.add(m, i);
-        if (widen_region(region.faces) || widen_at(m, place, "infeasible (its last proof's region, checked again)")) {
-          proof_region = region;
-          continue;
-        }
-      }
-    }
     bool watched_patiently = false;  // this attempt's first LP (its stop is not a suspicion to re-solve)
     try {
       RoundingOptions ro = rounding_for(l);
+      // The last local proof's region, again in this widened LP (after propagation's checks): where
+      // it is still infeasible, a proof as the rounding's, handled below (widened there again now
+      // rather than after a first LP that stalls the same way: at full resolution an hour each).
+      // The full LP here, not the rounding's reduction after propagation: a weaker relaxation,
+      // which may let a clash through (its LP is then solved). Found feasible, it says nothing
+      // about the rest of the LP: on to it.
+      if (proof_region && l > 0 && !going_on) {
+        const ProofRegion region = *std::exchange(proof_region, std::nullopt);
+        if (ro.local_proof_columns > 0) {
+          Stopwatch checking;
+          const std::unique_ptr<LpSolver> solver = make_solver(ro.local_proof_solver);
+          const detail::LocalProof proof =
+              detail::proof_over_x_region(m.space, m.lp, {}, region.faces, region.rings, ro.local_proof_columns,
+                                          *solver, ro.local_proof_seconds);
+          spdlog::info("level {}: the last local proof's region ({} X faces, {} rings out: {} rows, {} columns) "
+                       "checked again before its LP: {} ({:.2f} s)",
+                       l + 1, region.faces.size(), region.rings, proof.rows, proof.cols,
+                       proof.proved ? "still infeasible" : proof.ended, checking.seconds());
+          ++rep.proof_rechecks;
+          if (proof.proved)
+            throw LocalInfeasible(fmt::format("the matching LP is infeasible ({}'s ray on {} rows over the X faces "
+                                              "within {} rings of its last local proof's)",
+                                              ro.local_proof_solver, proof.rows, region.rings),
+                                  proof.support, region.faces, region.rings);
+        }
+      }
       // The stuck rounding's fixings to 1 that go on here (stuck_carry): those off the faces just
       // widened (and their stuck_carry_margin). Where none is left, this attempt is a fresh one (its
       // round 1 a first LP, pricing, a bound of its own).

@@ -2530,7 +2530,8 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
       spdlog::debug("rounding: {} of the stalled iterate's {} rows lie outside the dual growth's {}{}",
                     both.size() - growth, stalled.size(), growth, options.blame_residual ? " (blamed too)" : "");
       if (options.blame_residual) rows = std::move(both);
-      if (options.local_proof_columns > 0 && !stalled.empty()) {
+      // (Not from start_ones: a proof would be of the LP with those fixings, not of the LP.)
+      if (options.local_proof_columns > 0 && !stalled.empty() && options.start_ones.empty()) {
         Stopwatch local_clock;
         const std::unique_ptr<LpSolver> local_solver = make_solver(options.local_proof_solver);
         // The X region around the stalled rows, 0, 1, 2 … rings out: its rows, face rows' far
