@@ -613,6 +613,21 @@ TEST_CASE("cli: checkpoint --keep-levels drops the attempt of the level in progr
   Run r = run("checkpoint " + ckpt);
   REQUIRE_MESSAGE(r.code == 0, r.err);
   CHECK(r.out.find("\"faces_with_extra_rings\": 2") != std::string::npos);
+  CHECK(r.out.find("\"most_extra_rings\": 2") != std::string::npos);
+  CHECK(r.out.find("\"proof_region\": null") != std::string::npos);
+  {  // (a local proof's region to check again: its faces and rings)
+    shapematch::LevelCheckpoint p = c;
+    p.attempt.proof_faces = {1, 3};
+    p.attempt.proof_rings = 1;
+    p.attempt.report.proof_rechecks = 4;
+    const std::string region = (tmp.path / "region.ckpt").string();
+    shapematch::save_checkpoint(region, p);
+    const Run q = run("checkpoint " + region);
+    REQUIRE_MESSAGE(q.code == 0, q.err);
+    CHECK(q.out.find("\"faces\": 2") != std::string::npos);
+    CHECK(q.out.find("\"rings\": 1") != std::string::npos);
+    CHECK(q.out.find("\"proof_rechecks\": 4") != std::string::npos);
+  }
   const std::string two = (tmp.path / "two.ckpt").string(), one = (tmp.path / "one.ckpt").string();
   r = run("checkpoint " + ckpt + " --keep-levels 2 --out " + two);
   REQUIRE_MESSAGE(r.code == 0, r.err);
