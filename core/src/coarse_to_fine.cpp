@@ -1220,11 +1220,13 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
                     : local >= options_.max_local_widenings && !last)
       return false;
     extra.resize(lx.mesh.num_faces(), 0);
-    int64_t widened = 0;
+    int64_t widened = 0, at_cap = 0;
     for (int f : faces)
       if (ring + extra[f] < cap) {
         extra[f] = to_cap ? cap - ring : extra[f] + 1;
         ++widened;
+      } else {
+        ++at_cap;
       }
     if (widened == 0) return false;
     if (propagating) {
@@ -1235,8 +1237,10 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
     }
     ++rep.local_widenings;
     rep.widened_faces += widened;
-    spdlog::warn("level {}: the reduced LP is {}; widening {} of {} faces by one ring", l + 1, why, widened,
-                 lx.mesh.num_faces());
+    // (Those at the cap are named: a place whose own faces sit there is not widened by this.)
+    spdlog::warn("level {}: the reduced LP is {}; widening {} of {} faces by one ring{}", l + 1, why, widened,
+                 lx.mesh.num_faces(),
+                 at_cap > 0 ? fmt::format(" ({} more at ring {} left as they are)", at_cap, cap) : std::string());
     return true;
   };
   // The X faces within `rings` fine rings of every face widened so far at this level.
