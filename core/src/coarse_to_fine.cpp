@@ -5,8 +5,8 @@
 #include "shapematch/system.hpp"
 
 #include "divergence_rule.hpp"
-#include "local_proof.hpp"
 #include "key_set.hpp"
+#include "local_proof.hpp"
 #include "parallel.hpp"
 #include "recurring_conflicts.hpp"
 #include "suspicion_margin.hpp"
@@ -1108,7 +1108,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
   }
   std::vector<int> last_widened;
   // The region of the last local proof (LocalInfeasible) widened at: checked again in the next
-  // attempt's LP before it is solved (recheck_proof below).
+  // attempt's LP before it is solved (at the top of the attempt's try below).
   struct ProofRegion {
     std::vector<int> faces;
     int rings = 0;

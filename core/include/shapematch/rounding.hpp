@@ -81,8 +81,10 @@ struct RoundingOptions {
   // the rows its stalled primal iterate leaves furthest from b: the LP cut down to the rows of the
   // columns over the X faces within 0, 1, 2 … rings of theirs, a face row's far columns merged (a
   // relaxation, so a Farkas ray there proves the whole LP infeasible), while it has at most this
-  // many columns (0: off). A proof replaces the guess: the error is certified and names the ray's
-  // rows alone. None found is logged (debug) and changes nothing.
+  // many columns (0: off). A proof replaces the guess: the error (LocalInfeasible) is certified,
+  // names the ray's rows alone and the X faces the stalled rows lie on. None found is logged
+  // (debug) and changes nothing. Not where round 1 starts from start_ones (a proof would be of the
+  // LP with those fixings).
   int64_t local_proof_columns = 0;
   int local_proof_depth = 8;
   double local_proof_seconds = 600.0;  // in all
