@@ -1240,7 +1240,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
     // (Those at the cap are named: a place whose own faces sit there is not widened by this.)
     spdlog::warn("level {}: the reduced LP is {}; widening {} of {} faces by one ring{}", l + 1, why, widened,
                  lx.mesh.num_faces(),
-                 at_cap > 0 ? fmt::format(" ({} more at ring {} left as they are)", at_cap, cap) : std::string());
+                 at_cap > 0 ? fmt::format(" ({} more at ring {} or past it left as they are)", at_cap, cap) : std::string());
     return true;
   };
   // The X faces within `rings` fine rings of every face widened so far at this level.
