@@ -1293,7 +1293,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
   // by one ring, past max_ring up to kMaxRingBeyond more, before widen_at's place around them:
   // that widens only faces below max_ring while any is, which left the stalled faces themselves
   // as they were (measured, TOSCA_r dog3-dog8 at full resolution: 7 faces at 4 extra rings, their
-  // region proved infeasible again after 8 widenings around them, of 53-334 faces each; feasible
+  // region proved infeasible again after 8 widenings around them, of 4-334 faces each; feasible
   // with those 7 at 5).
   auto widen_region = [&](const std::vector<int>& faces) {
     std::vector<int> before = extra;
