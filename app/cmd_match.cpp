@@ -1086,7 +1086,8 @@ Action add_match_command(CLI::App& app) {
                "iterate leaves furthest from b, not only those its dual grew on");
   app.add_option("--local-proof", a->local_proof,
                  "where a refined level's first LP stops as diverging, look for a proof of infeasibility on a "
-                 "relaxation over the X faces around its stalled residual, up to N columns (0: off)")
+                 "relaxation over the X faces around its stalled residual, up to N columns (0: off); a proof widens "
+                 "those faces (past --max-ring if need be) and is checked again before the next LP")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   app.add_option("--local-proof-solver", a->local_proof_solver,
