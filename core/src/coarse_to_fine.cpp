@@ -1296,13 +1296,14 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
   // region proved infeasible again after 8 widenings around them, of 4-334 faces each; feasible
   // with those 7 at 5).
   auto widen_region = [&](const std::vector<int>& faces) {
-    std::vector<int> before = extra;
-    before.resize(lx.mesh.num_faces(), 0);
+    extra.resize(lx.mesh.num_faces(), 0);
+    std::vector<int> before;  // (their extra rings, to tell which grew past max_ring)
+    for (int f : faces) before.push_back(extra[f]);
     if (!widen_locally(faces, "infeasible where its first LP stalled", options_.max_ring + kMaxRingBeyond))
       return false;
     last_widened.clear();  // (widen_at's next place is not one it widened again)
-    for (int f : faces)
-      if (f < lx.mesh.num_faces() && ring + extra[f] > options_.max_ring && extra[f] > before[f]) {
+    for (size_t i = 0; i < faces.size(); ++i)
+      if (extra[faces[i]] > before[i] && ring + extra[faces[i]] > options_.max_ring) {
         ++rep.margin_widenings;  // (past max_ring)
         break;
       }

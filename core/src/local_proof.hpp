@@ -253,8 +253,7 @@ inline LocalProof local_infeasibility_within(const LpProblem& reduced, const std
 inline LocalProof proof_over_x_region(const ProductSpace& space, const LpProblem& lp, const std::vector<int64_t>& cols,
                                       const std::vector<int>& faces, int rings, int64_t max_cols, LpSolver& solver,
                                       double max_seconds) {
-  const std::vector<int64_t> rows =
-      faces.empty() ? std::vector<int64_t>{} : rows_over_x_faces(space, lp, cols, faces_near(space.x(), faces, 1 + rings));
+  const std::vector<int64_t> rows = x_region_rows(space, lp, cols, faces, rings);
   return local_infeasibility_on(
       lp, [&](int depth) { return depth == 0 ? rows : std::vector<int64_t>{}; }, 0, max_cols, solver, max_seconds, true);
 }

@@ -2543,9 +2543,7 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
         }
         const std::vector<int> seed_faces = detail::x_faces_of_rows(space, red.lp, red.cols, r.x, seeds);
         const auto region_rows = [&](int rings) {
-          return seed_faces.empty() ? std::vector<int64_t>{}
-                                    : detail::rows_over_x_faces(space, red.lp, red.cols,
-                                                                detail::faces_near(space.x(), seed_faces, 1 + rings));
+          return detail::x_region_rows(space, red.lp, red.cols, seed_faces, rings);
         };
         detail::LocalProof proof =
             detail::local_infeasibility_on(red.lp, region_rows, options.local_proof_depth,

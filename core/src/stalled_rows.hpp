@@ -112,4 +112,12 @@ inline std::vector<int64_t> rows_over_x_faces(const ProductSpace& space, const L
   return out;
 }
 
+// rows_over_x_faces over the X faces within `rings` rings of `faces` (none where `faces` is
+// empty): the region a local proof solves over, the same in the rounding and in its re-check.
+inline std::vector<int64_t> x_region_rows(const ProductSpace& space, const LpProblem& lp,
+                                          const std::vector<int64_t>& cols, const std::vector<int>& faces, int rings) {
+  if (faces.empty()) return {};
+  return rows_over_x_faces(space, lp, cols, faces_near(space.x(), faces, 1 + rings));
+}
+
 }  // namespace shapematch::detail
