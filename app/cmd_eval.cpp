@@ -29,6 +29,7 @@ struct EvalArgs {
   std::string gt_y_sym;  // Y's left-right-symmetric .vts (TOSCA_r, FAUST_r): also scored, the better one named
   std::string y_mesh;  // overrides report.json's y.file
   std::string pck_csv, pck_png;
+  std::string errors_csv;  // one line per ground-truth pair: where X's vertex went and how far off
   int threads = 0;
 };
 
@@ -87,6 +88,28 @@ void plot(const std::string& csv_path, const std::string& png_path, const std::s
   const std::string cmd = python + " " + shell_quote(script.string()) + " " + shell_quote(csv_path) + " " +
                           shell_quote(png_path) + " " + shell_quote(label) + " >&2";
   if (std::system(cmd.c_str()) != 0) spdlog::warn("plotting failed ({})", cmd);
+}
+
+// Per ground-truth pair (0-based input vertices): X's vertex, its true image, the map's image and
+// the error, empty where the map says nothing; with the symmetric ground truth its error too, so
+// a part matched to its mirror image shows as a run of large direct and small symmetric errors.
+std::string errors_table(const GroundTruth& truth, const std::vector<int>& phi, const GeodesicErrors& errors,
+                         const std::optional<GeodesicErrors>& symmetric) {
+  std::string csv = symmetric ? "x,y_true,y_mapped,error,symmetric_error\n" : "x,y_true,y_mapped,error\n";
+  size_t k = 0;  // errors holds the evaluated pairs only, in ground-truth order
+  for (const GroundTruthPair& p : truth) {
+    const int mapped = phi[p.x];
+    csv += fmt::format("{},{},", p.x, p.y);
+    if (mapped < 0) {
+      csv += symmetric ? ",,\n" : ",\n";
+      continue;
+    }
+    csv += fmt::format("{},{}", mapped, errors.errors[k]);
+    if (symmetric) csv += fmt::format(",{}", symmetric->errors[k]);
+    csv += "\n";
+    ++k;
+  }
+  return csv;
 }
 
 int run_eval(const EvalArgs& args) {
@@ -203,6 +226,8 @@ int run_eval(const EvalArgs& args) {
   if (point_flips && fs::exists(back_path))
     back_flips = count_orientation_flips(ym, xm, read_points(back_path, xm, ym, "y.ply"));
 
+  if (!args.errors_csv.empty()) write_file_atomic(args.errors_csv, errors_table(truth, phi, errors, symmetric));
+
   std::string csv = "threshold,fraction\n";
   Json pck = Json::array();
   for (const auto& [t, fraction] : errors.pck) {
@@ -295,6 +320,9 @@ Action add_eval_command(CLI::App& app) {
   app.add_option("--y-mesh", a->y_mesh, "full-resolution Y (default: the y.file of report.json)");
   app.add_option("--pck-csv", a->pck_csv, "write the PCK curve as CSV (threshold,fraction)");
   app.add_option("--pck-png", a->pck_png, "plot the PCK curve (needs python3-matplotlib)");
+  app.add_option("--errors-csv", a->errors_csv,
+                 "write each ground-truth pair's error as CSV (x,y_true,y_mapped,error[,symmetric_error]; 0-based "
+                 "input vertices)");
   app.add_option("--threads", a->threads, "geodesic solves in parallel (0: all cores)")->capture_default_str();
   return [a] { return run_eval(*a); };
 }

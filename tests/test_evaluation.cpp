@@ -364,12 +364,37 @@ TEST_CASE("evaluation: shapematch eval reads a match directory through the verte
   CHECK(json_number(r.out, "best_mean_geodesic_error") == 0.0);
   CHECK(r.out.find("\"best_ground_truth\": \"direct\"") != std::string::npos);
   r = run_cli("eval " + out.string() + " --gt-x " + (dir / "a.vts").string() + " --gt-y " +
-                  (dir / "reversed.vts").string() + " --gt-y-sym " + (dir / "a.vts").string(),
+                  (dir / "reversed.vts").string() + " --gt-y-sym " + (dir / "a.vts").string() + " --errors-csv " +
+                  (dir / "errors.csv").string(),
               dir);
   REQUIRE_MESSAGE(r.code == 0, r.err);
   CHECK(json_number(r.out, "mean_geodesic_error") > 0.1);
   CHECK(json_number(r.out, "best_mean_geodesic_error") == 0.0);
   CHECK(r.out.find("\"best_ground_truth\": \"symmetric\"") != std::string::npos);
+  {
+    // Per pair: X's vertex, the reversed truth, the map's image (the identity) and both errors;
+    // the errors' mean is the reported one.
+    std::ifstream in(dir / "errors.csv");
+    std::string line;
+    std::getline(in, line);
+    CHECK(line == "x,y_true,y_mapped,error,symmetric_error");
+    int rows = 0;
+    double sum = 0;
+    while (std::getline(in, line)) {
+      int xv = -1, yt = -1, ym = -1;
+      double e = -1, es = -1;
+      REQUIRE(std::sscanf(line.c_str(), "%d,%d,%d,%lf,%lf", &xv, &yt, &ym, &e, &es) == 5);
+      CHECK(xv == rows);
+      CHECK(yt == n - 1 - rows);
+      CHECK(ym == rows);
+      CHECK(es == 0.0);
+      CHECK((e > 0) == (xv != yt));
+      sum += e;
+      ++rows;
+    }
+    CHECK(rows == n);
+    CHECK(sum / n == doctest::Approx(json_number(r.out, "mean_geodesic_error")).epsilon(1e-9));
+  }
   std::string two_columns;
   for (int v = 0; v < n; v += 2) two_columns += std::to_string(v + 1) + " " + std::to_string(v + 1) + "\n";
   write(dir / "map.txt", two_columns);
