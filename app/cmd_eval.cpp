@@ -30,6 +30,8 @@ struct EvalArgs {
   std::string y_mesh;  // overrides report.json's y.file
   std::string pck_csv, pck_png;
   std::string errors_csv;  // one line per ground-truth pair: where X's vertex went and how far off
+  std::string x_mesh;      // overrides report.json's x.file (for error_regions)
+  double region_threshold = 0.1;
   int threads = 0;
 };
 
@@ -91,23 +93,20 @@ void plot(const std::string& csv_path, const std::string& png_path, const std::s
 }
 
 // Per ground-truth pair (0-based input vertices): X's vertex, its true image, the map's image and
-// the error, empty where the map says nothing; with the symmetric ground truth its error too, so
-// a part matched to its mirror image shows as a run of large direct and small symmetric errors.
-std::string errors_table(const GroundTruth& truth, const std::vector<int>& phi, const GeodesicErrors& errors,
-                         const std::optional<GeodesicErrors>& symmetric) {
-  std::string csv = symmetric ? "x,y_true,y_mapped,error,symmetric_error\n" : "x,y_true,y_mapped,error\n";
-  size_t k = 0;  // errors holds the evaluated pairs only, in ground-truth order
-  for (const GroundTruthPair& p : truth) {
-    const int mapped = phi[p.x];
+// the error, empty where the map says nothing; with the symmetric ground truth its error too.
+std::string errors_table(const GroundTruth& truth, const std::vector<int>& phi, const std::vector<double>& errors,
+                         const std::vector<double>& symmetric) {
+  std::string csv = symmetric.empty() ? "x,y_true,y_mapped,error\n" : "x,y_true,y_mapped,error,symmetric_error\n";
+  for (size_t k = 0; k < truth.size(); ++k) {
+    const GroundTruthPair& p = truth[k];
     csv += fmt::format("{},{},", p.x, p.y);
-    if (mapped < 0) {
-      csv += symmetric ? ",,\n" : ",\n";
+    if (phi[p.x] < 0) {
+      csv += symmetric.empty() ? ",\n" : ",,\n";
       continue;
     }
-    csv += fmt::format("{},{}", mapped, errors.errors[k]);
-    if (symmetric) csv += fmt::format(",{}", symmetric->errors[k]);
+    csv += fmt::format("{},{}", phi[p.x], errors[k]);
+    if (!symmetric.empty()) csv += fmt::format(",{}", symmetric[k]);
     csv += "\n";
-    ++k;
   }
   return csv;
 }
@@ -178,8 +177,11 @@ int run_eval(const EvalArgs& args) {
   // Intrinsic symmetries make a left-right swapped map as good as the direct one to the energy
   // and to WKS; benchmarks on these data sets score the better of the two.
   std::optional<GeodesicErrors> symmetric;
-  if (!args.gt_y_sym.empty())
-    symmetric = geodesic_errors(y_full, phi, read_vts_ground_truth(args.gt_x, args.gt_y_sym, x_input, y_input), options);
+  GroundTruth symmetric_truth;
+  if (!args.gt_y_sym.empty()) {
+    symmetric_truth = read_vts_ground_truth(args.gt_x, args.gt_y_sym, x_input, y_input);
+    symmetric = geodesic_errors(y_full, phi, symmetric_truth, options);
+  }
   const OrientationFlips flips = count_orientation_flips(xm, ym, map);
   // The coarser levels' maps, scored the same way on the points each level kept.
   Json levels = Json::array();
@@ -216,8 +218,7 @@ int run_eval(const EvalArgs& args) {
     }
     point_errors = geodesic_errors(y_full, phi_points, truth, options);
     if (!args.gt_y_sym.empty())
-      point_symmetric = geodesic_errors(y_full, phi_points,
-                                        read_vts_ground_truth(args.gt_x, args.gt_y_sym, x_input, y_input), options);
+      point_symmetric = geodesic_errors(y_full, phi_points, symmetric_truth, options);
     point_flips = count_orientation_flips(xm, ym, points);
   }
   // The other direction's point map (faces of Y inverted), where match wrote it.
@@ -226,7 +227,30 @@ int run_eval(const EvalArgs& args) {
   if (point_flips && fs::exists(back_path))
     back_flips = count_orientation_flips(ym, xm, read_points(back_path, xm, ym, "y.ply"));
 
-  if (!args.errors_csv.empty()) write_file_atomic(args.errors_csv, errors_table(truth, phi, errors, symmetric));
+  std::vector<char> mapped(x_input, 0);
+  for (int v = 0; v < x_input; ++v) mapped[v] = phi[v] >= 0;
+  const std::vector<double> per_pair = pair_errors(truth, mapped, errors);
+  const std::vector<double> per_pair_sym =
+      symmetric ? pair_errors(symmetric_truth, mapped, *symmetric)
+                : std::vector<double>{};
+  if (!args.errors_csv.empty()) write_file_atomic(args.errors_csv, errors_table(truth, phi, per_pair, per_pair_sym));
+  // Where the error lies, on X's input mesh (optional: eval needs only Y otherwise).
+  std::optional<std::vector<ErrorRegion>> regions;
+  std::string x_file = args.x_mesh;
+  if (x_file.empty()) {
+    const JsonNode* xs = report.get("x");
+    const JsonNode* xf = xs ? xs->get("file") : nullptr;
+    if (xf && xf->kind == JsonNode::Kind::String) x_file = xf->text;
+  }
+  if (!x_file.empty() && fs::exists(x_file)) {
+    const Mesh x_full = load_mesh(x_file, as_input);
+    if (x_full.num_vertices() != x_input)
+      throw InvalidInputError(fmt::format("{}: {} vertices, but X had {} when it was matched", x_file,
+                                          x_full.num_vertices(), x_input));
+    regions = error_regions(x_full, truth, per_pair, per_pair_sym, args.region_threshold);
+  } else {
+    spdlog::warn("{}: cannot open (X of {}; --x-mesh): no error regions", x_file, report_path.string());
+  }
 
   std::string csv = "threshold,fraction\n";
   Json pck = Json::array();
@@ -262,6 +286,22 @@ int run_eval(const EvalArgs& args) {
       .set("geodesic_solves", errors.geodesic_solves)
       .set("levels", levels)
       .set("seconds", total.seconds());
+  if (regions) {
+    Json list = Json::array();
+    for (size_t i = 0; i < regions->size() && i < 5; ++i) {
+      const ErrorRegion& r = (*regions)[i];
+      Json j = Json::object()
+                   .set("vertices", r.vertices)
+                   .set("points", r.points)
+                   .set("error_share", r.error_share)
+                   .set("mean_geodesic_error", r.mean_error);
+      if (symmetric) j.set("symmetric_mean_geodesic_error", r.mean_symmetric_error).set("mirrored", r.mirrored);
+      list.push(j);
+    }
+    out.set("error_region_threshold", args.region_threshold)
+        .set("error_regions_found", static_cast<int64_t>(regions->size()))
+        .set("error_regions", list);
+  }
   if (point_errors) {
     Json pm = Json::object()
                   .set("mean_geodesic_error", point_errors->mean)
@@ -294,6 +334,17 @@ int run_eval(const EvalArgs& args) {
                  point_flips->degenerate);
   if (symmetric)
     spdlog::info("against the symmetric ground truth: mean {:.4f} (median {:.4f})", symmetric->mean, symmetric->median);
+  if (regions && !regions->empty()) {
+    const ErrorRegion& r = regions->front();
+    spdlog::info("{} regions of X mapped more than {} off; the largest share: {} vertices, {:.0f} % of the error, mean "
+                 "{:.4f}{}",
+                 regions->size(), args.region_threshold, r.vertices, 100 * r.error_share, r.mean_error,
+                 !symmetric ? ""
+                 : r.mirrored
+                     ? fmt::format(" (against the symmetric ground truth {:.4f}: matched to its mirror image)",
+                                   r.mean_symmetric_error)
+                     : fmt::format(" (against the symmetric ground truth {:.4f})", r.mean_symmetric_error));
+  }
   return 0;
 }
 
@@ -323,6 +374,11 @@ Action add_eval_command(CLI::App& app) {
   app.add_option("--errors-csv", a->errors_csv,
                  "write each ground-truth pair's error as CSV (x,y_true,y_mapped,error[,symmetric_error]; 0-based "
                  "input vertices)");
+  app.add_option("--x-mesh", a->x_mesh, "full-resolution X, for error_regions (default: the x.file of report.json)");
+  app.add_option("--region-threshold", a->region_threshold,
+                 "error_regions: connected parts of X whose points are mapped more than this off (in √area(Y))")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
   app.add_option("--threads", a->threads, "geodesic solves in parallel (0: all cores)")->capture_default_str();
   return [a] { return run_eval(*a); };
 }

@@ -16,6 +16,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <numbers>
 #include <numeric>
 #include <random>
@@ -207,6 +208,87 @@ TEST_CASE("evaluation: errors agree with direct geodesic distances, marched from
   CHECK_THROWS_AS(geodesic_errors(y, std::vector<int>(n - 1, 0), identity), InvalidInputError);
 }
 
+TEST_CASE("evaluation: error regions are connected parts above the threshold, mirrored where the symmetric truth fits") {
+  const Mesh x = shapes::torus(12, 8);
+  const int n = x.num_vertices();
+  std::vector<std::vector<int>> nb(n);
+  for (const auto& f : x.faces)
+    for (int i = 0; i < 3; ++i) nb[f[i]].push_back(f[(i + 1) % 3]), nb[f[(i + 1) % 3]].push_back(f[i]);
+  auto adjacent = [&](int a, int b) { return std::find(nb[a].begin(), nb[a].end(), b) != nb[a].end(); };
+  // u's neighbours a and b, not adjacent to each other: connected through u alone.
+  const int u = 0, a = nb[u][0];
+  int b = -1;
+  for (int w : nb[u])
+    if (w != a && !adjacent(a, w)) b = w;
+  REQUIRE(b >= 0);
+  // c: far from all three, with two pairs.
+  int c = -1;
+  for (int v = 0; v < n && c < 0; ++v)
+    if (v != u && v != a && v != b && !adjacent(v, u) && !adjacent(v, a) && !adjacent(v, b)) {
+      bool near = false;
+      for (int w : nb[v]) near = near || adjacent(w, u) || adjacent(w, a) || adjacent(w, b) || w == u;
+      if (!near) c = v;
+    }
+  REQUIRE(c >= 0);
+  GroundTruth truth;
+  std::vector<double> err, sym;
+  for (int v = 0; v < n; ++v) {
+    if (v == u) continue;  // no ground truth: a bridge
+    truth.push_back({v, v});
+    const double e = v == a || v == b ? 0.2 : v == c ? 1.2 : 0.0;
+    err.push_back(e);
+    sym.push_back(v == c ? 0.1 : v == a || v == b ? 0.3 : 0.5);
+  }
+  truth.push_back({c, c});  // c's second pair: its vertex's mean is 0.9
+  err.push_back(0.6);
+  sym.push_back(0.1);
+  truth.push_back({a, a});  // a pair left out of the evaluation changes nothing
+  err.push_back(std::numeric_limits<double>::quiet_NaN());
+  sym.push_back(std::numeric_limits<double>::quiet_NaN());
+
+  std::vector<ErrorRegion> r = error_regions(x, truth, err, sym, 0.1);
+  REQUIRE(r.size() == 2);
+  CHECK(r[0].x_vertices == std::vector<int>{c});
+  CHECK(r[0].points == 2);
+  CHECK(r[0].mean_error == doctest::Approx(0.9));
+  CHECK(r[0].mean_symmetric_error == doctest::Approx(0.1));
+  CHECK(r[0].mirrored);
+  CHECK(r[0].error_share == doctest::Approx(1.8 / 2.2));
+  CHECK(r[1].vertices == 2);
+  CHECK(r[1].x_vertices == std::vector<int>{std::min(a, b), std::max(a, b)});
+  CHECK(r[1].points == 2);
+  CHECK(r[1].mean_error == doctest::Approx(0.2));
+  CHECK_FALSE(r[1].mirrored);
+  CHECK(r[1].error_share == doctest::Approx(0.4 / 2.2));
+  // With u's ground truth below the threshold, a and b are apart.
+  truth.push_back({u, u});
+  err.push_back(0.05);
+  sym.push_back(0.05);
+  r = error_regions(x, truth, err, sym, 0.1);
+  REQUIRE(r.size() == 3);
+  CHECK(r[1].vertices == 1);
+  CHECK(r[2].vertices == 1);
+  // A threshold above every vertex's mean: none; without the symmetric truth: never mirrored.
+  CHECK(error_regions(x, truth, err, sym, 1.0).empty());
+  r = error_regions(x, truth, err, {}, 0.1);
+  REQUIRE(r.size() == 3);
+  CHECK_FALSE(r[0].mirrored);
+  CHECK(r[0].mean_symmetric_error == -1);
+  CHECK_THROWS_AS(error_regions(x, truth, std::vector<double>(3, 0.0), {}, 0.1), InvalidInputError);
+
+  // pair_errors spreads a GeodesicErrors over the pairs, NaN where X's vertex has no image.
+  GeodesicErrors ge;
+  ge.errors = {0.25, 0.5};
+  const GroundTruth t3 = {{0, 0}, {1, 1}, {2, 2}};
+  const std::vector<double> spread = pair_errors(t3, {1, 0, 1}, ge);
+  REQUIRE(spread.size() == 3);
+  CHECK(spread[0] == 0.25);
+  CHECK(std::isnan(spread[1]));
+  CHECK(spread[2] == 0.5);
+  CHECK_THROWS_AS(pair_errors(t3, {1, 1, 1}, ge), InvalidInputError);
+  CHECK_THROWS_AS(pair_errors(t3, {1, 0, 0}, ge), InvalidInputError);
+}
+
 TEST_CASE("evaluation: PCK curve and its area") {
   const auto pck = pck_curve({0.0, 0.005, 0.045, 0.3}, 0.25, 0.01);
   REQUIRE(pck.size() == 26);
@@ -371,6 +453,11 @@ TEST_CASE("evaluation: shapematch eval reads a match directory through the verte
   CHECK(json_number(r.out, "mean_geodesic_error") > 0.1);
   CHECK(json_number(r.out, "best_mean_geodesic_error") == 0.0);
   CHECK(r.out.find("\"best_ground_truth\": \"symmetric\"") != std::string::npos);
+  // X's input mesh is found through report.json: the reversed part is a region, mirrored.
+  CHECK(json_number(r.out, "error_regions_found") >= 1);
+  CHECK(r.out.find("\"mirrored\": true") != std::string::npos);
+  CHECK(r.out.find("\"mirrored\": false") == std::string::npos);
+  CHECK(r.err.find("matched to its mirror image") != std::string::npos);
   {
     // Per pair: X's vertex, the reversed truth, the map's image (the identity) and both errors;
     // the errors' mean is the reported one.

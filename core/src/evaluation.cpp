@@ -178,6 +178,82 @@ double pck_auc(const std::vector<std::array<double, 2>>& pck) {
   return area / width;
 }
 
+std::vector<double> pair_errors(const GroundTruth& truth, const std::vector<char>& mapped, const GeodesicErrors& errors) {
+  std::vector<double> out(truth.size(), std::numeric_limits<double>::quiet_NaN());
+  size_t k = 0;  // errors holds the evaluated pairs only, in ground-truth order
+  for (size_t i = 0; i < truth.size(); ++i) {
+    const int x = truth[i].x;
+    if (x < 0 || x >= static_cast<int>(mapped.size()) || !mapped[x]) continue;
+    if (k >= errors.errors.size()) throw InvalidInputError("pair_errors: fewer errors than mapped pairs");
+    out[i] = errors.errors[k++];
+  }
+  if (k != errors.errors.size()) throw InvalidInputError("pair_errors: more errors than mapped pairs");
+  return out;
+}
+
+std::vector<ErrorRegion> error_regions(const Mesh& x, const GroundTruth& truth, const std::vector<double>& errors,
+                                       const std::vector<double>& symmetric, double threshold) {
+  if (errors.size() != truth.size() || (!symmetric.empty() && symmetric.size() != truth.size()))
+    throw InvalidInputError("error_regions: one error per ground-truth pair expected");
+  const int n = x.num_vertices();
+  // Per X vertex: its pairs' error sum and count (a vertex may be in several pairs).
+  std::vector<double> sum(n, 0), sym_sum(n, 0);
+  std::vector<int> count(n, 0);
+  double total = 0;
+  for (size_t k = 0; k < truth.size(); ++k) {
+    if (std::isnan(errors[k])) continue;
+    const int v = truth[k].x;
+    if (v < 0 || v >= n) throw InvalidInputError("error_regions: a ground-truth vertex X lacks");
+    sum[v] += errors[k];
+    if (!symmetric.empty()) sym_sum[v] += symmetric[k];
+    ++count[v];
+    total += errors[k];
+  }
+  // 1: above the threshold, 0: below, -1: no ground truth (a bridge, not counted).
+  std::vector<int> state(n, -1);
+  for (int v = 0; v < n; ++v)
+    if (count[v] > 0) state[v] = sum[v] / count[v] > threshold ? 1 : 0;
+  std::vector<std::vector<int>> neighbours(n);
+  for (const auto& f : x.faces)
+    for (int i = 0; i < 3; ++i) {
+      neighbours[f[i]].push_back(f[(i + 1) % 3]);
+      neighbours[f[(i + 1) % 3]].push_back(f[i]);
+    }
+  std::vector<char> seen(n, 0);
+  std::vector<ErrorRegion> regions;
+  for (int s = 0; s < n; ++s) {
+    if (state[s] != 1 || seen[s]) continue;
+    ErrorRegion r;
+    double err = 0, sym = 0;
+    std::vector<int> stack{s};
+    seen[s] = 1;
+    while (!stack.empty()) {
+      const int v = stack.back();
+      stack.pop_back();
+      if (state[v] == 1) {
+        r.x_vertices.push_back(v);
+        r.points += count[v];
+        err += sum[v];
+        sym += sym_sum[v];
+      }
+      for (int w : neighbours[v])
+        if (!seen[w] && state[w] != 0) seen[w] = 1, stack.push_back(w);
+    }
+    std::sort(r.x_vertices.begin(), r.x_vertices.end());
+    r.vertices = static_cast<int>(r.x_vertices.size());
+    r.error_share = total > 0 ? err / total : 0;
+    r.mean_error = err / r.points;
+    if (!symmetric.empty()) {
+      r.mean_symmetric_error = sym / r.points;
+      r.mirrored = r.mean_symmetric_error < r.mean_error / 2;
+    }
+    regions.push_back(std::move(r));
+  }
+  std::sort(regions.begin(), regions.end(),
+            [](const ErrorRegion& a, const ErrorRegion& b) { return a.error_share > b.error_share; });
+  return regions;
+}
+
 GeodesicErrors geodesic_errors(const Mesh& y, const std::vector<int>& phi, const GroundTruth& truth,
                                const EvaluationOptions& options) {
   std::vector<MappedPoint> points(phi.size());

@@ -80,6 +80,30 @@ struct MappedPoint {
 GeodesicErrors geodesic_errors(const Mesh& y, const std::vector<MappedPoint>& phi, const GroundTruth& truth,
                                const EvaluationOptions& options = {});
 
+// Each ground-truth pair's error, NaN where φ says nothing (`mapped[x]` false for its X vertex):
+// GeodesicErrors::errors spread back over the pairs.
+std::vector<double> pair_errors(const GroundTruth& truth, const std::vector<char>& mapped, const GeodesicErrors& errors);
+
+// A connected part of X whose ground-truth points are mapped more than a threshold off: where a
+// match went wrong. With a symmetric ground truth, a part whose error against it is under half the
+// direct one was matched to its mirror image (a left leg to the right one: the energy and
+// intrinsic features cannot tell them apart, and one such part can hold most of a pair's error).
+struct ErrorRegion {
+  int vertices = 0;          // X vertices with ground truth in it
+  int points = 0;            // ground-truth pairs
+  double error_share = 0;    // its pairs' errors over all pairs' errors
+  double mean_error = 0;
+  double mean_symmetric_error = -1;  // -1: no symmetric ground truth
+  bool mirrored = false;
+  std::vector<int> x_vertices;  // sorted
+};
+
+// The regions of X (connected over its edges, through vertices without ground truth too) whose
+// vertices' mean pair error exceeds `threshold`, largest share of the error first. `errors` and
+// `symmetric` (empty: none) hold one error per pair of `truth` (pair_errors), NaN for pairs left out.
+std::vector<ErrorRegion> error_regions(const Mesh& x, const GroundTruth& truth, const std::vector<double>& errors,
+                                       const std::vector<double>& symmetric, double threshold);
+
 // The PCK curve of `errors` at thresholds 0, step, …, max, and its normalised area (trapezoids).
 std::vector<std::array<double, 2>> pck_curve(const std::vector<double>& errors, double max, double step);
 double pck_auc(const std::vector<std::array<double, 2>>& pck);
