@@ -528,6 +528,9 @@ struct MatchRow {
   double max_level_gap = kNaN;  // the largest of the levels' gaps (issue 5 asks for each level's)
   double mean_error = kNaN, median_error = kNaN, symmetric_mean_error = kNaN, flips = kNaN;
   double point_mean_error = kNaN, point_flips = kNaN;  // the point map's (eval's `point_map`)
+  // The share of the error in parts matched to their mirror image (eval's `error_regions` marked
+  // `mirrored`; needs the symmetric truth): a pair whose error is one swapped leg shows here.
+  double mirrored_share = kNaN;
   double resumed_after_level = kNaN;  // levels taken from a checkpoint (their time is not in `run`)
   // `run`'s seconds plus those of the runs whose checkpoint it went on from (NaN where one of
   // them is not on record: a harness stopped during it).
@@ -774,7 +777,7 @@ double median_ok(const std::vector<MatchRow>& rows, double (*value)(const MatchR
 const std::vector<std::string> kPairsHeader{"pair",        "faces_x", "faces_y", "seconds", "total_seconds",
                                             "peak_rss_mb", "energy",  "lower_bound", "gap", "max_level_gap",
                                             "rounds",      "mean_geodesic_error", "median_geodesic_error",
-                                            "symmetric_mean_geodesic_error", "orientation_flips",
+                                            "symmetric_mean_geodesic_error", "mirrored_error_share", "orientation_flips",
                                             "point_mean_geodesic_error", "point_orientation_flips",
                                             "resumed_after_level", "status"};
 
@@ -788,7 +791,8 @@ std::vector<std::vector<std::string>> pairs_cells(const std::vector<MatchRow>& r
                      num(r.total_seconds, 6, 2), num(r.run.peak_rss_mb, 5, 0), general(r.energy, 12), general(r.lower_bound, 12),
                      general(r.gap, 4), general(r.max_level_gap, 4), csv_int(r.rounds), num(r.mean_error, 6, 4),
                      num(r.median_error, 6, 4),
-                     num(r.symmetric_mean_error, 6, 4), csv_int(r.flips), num(r.point_mean_error, 6, 4),
+                     num(r.symmetric_mean_error, 6, 4), num(r.mirrored_share, 4, 2), csv_int(r.flips),
+                     num(r.point_mean_error, 6, 4),
                      csv_int(r.point_flips), csv_int(r.resumed_after_level), r.run.status});
   const auto ok = std::count_if(rows.begin(), rows.end(), [](const MatchRow& r) { return r.run.status == "ok"; });
   cells.push_back({csv ? "median" : "**median**", "", "",
@@ -799,7 +803,7 @@ std::vector<std::vector<std::string>> pairs_cells(const std::vector<MatchRow>& r
                    general(median_ok(rows, [](const MatchRow& r) { return r.max_level_gap; }), 4), "",
                    num(median_ok(rows, [](const MatchRow& r) { return r.mean_error; }), 6, 4),
                    num(median_ok(rows, [](const MatchRow& r) { return r.median_error; }), 6, 4),
-                   num(median_ok(rows, [](const MatchRow& r) { return r.symmetric_mean_error; }), 6, 4), "",
+                   num(median_ok(rows, [](const MatchRow& r) { return r.symmetric_mean_error; }), 6, 4), "", "",
                    num(median_ok(rows, [](const MatchRow& r) { return r.point_mean_error; }), 6, 4), "", "",
                    fmt::format("{} of {} ok", ok, rows.size())});
   return cells;
@@ -818,6 +822,15 @@ void read_errors(const std::string& json_path, MatchRow& row) {
   row.median_error = result.number_or_nan("median_geodesic_error");
   row.symmetric_mean_error = result.number_or_nan("symmetric_mean_geodesic_error");
   row.flips = result.number_or_nan("orientation_flips");
+  const JsonNode* regions = result.get("error_regions");
+  if (regions && regions->kind == JsonNode::Kind::Array && result.get("symmetric_mean_geodesic_error")) {
+    row.mirrored_share = 0;
+    for (const auto& [key, region] : regions->members) {
+      const JsonNode* mirrored = region.get("mirrored");
+      if (mirrored && mirrored->kind == JsonNode::Kind::Bool && mirrored->number != 0)
+        row.mirrored_share += region.number_or_nan("error_share");
+    }
+  }
   if (const JsonNode* points = result.get("point_map")) {
     row.point_mean_error = points->number_or_nan("mean_geodesic_error");
     row.point_flips = points->number_or_nan("orientation_flips");

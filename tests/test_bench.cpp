@@ -246,7 +246,7 @@ TEST_CASE("cli: bench match --pairs matches and evaluates each pair and adds a r
   const std::vector<std::string> expected = {"pair", "faces_x", "faces_y", "seconds", "total_seconds", "peak_rss_mb", "energy",
                                              "lower_bound", "gap", "max_level_gap", "rounds", "mean_geodesic_error",
                                              "median_geodesic_error", "symmetric_mean_geodesic_error",
-                                             "orientation_flips", "point_mean_geodesic_error",
+                                             "mirrored_error_share", "orientation_flips", "point_mean_geodesic_error",
                                              "point_orientation_flips", "resumed_after_level", "status"};
   REQUIRE(header == expected);
   REQUIRE(rows.size() == 3);
@@ -272,6 +272,10 @@ TEST_CASE("cli: bench match --pairs matches and evaluates each pair and adds a r
     // Only the second line names a symmetric truth, a different one, so its error differs.
     CHECK(row.at("symmetric_mean_geodesic_error").empty() == (i == 0));
     if (i == 1) CHECK(std::stod(row.at("symmetric_mean_geodesic_error")) != doctest::Approx(mean));
+    // The share of the error in mirrored parts: only with the symmetric truth, a fraction.
+    CHECK(row.at("mirrored_error_share").empty() == (i == 0));
+    if (i == 1) CHECK(std::stod(row.at("mirrored_error_share")) >= 0);
+    if (i == 1) CHECK(std::stod(row.at("mirrored_error_share")) <= 1 + 1e-9);
     seconds.push_back(std::stod(row.at("seconds")));
     CHECK(row.at("total_seconds") == row.at("seconds"));  // (no checkpoint before it)
   }
