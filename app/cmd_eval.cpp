@@ -11,6 +11,10 @@
 #include <spdlog/fmt/fmt.h>
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
@@ -31,6 +35,7 @@ struct EvalArgs {
   std::string pck_csv, pck_png;
   std::string errors_csv;  // one line per ground-truth pair: where X's vertex went and how far off
   std::string x_mesh;      // overrides report.json's x.file (for error_regions)
+  std::string errors_ply;  // X's input mesh coloured by error
   double region_threshold = 0.1;
   int threads = 0;
 };
@@ -111,6 +116,29 @@ std::string errors_table(const GroundTruth& truth, const std::vector<int>& phi, 
   return csv;
 }
 
+// X's vertices coloured by their pairs' mean error: white at 0 through yellow to red at
+// `full_scale` and above; vertices of a mirrored region blue (whatever their error, so that a
+// swapped part stands out from a merely inaccurate one); grey without ground truth or image.
+std::vector<std::array<uint8_t, 3>> error_colors(int vertices, const GroundTruth& truth,
+                                                 const std::vector<double>& errors,
+                                                 const std::vector<ErrorRegion>& regions, double full_scale) {
+  std::vector<double> sum(vertices, 0);
+  std::vector<int> count(vertices, 0);
+  for (size_t k = 0; k < truth.size(); ++k)
+    if (!std::isnan(errors[k])) sum[truth[k].x] += errors[k], ++count[truth[k].x];
+  std::vector<std::array<uint8_t, 3>> colors(vertices, {160, 160, 160});
+  for (int v = 0; v < vertices; ++v) {
+    if (count[v] == 0) continue;
+    const double t = std::clamp(sum[v] / count[v] / full_scale, 0.0, 1.0);
+    const auto c = [](double u) { return static_cast<uint8_t>(std::lround(255 * std::clamp(u, 0.0, 1.0))); };
+    colors[v] = t < 0.5 ? std::array<uint8_t, 3>{255, 255, c(1 - 2 * t)} : std::array<uint8_t, 3>{255, c(2 - 2 * t), 0};
+  }
+  for (const ErrorRegion& r : regions)
+    if (r.mirrored)
+      for (int v : r.x_vertices) colors[v] = {60, 90, 230};
+  return colors;
+}
+
 int run_eval(const EvalArgs& args) {
   Stopwatch total;
   const fs::path dir(args.dir);
@@ -154,6 +182,18 @@ int run_eval(const EvalArgs& args) {
   if (y_full.num_vertices() != y_input)
     throw InvalidInputError(fmt::format("{}: {} vertices, but Y had {} when it was matched", y_file,
                                         y_full.num_vertices(), y_input));
+
+  // X's input mesh, for error_regions only (eval needs Y otherwise): report.json's or --x-mesh.
+  std::string x_file = args.x_mesh;
+  if (x_file.empty()) {
+    const JsonNode* xs = report.get("x");
+    const JsonNode* xf = xs ? xs->get("file") : nullptr;
+    if (xf && xf->kind == JsonNode::Kind::String) x_file = xf->text;
+  }
+  const bool x_found = !x_file.empty() && fs::exists(x_file);
+  if (!x_found && !args.errors_ply.empty())
+    throw IoError((x_file.empty() ? std::string("X") : x_file) + ": cannot open (X of " + report_path.string() +
+                  ", needed by --errors-ply; give --x-mesh)");
 
   GroundTruth truth;
   std::string truth_name;
@@ -236,20 +276,17 @@ int run_eval(const EvalArgs& args) {
   if (!args.errors_csv.empty()) write_file_atomic(args.errors_csv, errors_table(truth, phi, per_pair, per_pair_sym));
   // Where the error lies, on X's input mesh (optional: eval needs only Y otherwise).
   std::optional<std::vector<ErrorRegion>> regions;
-  std::string x_file = args.x_mesh;
-  if (x_file.empty()) {
-    const JsonNode* xs = report.get("x");
-    const JsonNode* xf = xs ? xs->get("file") : nullptr;
-    if (xf && xf->kind == JsonNode::Kind::String) x_file = xf->text;
-  }
-  if (!x_file.empty() && fs::exists(x_file)) {
+  if (x_found) {
     const Mesh x_full = load_mesh(x_file, as_input);
     if (x_full.num_vertices() != x_input)
       throw InvalidInputError(fmt::format("{}: {} vertices, but X had {} when it was matched", x_file,
                                           x_full.num_vertices(), x_input));
     regions = error_regions(x_full, truth, per_pair, per_pair_sym, args.region_threshold);
+    if (!args.errors_ply.empty())
+      save_mesh(x_full, args.errors_ply, error_colors(x_input, truth, per_pair, *regions, 0.25));
   } else {
-    spdlog::warn("{}: cannot open (X of {}; --x-mesh): no error regions", x_file, report_path.string());
+    spdlog::warn("{}: cannot open (X of {}; --x-mesh): no error regions", x_file.empty() ? "X" : x_file,
+                 report_path.string());
   }
 
   std::string csv = "threshold,fraction\n";
@@ -375,6 +412,9 @@ Action add_eval_command(CLI::App& app) {
                  "write each ground-truth pair's error as CSV (x,y_true,y_mapped,error[,symmetric_error]; 0-based "
                  "input vertices)");
   app.add_option("--x-mesh", a->x_mesh, "full-resolution X, for error_regions (default: the x.file of report.json)");
+  app.add_option("--errors-ply", a->errors_ply,
+                 "write X's input mesh as PLY coloured by error: white 0, yellow, red at 0.25 and above; blue: parts "
+                 "matched to their mirror image (with --gt-y-sym); grey: no ground truth");
   app.add_option("--region-threshold", a->region_threshold,
                  "error_regions: connected parts of X whose points are mapped more than this off (in √area(Y))")
       ->check(CLI::PositiveNumber)

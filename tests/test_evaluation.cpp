@@ -17,7 +17,9 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <map>
 #include <numbers>
+#include <sstream>
 #include <numeric>
 #include <random>
 #include <sys/wait.h>
@@ -482,6 +484,43 @@ TEST_CASE("evaluation: shapematch eval reads a match directory through the verte
     CHECK(rows == n);
     CHECK(sum / n == doctest::Approx(json_number(r.out, "mean_geodesic_error")).epsilon(1e-9));
   }
+  // X coloured by error: the mirrored vertices blue; with the true map, every vertex white.
+  auto colours = [&](const fs::path& ply) {
+    std::map<std::array<int, 3>, int> counts;
+    std::ifstream in(ply);
+    std::string line;
+    while (std::getline(in, line) && line != "end_header") {}
+    for (int v = 0; v < n && std::getline(in, line); ++v) {
+      std::istringstream row(line);
+      double c[3];
+      std::array<int, 3> rgb{};
+      row >> c[0] >> c[1] >> c[2] >> rgb[0] >> rgb[1] >> rgb[2];
+      ++counts[rgb];
+    }
+    return counts;
+  };
+  r = run_cli("eval " + out.string() + " --gt-x " + (dir / "a.vts").string() + " --gt-y " +
+                  (dir / "reversed.vts").string() + " --gt-y-sym " + (dir / "a.vts").string() + " --errors-ply " +
+                  (dir / "errors.ply").string(),
+              dir);
+  REQUIRE_MESSAGE(r.code == 0, r.err);
+  std::map<std::array<int, 3>, int> seen = colours(dir / "errors.ply");
+  CHECK(seen[{60, 90, 230}] > n / 2);
+  r = run_cli("eval " + out.string() + " --gt-x " + (dir / "a.vts").string() + " --gt-y " + (dir / "a.vts").string() +
+                  " --errors-ply " + (dir / "errors.ply").string(),
+              dir);
+  REQUIRE_MESSAGE(r.code == 0, r.err);
+  seen = colours(dir / "errors.ply");
+  CHECK(seen.size() == 1);
+  CHECK(seen[{255, 255, 255}] == n);
+  // Without X's mesh the coloured file cannot be written: said before any work, nothing written.
+  fs::remove(dir / "errors.ply");
+  r = run_cli("eval " + out.string() + " --x-mesh " + (dir / "none.off").string() + " --errors-ply " +
+                  (dir / "errors.ply").string(),
+              dir);
+  CHECK(r.code != 0);
+  CHECK(r.err.find("none.off: cannot open") != std::string::npos);
+  CHECK_FALSE(fs::exists(dir / "errors.ply"));
   std::string two_columns;
   for (int v = 0; v < n; v += 2) two_columns += std::to_string(v + 1) + " " + std::to_string(v + 1) + "\n";
   write(dir / "map.txt", two_columns);
