@@ -528,8 +528,8 @@ struct MatchRow {
   double max_level_gap = kNaN;  // the largest of the levels' gaps (issue 5 asks for each level's)
   double mean_error = kNaN, median_error = kNaN, symmetric_mean_error = kNaN, flips = kNaN;
   double point_mean_error = kNaN, point_flips = kNaN;  // the point map's (eval's `point_map`)
-  // The share of the error in parts matched to their mirror image (eval's `error_regions` marked
-  // `mirrored`; needs the symmetric truth): a pair whose error is one swapped leg shows here.
+  // The share of the error in points matched to their mirror image (eval's, with the symmetric
+  // truth): a pair whose error is one swapped leg shows here.
   double mirrored_share = kNaN;
   double resumed_after_level = kNaN;  // levels taken from a checkpoint (their time is not in `run`)
   // `run`'s seconds plus those of the runs whose checkpoint it went on from (NaN where one of
@@ -822,15 +822,7 @@ void read_errors(const std::string& json_path, MatchRow& row) {
   row.median_error = result.number_or_nan("median_geodesic_error");
   row.symmetric_mean_error = result.number_or_nan("symmetric_mean_geodesic_error");
   row.flips = result.number_or_nan("orientation_flips");
-  const JsonNode* regions = result.get("error_regions");
-  if (regions && regions->kind == JsonNode::Kind::Array && result.get("symmetric_mean_geodesic_error")) {
-    row.mirrored_share = 0;
-    for (const auto& [key, region] : regions->members) {
-      const JsonNode* mirrored = region.get("mirrored");
-      if (mirrored && mirrored->kind == JsonNode::Kind::Bool && mirrored->number != 0)
-        row.mirrored_share += region.number_or_nan("error_share");
-    }
-  }
+  row.mirrored_share = result.number_or_nan("mirrored_error_share");
   if (const JsonNode* points = result.get("point_map")) {
     row.point_mean_error = points->number_or_nan("mean_geodesic_error");
     row.point_flips = points->number_or_nan("orientation_flips");

@@ -228,13 +228,28 @@ int run_eval(const EvalArgs& args) {
   for (int k = 1;; ++k) {
     const fs::path path = dir / "levels" / fmt::format("level_{}.txt", k);
     if (!fs::exists(path)) break;
-    const GeodesicErrors e = geodesic_errors(y_full, read_level_map(path, x_input, y_input), truth, options);
-    levels.push(Json::object()
-                    .set("level", k)
-                    .set("points", e.points)
-                    .set("mean_geodesic_error", e.mean)
-                    .set("median_geodesic_error", e.median));
-    spdlog::info("level {}: mean geodesic error {:.4f} (median {:.4f}) over {} points", k, e.mean, e.median, e.points);
+    const std::vector<int> level_phi = read_level_map(path, x_input, y_input);
+    const GeodesicErrors e = geodesic_errors(y_full, level_phi, truth, options);
+    Json level = Json::object()
+                     .set("level", k)
+                     .set("points", e.points)
+                     .set("mean_geodesic_error", e.mean)
+                     .set("median_geodesic_error", e.median);
+    std::string mirrored;
+    if (symmetric) {
+      // Where a part went to its mirror image: from which level on (pair by pair: too few points
+      // at the coarse levels for regions).
+      std::vector<char> kept(x_input, 0);
+      for (int v = 0; v < x_input; ++v) kept[v] = level_phi[v] >= 0;
+      const GeodesicErrors es = geodesic_errors(y_full, level_phi, symmetric_truth, options);
+      const double share = mirrored_error_share(pair_errors(truth, kept, e), pair_errors(symmetric_truth, kept, es),
+                                                args.region_threshold);
+      level.set("symmetric_mean_geodesic_error", es.mean).set("mirrored_error_share", share);
+      mirrored = fmt::format("; {:.0f} % of it mirrored", 100 * share);
+    }
+    levels.push(level);
+    spdlog::info("level {}: mean geodesic error {:.4f} (median {:.4f}) over {} points{}", k, e.mean, e.median, e.points,
+                 mirrored);
   }
   // The point map (written by match since it has one): the same scores for points, whose
   // corners are vertices of the matched Y, i.e. input vertices of Y.
@@ -359,7 +374,8 @@ int run_eval(const EvalArgs& args) {
         .set("symmetric_mean_geodesic_error", symmetric->mean)
         .set("symmetric_median_geodesic_error", symmetric->median)
         .set("best_ground_truth", sym_better ? "symmetric" : "direct")
-        .set("best_mean_geodesic_error", std::min(errors.mean, symmetric->mean));
+        .set("best_mean_geodesic_error", std::min(errors.mean, symmetric->mean))
+        .set("mirrored_error_share", mirrored_error_share(per_pair, per_pair_sym, args.region_threshold));
   }
   std::cout << out.dump() << "\n";
   spdlog::info("mean geodesic error {:.4f} (median {:.4f}) over {} points, AUC {:.3f}; {} of {} faces flipped, {} "

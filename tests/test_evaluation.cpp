@@ -278,6 +278,11 @@ TEST_CASE("evaluation: error regions are connected parts above the threshold, mi
   CHECK(r[0].mean_symmetric_error == -1);
   CHECK_THROWS_AS(error_regions(x, truth, std::vector<double>(3, 0.0), {}, 0.1), InvalidInputError);
 
+  // Pair by pair: the pairs above the threshold whose symmetric error is under half theirs.
+  CHECK(mirrored_error_share({0.4, 0.2, 0.05, std::nan("")}, {0.1, 0.15, 0.0, 0.0}, 0.1) == doctest::Approx(0.4 / 0.65));
+  CHECK(mirrored_error_share({0.0, 0.0}, {0.0, 0.0}, 0.1) == 0.0);
+  CHECK_THROWS_AS(mirrored_error_share({0.1}, {}, 0.1), InvalidInputError);
+
   // pair_errors spreads a GeodesicErrors over the pairs, NaN where X's vertex has no image.
   GeodesicErrors ge;
   ge.errors = {0.25, 0.5};
@@ -447,6 +452,13 @@ TEST_CASE("evaluation: shapematch eval reads a match directory through the verte
   CHECK(json_number(r.out, "symmetric_mean_geodesic_error") > 0.1);
   CHECK(json_number(r.out, "best_mean_geodesic_error") == 0.0);
   CHECK(r.out.find("\"best_ground_truth\": \"direct\"") != std::string::npos);
+  CHECK(json_number(r.out, "mirrored_error_share") == 0.0);
+  // A coarser level's map, as match writes it (0-based input vertices): every third vertex of X to
+  // the same vertex of Y, which the reversed truth scores as mirrored.
+  fs::create_directories(out / "levels");
+  std::string level;
+  for (int v = 0; v < n; v += 3) level += std::to_string(v) + " " + std::to_string(v) + "\n";
+  write(out / "levels" / "level_1.txt", level);
   r = run_cli("eval " + out.string() + " --gt-x " + (dir / "a.vts").string() + " --gt-y " +
                   (dir / "reversed.vts").string() + " --gt-y-sym " + (dir / "a.vts").string() + " --errors-csv " +
                   (dir / "errors.csv").string(),
@@ -455,6 +467,19 @@ TEST_CASE("evaluation: shapematch eval reads a match directory through the verte
   CHECK(json_number(r.out, "mean_geodesic_error") > 0.1);
   CHECK(json_number(r.out, "best_mean_geodesic_error") == 0.0);
   CHECK(r.out.find("\"best_ground_truth\": \"symmetric\"") != std::string::npos);
+  {
+    // The share of the error mirrored pair by pair: most of it, at the level as at the finest (the
+    // last "mirrored_error_share" is the finest's, the levels' come first).
+    const std::string levels = r.out.substr(r.out.find("\"levels\""));
+    CHECK(json_number(levels, "points") == (n + 2) / 3);
+    CHECK(json_number(levels, "mirrored_error_share") > 0.8);
+    CHECK(json_number(levels, "mirrored_error_share") <= 1.0);
+    const std::string finest = r.out.substr(r.out.rfind("\"mirrored_error_share\""));
+    CHECK(json_number(finest, "mirrored_error_share") > 0.8);
+    CHECK(json_number(finest, "mirrored_error_share") <= 1.0);
+    CHECK(r.err.find("% of it mirrored") != std::string::npos);
+  }
+  fs::remove_all(out / "levels");
   // X's input mesh is found through report.json: the reversed part is a region, mirrored.
   CHECK(json_number(r.out, "error_regions_found") >= 1);
   CHECK(r.out.find("\"mirrored\": true") != std::string::npos);

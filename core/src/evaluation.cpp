@@ -254,6 +254,17 @@ std::vector<ErrorRegion> error_regions(const Mesh& x, const GroundTruth& truth, 
   return regions;
 }
 
+double mirrored_error_share(const std::vector<double>& errors, const std::vector<double>& symmetric, double threshold) {
+  if (symmetric.size() != errors.size()) throw InvalidInputError("mirrored_error_share: one symmetric error per pair expected");
+  double total = 0, mirrored = 0;
+  for (size_t k = 0; k < errors.size(); ++k) {
+    if (std::isnan(errors[k])) continue;
+    total += errors[k];
+    if (errors[k] > threshold && symmetric[k] < errors[k] / 2) mirrored += errors[k];
+  }
+  return total > 0 ? mirrored / total : 0.0;
+}
+
 GeodesicErrors geodesic_errors(const Mesh& y, const std::vector<int>& phi, const GroundTruth& truth,
                                const EvaluationOptions& options) {
   std::vector<MappedPoint> points(phi.size());

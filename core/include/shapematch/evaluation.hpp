@@ -104,6 +104,11 @@ struct ErrorRegion {
 std::vector<ErrorRegion> error_regions(const Mesh& x, const GroundTruth& truth, const std::vector<double>& errors,
                                        const std::vector<double>& symmetric, double threshold);
 
+// Pair by pair, without X's connectivity (for a coarse level's few points): the share of the
+// error in pairs mapped more than `threshold` off whose symmetric error is under half the direct
+// one. `errors` and `symmetric` as for error_regions (both given); 0 where there is no error.
+double mirrored_error_share(const std::vector<double>& errors, const std::vector<double>& symmetric, double threshold);
+
 // The PCK curve of `errors` at thresholds 0, step, …, max, and its normalised area (trapezoids).
 std::vector<std::array<double, 2>> pck_curve(const std::vector<double>& errors, double max, double step);
 double pck_auc(const std::vector<std::array<double, 2>>& pck);
