@@ -105,7 +105,7 @@ std::string errors_table(const GroundTruth& truth, const std::vector<int>& phi, 
   for (size_t k = 0; k < truth.size(); ++k) {
     const GroundTruthPair& p = truth[k];
     csv += fmt::format("{},{},", p.x, p.y);
-    if (phi[p.x] < 0) {
+    if (std::isnan(errors[k])) {  // (X's vertex without an image)
       csv += symmetric.empty() ? ",\n" : ",,\n";
       continue;
     }
@@ -118,19 +118,17 @@ std::string errors_table(const GroundTruth& truth, const std::vector<int>& phi, 
 
 // X's vertices coloured by their pairs' mean error: white at 0 through yellow to red at
 // `full_scale` and above; vertices of a mirrored region blue (whatever their error, so that a
-// swapped part stands out from a merely inaccurate one); grey without ground truth or image.
-std::vector<std::array<uint8_t, 3>> error_colors(int vertices, const GroundTruth& truth,
+// swapped part stands out from a merely inaccurate one); grey without an error (no ground truth, or
+// removed by decimation).
+std::vector<std::array<uint8_t, 3>> error_colors(const Mesh& x, const GroundTruth& truth,
                                                  const std::vector<double>& errors,
                                                  const std::vector<ErrorRegion>& regions, double full_scale) {
-  std::vector<double> sum(vertices, 0);
-  std::vector<int> count(vertices, 0);
-  for (size_t k = 0; k < truth.size(); ++k)
-    if (!std::isnan(errors[k])) sum[truth[k].x] += errors[k], ++count[truth[k].x];
-  std::vector<std::array<uint8_t, 3>> colors(vertices, {160, 160, 160});
-  for (int v = 0; v < vertices; ++v) {
-    if (count[v] == 0) continue;
-    const double t = std::clamp(sum[v] / count[v] / full_scale, 0.0, 1.0);
-    const auto c = [](double u) { return static_cast<uint8_t>(std::lround(255 * std::clamp(u, 0.0, 1.0))); };
+  const std::vector<double> mean = vertex_mean_errors(x.num_vertices(), truth, errors);
+  std::vector<std::array<uint8_t, 3>> colors(x.num_vertices(), {160, 160, 160});
+  const auto c = [](double u) { return static_cast<uint8_t>(std::lround(255 * std::clamp(u, 0.0, 1.0))); };
+  for (int v = 0; v < x.num_vertices(); ++v) {
+    if (std::isnan(mean[v])) continue;
+    const double t = std::clamp(mean[v] / full_scale, 0.0, 1.0);
     colors[v] = t < 0.5 ? std::array<uint8_t, 3>{255, 255, c(1 - 2 * t)} : std::array<uint8_t, 3>{255, c(2 - 2 * t), 0};
   }
   for (const ErrorRegion& r : regions)
@@ -183,7 +181,8 @@ int run_eval(const EvalArgs& args) {
     throw InvalidInputError(fmt::format("{}: {} vertices, but Y had {} when it was matched", y_file,
                                         y_full.num_vertices(), y_input));
 
-  // X's input mesh, for error_regions only (eval needs Y otherwise): report.json's or --x-mesh.
+  // X's input mesh, for error_regions only (eval needs Y otherwise): report.json's or --x-mesh;
+  // loaded and checked before any geodesic is solved. Its own coordinates: --errors-ply writes it.
   std::string x_file = args.x_mesh;
   if (x_file.empty()) {
     const JsonNode* xs = report.get("x");
@@ -191,9 +190,23 @@ int run_eval(const EvalArgs& args) {
     if (xf && xf->kind == JsonNode::Kind::String) x_file = xf->text;
   }
   const bool x_found = !x_file.empty() && fs::exists(x_file);
-  if (!x_found && !args.errors_ply.empty())
+  if (!x_found && (!args.x_mesh.empty() || !args.errors_ply.empty()))
     throw IoError((x_file.empty() ? std::string("X") : x_file) + ": cannot open (X of " + report_path.string() +
-                  ", needed by --errors-ply; give --x-mesh)");
+                  (args.x_mesh.empty() ? ", needed by --errors-ply; give --x-mesh)" : ")"));
+  if (!args.errors_ply.empty() && fs::path(args.errors_ply).extension() != ".ply")
+    throw InvalidInputError(args.errors_ply + ": --errors-ply writes PLY (vertex colours): name it .ply");
+  std::optional<Mesh> x_full;
+  if (x_found) {
+    LoadOptions x_as_input = as_input;
+    x_as_input.normalize_area = false;
+    x_full = load_mesh(x_file, x_as_input);
+    if (x_full->num_vertices() != x_input)
+      throw InvalidInputError(fmt::format("{}: {} vertices, but X had {} when it was matched", x_file,
+                                          x_full->num_vertices(), x_input));
+  } else {
+    spdlog::warn("{}: cannot open (X of {}; --x-mesh): no error regions", x_file.empty() ? "X" : x_file,
+                 report_path.string());
+  }
 
   GroundTruth truth;
   std::string truth_name;
@@ -207,6 +220,10 @@ int run_eval(const EvalArgs& args) {
     truth = identity_ground_truth(x_input, y_input);
     truth_name = "identity";
   }
+  // Intrinsic symmetries make a left-right swapped map as good as the direct one to the energy
+  // and to WKS; benchmarks on these data sets score the better of the two.
+  GroundTruth symmetric_truth;
+  if (!args.gt_y_sym.empty()) symmetric_truth = read_vts_ground_truth(args.gt_x, args.gt_y_sym, x_input, y_input);
 
   // φ on the input vertices of X; those that decimation removed have no image.
   std::vector<int> phi(x_input, -1);
@@ -214,14 +231,8 @@ int run_eval(const EvalArgs& args) {
   EvaluationOptions options;
   options.threads = args.threads;
   const GeodesicErrors errors = geodesic_errors(y_full, phi, truth, options);
-  // Intrinsic symmetries make a left-right swapped map as good as the direct one to the energy
-  // and to WKS; benchmarks on these data sets score the better of the two.
   std::optional<GeodesicErrors> symmetric;
-  GroundTruth symmetric_truth;
-  if (!args.gt_y_sym.empty()) {
-    symmetric_truth = read_vts_ground_truth(args.gt_x, args.gt_y_sym, x_input, y_input);
-    symmetric = geodesic_errors(y_full, phi, symmetric_truth, options);
-  }
+  if (!args.gt_y_sym.empty()) symmetric = geodesic_errors(y_full, phi, symmetric_truth, options);
   const OrientationFlips flips = count_orientation_flips(xm, ym, map);
   // The coarser levels' maps, scored the same way on the points each level kept.
   Json levels = Json::array();
@@ -239,10 +250,8 @@ int run_eval(const EvalArgs& args) {
     if (symmetric) {
       // Where a part went to its mirror image: from which level on (pair by pair: too few points
       // at the coarse levels for regions).
-      std::vector<char> kept(x_input, 0);
-      for (int v = 0; v < x_input; ++v) kept[v] = level_phi[v] >= 0;
       const GeodesicErrors es = geodesic_errors(y_full, level_phi, symmetric_truth, options);
-      const double share = mirrored_error_share(pair_errors(truth, kept, e), pair_errors(symmetric_truth, kept, es),
+      const double share = mirrored_error_share(pair_errors(truth.size(), e), pair_errors(truth.size(), es),
                                                 args.region_threshold);
       level.set("symmetric_mean_geodesic_error", es.mean).set("mirrored_error_share", share);
       mirrored = fmt::format("; {:.0f} % of it mirrored", 100 * share);
@@ -282,27 +291,11 @@ int run_eval(const EvalArgs& args) {
   if (point_flips && fs::exists(back_path))
     back_flips = count_orientation_flips(ym, xm, read_points(back_path, xm, ym, "y.ply"));
 
-  std::vector<char> mapped(x_input, 0);
-  for (int v = 0; v < x_input; ++v) mapped[v] = phi[v] >= 0;
-  const std::vector<double> per_pair = pair_errors(truth, mapped, errors);
-  const std::vector<double> per_pair_sym =
-      symmetric ? pair_errors(symmetric_truth, mapped, *symmetric)
-                : std::vector<double>{};
-  if (!args.errors_csv.empty()) write_file_atomic(args.errors_csv, errors_table(truth, phi, per_pair, per_pair_sym));
-  // Where the error lies, on X's input mesh (optional: eval needs only Y otherwise).
+  const std::vector<double> per_pair = pair_errors(truth.size(), errors);
+  const std::vector<double> per_pair_sym = symmetric ? pair_errors(truth.size(), *symmetric) : std::vector<double>{};
+  // Where the error lies, on X's input mesh.
   std::optional<std::vector<ErrorRegion>> regions;
-  if (x_found) {
-    const Mesh x_full = load_mesh(x_file, as_input);
-    if (x_full.num_vertices() != x_input)
-      throw InvalidInputError(fmt::format("{}: {} vertices, but X had {} when it was matched", x_file,
-                                          x_full.num_vertices(), x_input));
-    regions = error_regions(x_full, truth, per_pair, per_pair_sym, args.region_threshold);
-    if (!args.errors_ply.empty())
-      save_mesh(x_full, args.errors_ply, error_colors(x_input, truth, per_pair, *regions, 0.25));
-  } else {
-    spdlog::warn("{}: cannot open (X of {}; --x-mesh): no error regions", x_file.empty() ? "X" : x_file,
-                 report_path.string());
-  }
+  if (x_full) regions = error_regions(*x_full, truth, per_pair, per_pair_sym, args.region_threshold);
 
   std::string csv = "threshold,fraction\n";
   Json pck = Json::array();
@@ -377,6 +370,10 @@ int run_eval(const EvalArgs& args) {
         .set("best_mean_geodesic_error", std::min(errors.mean, symmetric->mean))
         .set("mirrored_error_share", mirrored_error_share(per_pair, per_pair_sym, args.region_threshold));
   }
+  // The files asked for, last: nothing written by an evaluation that failed.
+  if (!args.errors_csv.empty()) write_file_atomic(args.errors_csv, errors_table(truth, phi, per_pair, per_pair_sym));
+  if (!args.errors_ply.empty())
+    save_mesh(*x_full, args.errors_ply, error_colors(*x_full, truth, per_pair, *regions, 0.25));
   std::cout << out.dump() << "\n";
   spdlog::info("mean geodesic error {:.4f} (median {:.4f}) over {} points, AUC {:.3f}; {} of {} faces flipped, {} "
                "degenerate",
@@ -433,7 +430,12 @@ Action add_eval_command(CLI::App& app) {
                  "matched to their mirror image (with --gt-y-sym); grey: no ground truth");
   app.add_option("--region-threshold", a->region_threshold,
                  "error_regions: connected parts of X whose points are mapped more than this off (in √area(Y))")
-      ->check(CLI::PositiveNumber)
+      ->check(CLI::Validator(
+          [](std::string& text) {
+            const double t = std::strtod(text.c_str(), nullptr);
+            return std::isfinite(t) && t > 0 ? std::string() : std::string("must be a positive number");
+          },
+          "POSITIVE"))
       ->capture_default_str();
   app.add_option("--threads", a->threads, "geodesic solves in parallel (0: all cores)")->capture_default_str();
   return [a] { return run_eval(*a); };

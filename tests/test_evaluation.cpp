@@ -205,71 +205,62 @@ TEST_CASE("evaluation: errors agree with direct geodesic distances, marched from
   CHECK(e.points == 2);
   CHECK(e.errors[0] == 0.0);
   CHECK(e.errors[1] > 0.0);
+  CHECK(e.pair == std::vector<size_t>{4, 7});  // (each error's ground-truth pair)
   CHECK_THROWS_AS(geodesic_errors(y, std::vector<int>(n, -1), identity), InvalidInputError);
   CHECK_THROWS_AS(geodesic_errors(y, std::vector<int>(n, n), identity), InvalidInputError);
   CHECK_THROWS_AS(geodesic_errors(y, std::vector<int>(n - 1, 0), identity), InvalidInputError);
 }
 
 TEST_CASE("evaluation: error regions are connected parts above the threshold, mirrored where the symmetric truth fits") {
-  const Mesh x = shapes::torus(12, 8);
-  const int n = x.num_vertices();
-  std::vector<std::vector<int>> nb(n);
-  for (const auto& f : x.faces)
-    for (int i = 0; i < 3; ++i) nb[f[i]].push_back(f[(i + 1) % 3]), nb[f[(i + 1) % 3]].push_back(f[i]);
-  auto adjacent = [&](int a, int b) { return std::find(nb[a].begin(), nb[a].end(), b) != nb[a].end(); };
-  // u's neighbours a and b, not adjacent to each other: connected through u alone.
-  const int u = 0, a = nb[u][0];
-  int b = -1;
-  for (int w : nb[u])
-    if (w != a && !adjacent(a, w)) b = w;
-  REQUIRE(b >= 0);
-  // c: far from all three, with two pairs.
-  int c = -1;
-  for (int v = 0; v < n && c < 0; ++v)
-    if (v != u && v != a && v != b && !adjacent(v, u) && !adjacent(v, a) && !adjacent(v, b)) {
-      bool near = false;
-      for (int w : nb[v]) near = near || adjacent(w, u) || adjacent(w, a) || adjacent(w, b) || w == u;
-      if (!near) c = v;
-    }
-  REQUIRE(c >= 0);
+  // A torus of 24 rings of 6 vertices (vertex 6i + j on ring i), ground truth on the even rings
+  // only, as after decimation. Rings 2 and 4 mapped 0.5 off but near their mirror image, rings 14
+  // and 16 0.3 off and not, the other even rings 0.01 off.
+  const Mesh x = shapes::torus(24, 6);
   GroundTruth truth;
   std::vector<double> err, sym;
-  for (int v = 0; v < n; ++v) {
-    if (v == u) continue;  // no ground truth: a bridge
-    truth.push_back({v, v});
-    const double e = v == a || v == b ? 0.2 : v == c ? 1.2 : 0.0;
-    err.push_back(e);
-    sym.push_back(v == c ? 0.1 : v == a || v == b ? 0.3 : 0.5);
-  }
-  truth.push_back({c, c});  // c's second pair: its vertex's mean is 0.9
-  err.push_back(0.6);
-  sym.push_back(0.1);
-  truth.push_back({a, a});  // a pair left out of the evaluation changes nothing
+  for (int i = 0; i < 24; i += 2)
+    for (int j = 0; j < 6; ++j) {
+      truth.push_back({6 * i + j, 6 * i + j});
+      err.push_back(i == 2 || i == 4 ? 0.5 : i == 14 || i == 16 ? 0.3 : 0.01);
+      sym.push_back(i == 2 || i == 4 ? 0.05 : 0.4);
+    }
+  truth.push_back({12, 12});  // a second pair on vertex 12 (ring 2)
+  err.push_back(0.5);
+  sym.push_back(0.05);
+  truth.push_back({7, 7});  // a pair left out (ring 1: no image) changes nothing
   err.push_back(std::numeric_limits<double>::quiet_NaN());
   sym.push_back(std::numeric_limits<double>::quiet_NaN());
+  const double total = 13 * 0.5 + 12 * 0.3 + 8 * 6 * 0.01;
 
   std::vector<ErrorRegion> r = error_regions(x, truth, err, sym, 0.1);
+  // Ring 3 (no ground truth) takes its neighbours' verdict and joins rings 2 and 4; rings 5–13
+  // (below, or borrowing from below) keep the two parts apart.
   REQUIRE(r.size() == 2);
-  CHECK(r[0].x_vertices == std::vector<int>{c});
-  CHECK(r[0].points == 2);
-  CHECK(r[0].mean_error == doctest::Approx(0.9));
-  CHECK(r[0].mean_symmetric_error == doctest::Approx(0.1));
+  std::vector<int> a, b;
+  for (int j = 0; j < 6; ++j) a.push_back(12 + j), b.push_back(84 + j);
+  for (int j = 0; j < 6; ++j) a.push_back(24 + j), b.push_back(96 + j);
+  CHECK(r[0].x_vertices == a);
+  CHECK(r[0].vertices == 12);
+  CHECK(r[0].points == 13);
+  CHECK(r[0].mean_error == doctest::Approx(0.5));
+  CHECK(r[0].mean_symmetric_error == doctest::Approx(0.05));
   CHECK(r[0].mirrored);
-  CHECK(r[0].error_share == doctest::Approx(1.8 / 2.2));
-  CHECK(r[1].vertices == 2);
-  CHECK(r[1].x_vertices == std::vector<int>{std::min(a, b), std::max(a, b)});
-  CHECK(r[1].points == 2);
-  CHECK(r[1].mean_error == doctest::Approx(0.2));
+  CHECK(r[0].error_share == doctest::Approx(13 * 0.5 / total));
+  CHECK(r[1].x_vertices == b);
+  CHECK(r[1].points == 12);
+  CHECK(r[1].mean_error == doctest::Approx(0.3));
   CHECK_FALSE(r[1].mirrored);
-  CHECK(r[1].error_share == doctest::Approx(0.4 / 2.2));
-  // With u's ground truth below the threshold, a and b are apart.
-  truth.push_back({u, u});
-  err.push_back(0.05);
-  sym.push_back(0.05);
+  CHECK(r[1].error_share == doctest::Approx(12 * 0.3 / total));
+  // Ring 15's vertices 0.05 off: rated below, they split the second part in two.
+  for (int j = 0; j < 6; ++j) {
+    truth.push_back({90 + j, 90 + j});
+    err.push_back(0.05);
+    sym.push_back(0.05);
+  }
   r = error_regions(x, truth, err, sym, 0.1);
   REQUIRE(r.size() == 3);
-  CHECK(r[1].vertices == 1);
-  CHECK(r[2].vertices == 1);
+  CHECK(r[1].vertices == 6);
+  CHECK(r[2].vertices == 6);
   // A threshold above every vertex's mean: none; without the symmetric truth: never mirrored.
   CHECK(error_regions(x, truth, err, sym, 1.0).empty());
   r = error_regions(x, truth, err, {}, 0.1);
@@ -277,6 +268,15 @@ TEST_CASE("evaluation: error regions are connected parts above the threshold, mi
   CHECK_FALSE(r[0].mirrored);
   CHECK(r[0].mean_symmetric_error == -1);
   CHECK_THROWS_AS(error_regions(x, truth, std::vector<double>(3, 0.0), {}, 0.1), InvalidInputError);
+  std::vector<double> other = sym;  // NaN where the direct errors have none: not the same pairs
+  other[0] = std::numeric_limits<double>::quiet_NaN();
+  CHECK_THROWS_AS(error_regions(x, truth, err, other, 0.1), InvalidInputError);
+
+  // Per vertex: the mean of its pairs, NaN without any.
+  const std::vector<double> mean = vertex_mean_errors(x.num_vertices(), truth, err);
+  CHECK(mean[12] == doctest::Approx(0.5));
+  CHECK(std::isnan(mean[7]));
+  CHECK(std::isnan(mean[18]));  // (ring 3)
 
   // Pair by pair: the pairs above the threshold whose symmetric error is under half theirs.
   CHECK(mirrored_error_share({0.4, 0.2, 0.05, std::nan("")}, {0.1, 0.15, 0.0, 0.0}, 0.1) == doctest::Approx(0.4 / 0.65));
@@ -286,14 +286,15 @@ TEST_CASE("evaluation: error regions are connected parts above the threshold, mi
   // pair_errors spreads a GeodesicErrors over the pairs, NaN where X's vertex has no image.
   GeodesicErrors ge;
   ge.errors = {0.25, 0.5};
-  const GroundTruth t3 = {{0, 0}, {1, 1}, {2, 2}};
-  const std::vector<double> spread = pair_errors(t3, {1, 0, 1}, ge);
+  ge.pair = {0, 2};
+  const std::vector<double> spread = pair_errors(3, ge);
   REQUIRE(spread.size() == 3);
   CHECK(spread[0] == 0.25);
   CHECK(std::isnan(spread[1]));
   CHECK(spread[2] == 0.5);
-  CHECK_THROWS_AS(pair_errors(t3, {1, 1, 1}, ge), InvalidInputError);
-  CHECK_THROWS_AS(pair_errors(t3, {1, 0, 0}, ge), InvalidInputError);
+  CHECK_THROWS_AS(pair_errors(2, ge), InvalidInputError);
+  ge.pair = {0};
+  CHECK_THROWS_AS(pair_errors(3, ge), InvalidInputError);
 }
 
 TEST_CASE("evaluation: PCK curve and its area") {
@@ -657,6 +658,60 @@ TEST_CASE("evaluation: shapematch eval on a real match output of a shared-connec
   CHECK(json_number(r.out, "mean_geodesic_error") == 0.0);
   CHECK(json_number(r.out, "orientation_flips") == 0);
   CHECK(json_number(r.out, "degenerate_faces") == 0);
+
+  // Decimated to 40 faces: the X vertices removed have no image, an empty error in the table and
+  // grey in the coloured mesh; the rest are rated.
+  const fs::path small = dir / "small";
+  r = run_cli("match " + (dir / "a.off").string() + " " + (dir / "b.off").string() +
+                  " --faces 40 --backend cpu --membrane svk -o " + small.string(),
+              dir);
+  REQUIRE_MESSAGE(r.code == 0, r.err);
+  r = run_cli("eval " + small.string() + " --errors-csv " + (dir / "e.csv").string() + " --errors-ply " +
+                  (dir / "e.ply").string(),
+              dir);
+  REQUIRE_MESSAGE(r.code == 0, r.err);
+  const int kept = static_cast<int>(json_number(r.out, "points"));
+  CHECK(kept < 32);
+  int empty = 0, rows = 0;
+  {
+    std::ifstream in(dir / "e.csv");
+    std::string line;
+    std::getline(in, line);
+    CHECK(line == "x,y_true,y_mapped,error");
+    while (std::getline(in, line)) {
+      ++rows;
+      empty += line.back() == ',';
+    }
+  }
+  CHECK(rows == 32);
+  CHECK(empty == 32 - kept);
+  int grey = 0;
+  {
+    std::ifstream in(dir / "e.ply");
+    std::string line;
+    while (std::getline(in, line) && line != "end_header") {}
+    for (int v = 0; v < 32 && std::getline(in, line); ++v) grey += line.ends_with(" 160 160 160");
+  }
+  CHECK(grey == 32 - kept);
+
+  // X's mesh is checked before any work, and a failed evaluation writes nothing: another X, a
+  // missing one named, a coloured mesh not named .ply.
+  fs::remove(dir / "e.csv");
+  save_mesh(shapes::bent_finger(10, 8, 5), (dir / "other.off").string());
+  r = run_cli("eval " + small.string() + " --x-mesh " + (dir / "other.off").string() + " --errors-csv " +
+                  (dir / "e.csv").string(),
+              dir);
+  CHECK(r.code == 1);
+  CHECK(r.err.find("other.off: 42 vertices, but X had 32 when it was matched") != std::string::npos);
+  CHECK_FALSE(fs::exists(dir / "e.csv"));
+  r = run_cli("eval " + small.string() + " --x-mesh " + (dir / "none.off").string(), dir);
+  CHECK(r.code != 0);
+  CHECK(r.err.find("none.off: cannot open") != std::string::npos);
+  r = run_cli("eval " + small.string() + " --errors-ply " + (dir / "e.off").string(), dir);
+  CHECK(r.code == 1);
+  CHECK(r.err.find("name it .ply") != std::string::npos);
+  r = run_cli("eval " + small.string() + " --region-threshold nan", dir);
+  CHECK(r.code != 0);
   fs::remove_all(dir);
 }
 

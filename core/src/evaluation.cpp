@@ -178,51 +178,71 @@ double pck_auc(const std::vector<std::array<double, 2>>& pck) {
   return area / width;
 }
 
-std::vector<double> pair_errors(const GroundTruth& truth, const std::vector<char>& mapped, const GeodesicErrors& errors) {
-  std::vector<double> out(truth.size(), std::numeric_limits<double>::quiet_NaN());
-  size_t k = 0;  // errors holds the evaluated pairs only, in ground-truth order
-  for (size_t i = 0; i < truth.size(); ++i) {
-    const int x = truth[i].x;
-    if (x < 0 || x >= static_cast<int>(mapped.size()) || !mapped[x]) continue;
-    if (k >= errors.errors.size()) throw InvalidInputError("pair_errors: fewer errors than mapped pairs");
-    out[i] = errors.errors[k++];
+std::vector<double> pair_errors(size_t pairs, const GeodesicErrors& errors) {
+  if (errors.pair.size() != errors.errors.size()) throw InvalidInputError("pair_errors: errors without their pairs");
+  std::vector<double> out(pairs, std::numeric_limits<double>::quiet_NaN());
+  for (size_t k = 0; k < errors.errors.size(); ++k) {
+    if (errors.pair[k] >= pairs) throw InvalidInputError("pair_errors: a pair past the ground truth");
+    out[errors.pair[k]] = errors.errors[k];
   }
-  if (k != errors.errors.size()) throw InvalidInputError("pair_errors: more errors than mapped pairs");
   return out;
+}
+
+std::vector<double> vertex_mean_errors(int vertices, const GroundTruth& truth, const std::vector<double>& errors) {
+  if (errors.size() != truth.size()) throw InvalidInputError("vertex errors: one error per ground-truth pair expected");
+  std::vector<double> sum(vertices, 0.0);
+  std::vector<int> count(vertices, 0);
+  for (size_t k = 0; k < truth.size(); ++k) {
+    if (std::isnan(errors[k])) continue;
+    const int v = truth[k].x;
+    if (v < 0 || v >= vertices) throw InvalidInputError("vertex errors: a ground-truth vertex X lacks");
+    sum[v] += errors[k];
+    ++count[v];
+  }
+  for (int v = 0; v < vertices; ++v) sum[v] = count[v] > 0 ? sum[v] / count[v] : std::numeric_limits<double>::quiet_NaN();
+  return sum;
 }
 
 std::vector<ErrorRegion> error_regions(const Mesh& x, const GroundTruth& truth, const std::vector<double>& errors,
                                        const std::vector<double>& symmetric, double threshold) {
-  if (errors.size() != truth.size() || (!symmetric.empty() && symmetric.size() != truth.size()))
-    throw InvalidInputError("error_regions: one error per ground-truth pair expected");
-  const int n = x.num_vertices();
-  // Per X vertex: its pairs' error sum and count (a vertex may be in several pairs).
-  std::vector<double> sum(n, 0), sym_sum(n, 0);
-  std::vector<int> count(n, 0);
-  double total = 0;
-  for (size_t k = 0; k < truth.size(); ++k) {
-    if (std::isnan(errors[k])) continue;
-    const int v = truth[k].x;
-    if (v < 0 || v >= n) throw InvalidInputError("error_regions: a ground-truth vertex X lacks");
-    sum[v] += errors[k];
-    if (!symmetric.empty()) sym_sum[v] += symmetric[k];
-    ++count[v];
-    total += errors[k];
+  if (!symmetric.empty()) {
+    if (symmetric.size() != errors.size()) throw InvalidInputError("error_regions: one symmetric error per pair expected");
+    for (size_t k = 0; k < errors.size(); ++k)
+      if (std::isnan(errors[k]) != std::isnan(symmetric[k]))
+        throw InvalidInputError("error_regions: the symmetric errors leave out other pairs than the direct ones");
   }
-  // 1: above the threshold, 0: below, -1: no ground truth (a bridge, not counted).
-  std::vector<int> state(n, -1);
-  for (int v = 0; v < n; ++v)
-    if (count[v] > 0) state[v] = sum[v] / count[v] > threshold ? 1 : 0;
+  const int n = x.num_vertices();
+  const std::vector<double> mean = vertex_mean_errors(n, truth, errors);
   std::vector<std::vector<int>> neighbours(n);
   for (const auto& f : x.faces)
     for (int i = 0; i < 3; ++i) {
       neighbours[f[i]].push_back(f[(i + 1) % 3]);
       neighbours[f[(i + 1) % 3]].push_back(f[i]);
     }
+  // Above the threshold or not, for every vertex: a vertex's own verdict, else the nearest rated
+  // vertex's (breadth first from all rated vertices at once, in vertex order).
+  std::vector<int> above(n, -1);
+  std::vector<int> queue;
+  for (int v = 0; v < n; ++v)
+    if (!std::isnan(mean[v])) above[v] = mean[v] > threshold, queue.push_back(v);
+  for (size_t head = 0; head < queue.size(); ++head)
+    for (int w : neighbours[queue[head]])
+      if (above[w] < 0) above[w] = above[queue[head]], queue.push_back(w);
+  // Each pair's error on its vertex, for the regions' sums.
+  std::vector<double> err_sum(n, 0.0), sym_sum(n, 0.0);
+  std::vector<int> points(n, 0);
+  double total = 0;
+  for (size_t k = 0; k < truth.size(); ++k) {
+    if (std::isnan(errors[k])) continue;
+    err_sum[truth[k].x] += errors[k];
+    if (!symmetric.empty()) sym_sum[truth[k].x] += symmetric[k];
+    ++points[truth[k].x];
+    total += errors[k];
+  }
   std::vector<char> seen(n, 0);
   std::vector<ErrorRegion> regions;
   for (int s = 0; s < n; ++s) {
-    if (state[s] != 1 || seen[s]) continue;
+    if (above[s] != 1 || seen[s]) continue;
     ErrorRegion r;
     double err = 0, sym = 0;
     std::vector<int> stack{s};
@@ -230,15 +250,16 @@ std::vector<ErrorRegion> error_regions(const Mesh& x, const GroundTruth& truth, 
     while (!stack.empty()) {
       const int v = stack.back();
       stack.pop_back();
-      if (state[v] == 1) {
+      if (points[v] > 0) {
         r.x_vertices.push_back(v);
-        r.points += count[v];
-        err += sum[v];
+        r.points += points[v];
+        err += err_sum[v];
         sym += sym_sum[v];
       }
       for (int w : neighbours[v])
-        if (!seen[w] && state[w] != 0) seen[w] = 1, stack.push_back(w);
+        if (!seen[w] && above[w] == 1) seen[w] = 1, stack.push_back(w);
     }
+    if (r.points == 0) continue;  // (none of its own: a component that has only borrowed verdicts cannot be)
     std::sort(r.x_vertices.begin(), r.x_vertices.end());
     r.vertices = static_cast<int>(r.x_vertices.size());
     r.error_share = total > 0 ? err / total : 0;
@@ -249,8 +270,8 @@ std::vector<ErrorRegion> error_regions(const Mesh& x, const GroundTruth& truth, 
     }
     regions.push_back(std::move(r));
   }
-  std::sort(regions.begin(), regions.end(),
-            [](const ErrorRegion& a, const ErrorRegion& b) { return a.error_share > b.error_share; });
+  std::stable_sort(regions.begin(), regions.end(),
+                   [](const ErrorRegion& a, const ErrorRegion& b) { return a.error_share > b.error_share; });
   return regions;
 }
 
@@ -307,6 +328,7 @@ GeodesicErrors geodesic_errors(const Mesh& y, const std::vector<MappedPoint>& ph
     }
     if (q.n == 0) throw InvalidInputError("evaluation: X vertex " + std::to_string(p.x) + " maps to a point without weights");
     r.errors.push_back(0.0);
+    r.pair.push_back(static_cast<size_t>(&p - truth.data()));
     if (q.n == 1 && q.targets[0] == p.y) continue;  // exactly zero: no solve needed
     all_vertices = all_vertices && q.n == 1;
     for (int i = 0; i < q.n; ++i)

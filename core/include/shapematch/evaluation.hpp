@@ -52,6 +52,7 @@ struct EvaluationOptions {
 
 struct GeodesicErrors {
   std::vector<double> errors;  // d_Y(φ(x_k), y_k) / √area(Y) per evaluated pair, in ground-truth order
+  std::vector<size_t> pair;    // the ground-truth pair of each error (its index in the truth)
   int points = 0;              // ground-truth pairs whose x has an image under φ
   double mean = 0, median = 0;
   std::vector<std::array<double, 2>> pck;  // (threshold t, fraction of points with error ≤ t)
@@ -80,16 +81,20 @@ struct MappedPoint {
 GeodesicErrors geodesic_errors(const Mesh& y, const std::vector<MappedPoint>& phi, const GroundTruth& truth,
                                const EvaluationOptions& options = {});
 
-// Each ground-truth pair's error, NaN where φ says nothing (`mapped[x]` false for its X vertex):
-// GeodesicErrors::errors spread back over the pairs.
-std::vector<double> pair_errors(const GroundTruth& truth, const std::vector<char>& mapped, const GeodesicErrors& errors);
+// One error per ground-truth pair (`pairs` of them), NaN for a pair left out (its X vertex without
+// an image): GeodesicErrors::errors spread back over the pairs.
+std::vector<double> pair_errors(size_t pairs, const GeodesicErrors& errors);
+
+// Per vertex of X (`vertices` of them): the mean of its pairs' errors (one per pair of `truth`,
+// NaN skipped), NaN for a vertex without any.
+std::vector<double> vertex_mean_errors(int vertices, const GroundTruth& truth, const std::vector<double>& errors);
 
 // A connected part of X whose ground-truth points are mapped more than a threshold off: where a
 // match went wrong. With a symmetric ground truth, a part whose error against it is under half the
 // direct one was matched to its mirror image (a left leg to the right one: the energy and
 // intrinsic features cannot tell them apart, and one such part can hold most of a pair's error).
 struct ErrorRegion {
-  int vertices = 0;          // X vertices with ground truth in it
+  int vertices = 0;          // X vertices with an error in it
   int points = 0;            // ground-truth pairs
   double error_share = 0;    // its pairs' errors over all pairs' errors
   double mean_error = 0;
@@ -98,9 +103,11 @@ struct ErrorRegion {
   std::vector<int> x_vertices;  // sorted
 };
 
-// The regions of X (connected over its edges, through vertices without ground truth too) whose
-// vertices' mean pair error exceeds `threshold`, largest share of the error first. `errors` and
-// `symmetric` (empty: none) hold one error per pair of `truth` (pair_errors), NaN for pairs left out.
+// The regions of X whose vertices' mean pair error exceeds `threshold`, largest share of the error
+// first. A vertex without an error (no ground truth, or removed by decimation) takes the verdict of
+// the nearest one with an error (in edges; ties to the lower vertex), so regions connect across
+// gaps in the ground truth without joining through them. `errors` and `symmetric` (empty: none)
+// hold one error per pair of `truth` (pair_errors), NaN in the same places.
 std::vector<ErrorRegion> error_regions(const Mesh& x, const GroundTruth& truth, const std::vector<double>& errors,
                                        const std::vector<double>& symmetric, double threshold);
 
