@@ -12,6 +12,7 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <cctype>
 #include <array>
 #include <cmath>
 #include <cstdint>
@@ -189,23 +190,29 @@ int run_eval(const EvalArgs& args) {
     const JsonNode* xf = xs ? xs->get("file") : nullptr;
     if (xf && xf->kind == JsonNode::Kind::String) x_file = xf->text;
   }
-  const bool x_found = !x_file.empty() && fs::exists(x_file);
-  if (!x_found && (!args.x_mesh.empty() || !args.errors_ply.empty()))
-    throw IoError((x_file.empty() ? std::string("X") : x_file) + ": cannot open (X of " + report_path.string() +
-                  (args.x_mesh.empty() ? ", needed by --errors-ply; give --x-mesh)" : ")"));
-  if (!args.errors_ply.empty() && fs::path(args.errors_ply).extension() != ".ply")
-    throw InvalidInputError(args.errors_ply + ": --errors-ply writes PLY (vertex colours): name it .ply");
+  // Needed where asked for (--x-mesh, --errors-ply): then a one-line error; else a warning, so that
+  // an evaluation that never needed X does not fail for it (bench match evaluates every pair).
+  const bool x_needed = !args.x_mesh.empty() || !args.errors_ply.empty();
+  if (!args.errors_ply.empty()) {
+    std::string ext = fs::path(args.errors_ply).extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char ch) { return std::tolower(ch); });
+    if (ext != ".ply") throw InvalidInputError(args.errors_ply + ": --errors-ply writes PLY (vertex colours): name it .ply");
+  }
   std::optional<Mesh> x_full;
-  if (x_found) {
+  try {
+    if (x_file.empty() || !fs::exists(x_file))
+      throw IoError((x_file.empty() ? std::string("X") : x_file) + ": cannot open (X of " + report_path.string() +
+                    (args.x_mesh.empty() ? "; give --x-mesh)" : ")"));
     LoadOptions x_as_input = as_input;
     x_as_input.normalize_area = false;
-    x_full = load_mesh(x_file, x_as_input);
-    if (x_full->num_vertices() != x_input)
-      throw InvalidInputError(fmt::format("{}: {} vertices, but X had {} when it was matched", x_file,
-                                          x_full->num_vertices(), x_input));
-  } else {
-    spdlog::warn("{}: cannot open (X of {}; --x-mesh): no error regions", x_file.empty() ? "X" : x_file,
-                 report_path.string());
+    Mesh x = load_mesh(x_file, x_as_input);
+    if (x.num_vertices() != x_input)
+      throw InvalidInputError(fmt::format("{}: {} vertices, but X had {} when it was matched", x_file, x.num_vertices(),
+                                          x_input));
+    x_full = std::move(x);
+  } catch (const Error& e) {
+    if (x_needed) throw;
+    spdlog::warn("{}: no error regions", e.what());
   }
 
   GroundTruth truth;
@@ -303,18 +310,6 @@ int run_eval(const EvalArgs& args) {
     pck.push(Json(Json::Array{Json(t), Json(fraction)}));
     csv += fmt::format("{},{}\n", t, fraction);
   }
-  if (!args.pck_csv.empty()) write_file_atomic(args.pck_csv, csv);
-  if (!args.pck_png.empty()) {
-    // The plot reads a CSV: the one asked for, or a temporary one.
-    std::string csv_path = args.pck_csv;
-    if (csv_path.empty()) {
-      csv_path = (fs::temp_directory_path() / ("shapematch-pck-" + std::to_string(std::random_device{}()) + ".csv"))
-                     .string();
-      write_file_atomic(csv_path, csv);
-    }
-    plot(csv_path, args.pck_png, fs::path(args.dir).lexically_normal().filename().string());
-    if (args.pck_csv.empty()) fs::remove(csv_path);
-  }
 
   Json out = Json::object();
   out.set("dir", args.dir)
@@ -370,10 +365,23 @@ int run_eval(const EvalArgs& args) {
         .set("best_mean_geodesic_error", std::min(errors.mean, symmetric->mean))
         .set("mirrored_error_share", mirrored_error_share(per_pair, per_pair_sym, args.region_threshold));
   }
-  // The files asked for, last: nothing written by an evaluation that failed.
-  if (!args.errors_csv.empty()) write_file_atomic(args.errors_csv, errors_table(truth, phi, per_pair, per_pair_sym));
+  // The files asked for, last (the one most likely to fail first): nothing written by an
+  // evaluation that failed.
   if (!args.errors_ply.empty())
     save_mesh(*x_full, args.errors_ply, error_colors(*x_full, truth, per_pair, *regions, 0.25));
+  if (!args.errors_csv.empty()) write_file_atomic(args.errors_csv, errors_table(truth, phi, per_pair, per_pair_sym));
+  if (!args.pck_csv.empty()) write_file_atomic(args.pck_csv, csv);
+  if (!args.pck_png.empty()) {
+    // The plot reads a CSV: the one asked for, or a temporary one.
+    std::string csv_path = args.pck_csv;
+    if (csv_path.empty()) {
+      csv_path = (fs::temp_directory_path() / ("shapematch-pck-" + std::to_string(std::random_device{}()) + ".csv"))
+                     .string();
+      write_file_atomic(csv_path, csv);
+    }
+    plot(csv_path, args.pck_png, fs::path(args.dir).lexically_normal().filename().string());
+    if (args.pck_csv.empty()) fs::remove(csv_path);
+  }
   std::cout << out.dump() << "\n";
   spdlog::info("mean geodesic error {:.4f} (median {:.4f}) over {} points, AUC {:.3f}; {} of {} faces flipped, {} "
                "degenerate",

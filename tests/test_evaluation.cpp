@@ -233,8 +233,9 @@ TEST_CASE("evaluation: error regions are connected parts above the threshold, mi
   const double total = 13 * 0.5 + 12 * 0.3 + 8 * 6 * 0.01;
 
   std::vector<ErrorRegion> r = error_regions(x, truth, err, sym, 0.1);
-  // Ring 3 (no ground truth) takes its neighbours' verdict and joins rings 2 and 4; rings 5–13
-  // (below, or borrowing from below) keep the two parts apart.
+  // Ring 3 (no ground truth) takes its neighbours' verdict and joins rings 2 and 4; the rated rings
+  // 6–12, below, keep the two parts apart (rings 5 and 13 borrow from 4 and 12, the lower-numbered
+  // of their rated neighbours, but hold no points of their own).
   REQUIRE(r.size() == 2);
   std::vector<int> a, b;
   for (int j = 0; j < 6; ++j) a.push_back(12 + j), b.push_back(84 + j);
@@ -271,6 +272,20 @@ TEST_CASE("evaluation: error regions are connected parts above the threshold, mi
   std::vector<double> other = sym;  // NaN where the direct errors have none: not the same pairs
   other[0] = std::numeric_limits<double>::quiet_NaN();
   CHECK_THROWS_AS(error_regions(x, truth, err, other, 0.1), InvalidInputError);
+
+  // A vertex without an error next to several rated ones takes the lowest-numbered one's verdict,
+  // and that decides whether two parts join through it. Octahedron: vertex 0 unrated, its
+  // neighbours 2, 3, 4, 5; 2 and 3 (opposite, apart) join through it where 2 is above the
+  // threshold, 4 and 5 do not where 2 is below.
+  const Mesh o = shapes::octahedron();
+  const GroundTruth six = {{1, 1}, {2, 2}, {3, 3}, {4, 4}, {5, 5}};
+  r = error_regions(o, six, {0.0, 0.5, 0.5, 0.0, 0.0}, {}, 0.1);
+  REQUIRE(r.size() == 1);
+  CHECK(r[0].x_vertices == std::vector<int>{2, 3});
+  r = error_regions(o, six, {0.0, 0.0, 0.0, 0.5, 0.5}, {}, 0.1);
+  REQUIRE(r.size() == 2);
+  CHECK(r[0].vertices == 1);
+  CHECK(r[1].vertices == 1);
 
   // Per vertex: the mean of its pairs, NaN without any.
   const std::vector<double> mean = vertex_mean_errors(x.num_vertices(), truth, err);
@@ -704,12 +719,23 @@ TEST_CASE("evaluation: shapematch eval on a real match output of a shared-connec
   CHECK(r.code == 1);
   CHECK(r.err.find("other.off: 42 vertices, but X had 32 when it was matched") != std::string::npos);
   CHECK_FALSE(fs::exists(dir / "e.csv"));
+  // Not asked for, X is optional: report.json's X replaced by another mesh, eval warns and goes on.
+  fs::copy_file(dir / "a.off", dir / "a_saved.off");
+  fs::copy_file(dir / "other.off", dir / "a.off", fs::copy_options::overwrite_existing);
+  r = run_cli("eval " + small.string(), dir);
+  CHECK_MESSAGE(r.code == 0, r.err);
+  CHECK(r.err.find("no error regions") != std::string::npos);
+  CHECK(r.out.find("error_regions") == std::string::npos);
+  fs::copy_file(dir / "a_saved.off", dir / "a.off", fs::copy_options::overwrite_existing);
   r = run_cli("eval " + small.string() + " --x-mesh " + (dir / "none.off").string(), dir);
   CHECK(r.code != 0);
   CHECK(r.err.find("none.off: cannot open") != std::string::npos);
   r = run_cli("eval " + small.string() + " --errors-ply " + (dir / "e.off").string(), dir);
   CHECK(r.code == 1);
   CHECK(r.err.find("name it .ply") != std::string::npos);
+  r = run_cli("eval " + small.string() + " --errors-ply " + (dir / "E.PLY").string(), dir);  // (any case)
+  CHECK_MESSAGE(r.code == 0, r.err);
+  CHECK(fs::exists(dir / "E.PLY"));
   r = run_cli("eval " + small.string() + " --region-threshold nan", dir);
   CHECK(r.code != 0);
   fs::remove_all(dir);
