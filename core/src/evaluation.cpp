@@ -205,6 +205,7 @@ std::vector<double> vertex_mean_errors(int vertices, const GroundTruth& truth, c
 
 std::vector<ErrorRegion> error_regions(const Mesh& x, const GroundTruth& truth, const std::vector<double>& errors,
                                        const std::vector<double>& symmetric, double threshold) {
+  if (errors.size() != truth.size()) throw InvalidInputError("error_regions: one error per ground-truth pair expected");
   if (!symmetric.empty()) {
     if (symmetric.size() != errors.size()) throw InvalidInputError("error_regions: one symmetric error per pair expected");
     for (size_t k = 0; k < errors.size(); ++k)
@@ -212,33 +213,34 @@ std::vector<ErrorRegion> error_regions(const Mesh& x, const GroundTruth& truth, 
         throw InvalidInputError("error_regions: the symmetric errors leave out other pairs than the direct ones");
   }
   const int n = x.num_vertices();
-  const std::vector<double> mean = vertex_mean_errors(n, truth, errors);
+  // Each vertex's pairs: their errors summed (direct and symmetric) and counted.
+  std::vector<double> err_sum(n, 0.0), sym_sum(n, 0.0);
+  std::vector<int> points(n, 0);
+  double total = 0;
+  for (size_t k = 0; k < truth.size(); ++k) {
+    if (std::isnan(errors[k])) continue;
+    const int v = truth[k].x;
+    if (v < 0 || v >= n) throw InvalidInputError("error_regions: a ground-truth vertex X lacks");
+    err_sum[v] += errors[k];
+    if (!symmetric.empty()) sym_sum[v] += symmetric[k];
+    ++points[v];
+    total += errors[k];
+  }
   std::vector<std::vector<int>> neighbours(n);
   for (const auto& f : x.faces)
     for (int i = 0; i < 3; ++i) {
       neighbours[f[i]].push_back(f[(i + 1) % 3]);
       neighbours[f[(i + 1) % 3]].push_back(f[i]);
     }
-  // Above the threshold or not, for every vertex: a vertex's own verdict, else the nearest rated
-  // vertex's (breadth first from all rated vertices at once, in vertex order).
+  // Above the threshold or not, for every vertex: a vertex's own verdict (its pairs' mean), else
+  // the nearest rated vertex's (breadth first from all rated vertices at once, in vertex order).
   std::vector<int> above(n, -1);
   std::vector<int> queue;
   for (int v = 0; v < n; ++v)
-    if (!std::isnan(mean[v])) above[v] = mean[v] > threshold, queue.push_back(v);
+    if (points[v] > 0) above[v] = err_sum[v] / points[v] > threshold, queue.push_back(v);
   for (size_t head = 0; head < queue.size(); ++head)
     for (int w : neighbours[queue[head]])
       if (above[w] < 0) above[w] = above[queue[head]], queue.push_back(w);
-  // Each pair's error on its vertex, for the regions' sums.
-  std::vector<double> err_sum(n, 0.0), sym_sum(n, 0.0);
-  std::vector<int> points(n, 0);
-  double total = 0;
-  for (size_t k = 0; k < truth.size(); ++k) {
-    if (std::isnan(errors[k])) continue;
-    err_sum[truth[k].x] += errors[k];
-    if (!symmetric.empty()) sym_sum[truth[k].x] += symmetric[k];
-    ++points[truth[k].x];
-    total += errors[k];
-  }
   std::vector<char> seen(n, 0);
   std::vector<ErrorRegion> regions;
   for (int s = 0; s < n; ++s) {
@@ -259,7 +261,6 @@ std::vector<ErrorRegion> error_regions(const Mesh& x, const GroundTruth& truth, 
       for (int w : neighbours[v])
         if (!seen[w] && above[w] == 1) seen[w] = 1, stack.push_back(w);
     }
-    if (r.points == 0) continue;  // (none of its own: a component that has only borrowed verdicts cannot be)
     std::sort(r.x_vertices.begin(), r.x_vertices.end());
     r.vertices = static_cast<int>(r.x_vertices.size());
     r.error_share = total > 0 ? err / total : 0;
