@@ -6,6 +6,7 @@
 #include "json_read.hpp"
 #include "shapematch/coarse_to_fine.hpp"
 #include "shapematch/errors.hpp"
+#include "shapematch/files.hpp"
 #include "shapematch/json.hpp"
 #include "shapematch/matching.hpp"
 #include "shapematch/pdhg.hpp"
@@ -576,6 +577,24 @@ std::vector<std::string> match_command(const BenchMatchArgs& args, const std::st
   return cmd;
 }
 
+// The options after `--`, checked once before any run: a typo would otherwise fail every pair in
+// turn, each row "failed" and bench's exit 0. Those the benchmark sets itself are refused.
+void check_match_args(const std::vector<std::string>& args) {
+  for (const std::string& a : args)
+    for (const std::string own : {"-o", "--out", "--faces", "--checkpoint"})
+      if (a == own || a.rfind(own + "=", 0) == 0 || (own == "-o" && a.size() > 2 && a.rfind("-o", 0) == 0))
+        throw InvalidInputError(fmt::format("bench match: {} after `--` is set by the benchmark for each run", own));
+  CLI::App probe;
+  add_match_command(probe);
+  std::vector<std::string> reversed(args.rbegin(), args.rend());  // (CLI11 takes them last first)
+  try {
+    probe.parse(reversed);
+    check_finite_options(probe);
+  } catch (const CLI::ParseError& e) {
+    throw InvalidInputError(fmt::format("bench match: the match options after `--`: {}", e.what()));
+  }
+}
+
 // `match X Y` into `dir` (kept for inspection, its log beside it as dir.match.log). With a
 // `checkpoint` file the run goes on from it where it exists and saves its levels there;
 // `started` is called once the previous run's outputs are gone, before this one starts.
@@ -728,8 +747,7 @@ struct PairSpec {
 // One pair per line, `X Y [identity | A.vts B.vts [B.sym.vts] | map FILE] [# comment]`; relative paths are
 // relative to the file, so that a pairs file can travel with its data set.
 std::vector<PairSpec> read_pairs_file(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw IoError(path + ": cannot open");
+  std::ifstream in = open_for_reading(path);
   const fs::path base = fs::absolute(path).parent_path();
   auto resolve = [&](const std::string& p) {
     const fs::path q(p);
@@ -1157,28 +1175,30 @@ Action add_bench_command(CLI::App& app) {
   lp->add_option("--pair", args->pair, "the two meshes X Y; default: the bundled finger pair")->expected(2);
   lp->add_option("--faces", args->faces, "faces per shape of each size (decimated)")
       ->delimiter(',')
-      ->check(CLI::PositiveNumber)
+      ->check(positive_number())
       ->capture_default_str();
   lp->add_option("--solvers", args->solvers, "solvers to run")
       ->delimiter(',')
       ->check(CLI::IsMember(solver_names()))
       ->capture_default_str();
-  lp->add_option("--tol", args->tolerance, "relative tolerance of the first-order solvers")->capture_default_str();
+  lp->add_option("--tol", args->tolerance, "relative tolerance of the first-order solvers")
+      ->check(positive_number())
+      ->capture_default_str();
   lp->add_option("--clp-time-limit", args->clp_time_limit, "seconds per Clp solve; a solver that hits it is skipped at larger sizes")
-      ->check(CLI::PositiveNumber)
+      ->check(positive_number())
       ->capture_default_str();
   lp->add_option("--pdhg-time-limit", args->pdhg_time_limit, "seconds per PDHG solve (default none)")
-      ->check(CLI::PositiveNumber);
+      ->check(positive_number());
   lp->add_option("--out", args->out, "directory for bench_lp.csv and bench_lp.png")->capture_default_str();
   lp->add_option("--repeat", args->repeat, "runs per solver and size; the fastest is reported")
-      ->check(CLI::PositiveNumber)
+      ->check(positive_number())
       ->capture_default_str();
   lp->add_flag("--bandwidth", args->bandwidth, "also measure the streaming bandwidth and report time per iteration against it");
 
   CLI::App* bandwidth = app.add_subcommand("bandwidth", "measure streaming memory bandwidth (STREAM triad, all threads)");
   auto bw = std::make_shared<BandwidthOptions>();
-  bandwidth->add_option("--threads", bw->threads, "threads (0 = all)")->check(CLI::NonNegativeNumber)->capture_default_str();
-  bandwidth->add_option("--repeats", bw->repeats, "best of this many runs")->check(CLI::PositiveNumber)->capture_default_str();
+  bandwidth->add_option("--threads", bw->threads, "threads (0 = all)")->check(non_negative_number())->capture_default_str();
+  bandwidth->add_option("--repeats", bw->repeats, "best of this many runs")->check(positive_number())->capture_default_str();
 
   CLI::App* match = app.add_subcommand(
       "match", "time whole match runs at growing sizes, or match and evaluate a list of pairs (CSV, Markdown, plot)");
@@ -1202,7 +1222,7 @@ Action add_bench_command(CLI::App& app) {
       ->check(size);
   match->add_option("--out", m->out, "directory for the tables, the plot and runs/")->capture_default_str();
   match->add_option("--time-limit", m->time_limit, "seconds per child run (match, eval); then it is killed")
-      ->check(CLI::PositiveNumber)
+      ->check(positive_number())
       ->capture_default_str();
   match->add_flag("--resume", m->resume,
                   "pairs: reuse each pair's row where this --out already holds a finished run of the same command and "
@@ -1213,14 +1233,17 @@ Action add_bench_command(CLI::App& app) {
   match->add_option("--jobs", m->jobs,
                     "pairs: runs at once (a GPU machine with many cores); each match and eval gets its share of "
                     "the CPUs as --threads")
-      ->check(CLI::PositiveNumber)
+      ->check(positive_number())
       ->needs(match->get_option("--pairs"))
       ->capture_default_str();
   match->add_option("match-args", m->match_args, "after `--`: options for every match run, verbatim");
 
   return [lp, args, match, m, bw] {
     if (lp->parsed()) return run_bench_lp(*args);
-    if (match->parsed()) return m->pairs_file.empty() ? run_bench_scaling(*m) : run_bench_pairs(*m);
+    if (match->parsed()) {
+      check_match_args(m->match_args);
+      return m->pairs_file.empty() ? run_bench_scaling(*m) : run_bench_pairs(*m);
+    }
     const double gbps = measure_bandwidth_gbps(*bw);
     Json out = Json::object();
     out.set("threads", bw->threads > 0 ? bw->threads : worker_threads());

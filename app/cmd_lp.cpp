@@ -83,14 +83,16 @@ Action add_lp_command(CLI::App& app) {
                                       "--dump-first-lps`) instead of the one of meshes X and Y");
   app.add_option("--export-mps", args->mps_path, "write the LP in MPS format");
   app.add_option("--export-lp", args->lp_path, "write the LP in shapematch's binary LP format");
-  app.add_option("--tol", args->params.tolerance, "relative tolerance (first-order solvers)")->capture_default_str();
-  app.add_option("--max-iter", args->params.max_iterations, "iteration limit");
-  app.add_option("--time-limit", args->params.time_limit, "time limit in seconds");
+  app.add_option("--tol", args->params.tolerance, "relative tolerance (first-order solvers)")
+      ->check(positive_number())
+      ->capture_default_str();
+  app.add_option("--max-iter", args->params.max_iterations, "iteration limit")->check(positive_number());
+  app.add_option("--time-limit", args->params.time_limit, "time limit in seconds")->check(positive_number());
   app.add_option("--initial-primal-weight", args->params.initial_primal_weight,
                  "PDHG's primal weight ω to start from (0: the solver's own)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(non_negative_number())
       ->capture_default_str();
-  app.add_option("--threads", args->params.threads, "CPU threads (0: all)")->check(CLI::NonNegativeNumber);
+  app.add_option("--threads", args->params.threads, "CPU threads (0: all)")->check(non_negative_number());
   app.add_option("--primal-weight-smoothing", args->pdhg.primal_weight_smoothing,
                  "PDHG: at a restart log ω moves this fraction of the way to log(Δy/Δx)")
       ->check(CLI::Range(0.0, 1.0))

@@ -15,12 +15,15 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <cerrno>
+#include <csignal>
 #include <filesystem>
 #include <fstream>
 #include <numeric>
 #include <optional>
-#include <random>
 #include <sstream>
+
+#include <unistd.h>
 
 namespace fs = std::filesystem;
 
@@ -172,13 +175,64 @@ std::string lines(const std::vector<int>& values) {
   return s;
 }
 
+// The output directory --out names, absolute. Refused (before any work) unless it does not
+// exist yet, is empty, or is an earlier match's output (it has a report.json): publish replaces
+// it whole, and a mistyped -o must not remove a user's own files.
+fs::path output_directory(const std::string& arg) {
+  if (arg.empty()) throw InvalidInputError("--out: empty path");
+  fs::path out = fs::absolute(arg).lexically_normal();
+  if (!out.has_filename()) out = out.parent_path();  // "dir/" names dir
+  if (out == out.root_path()) throw InvalidInputError(out.string() + ": the root cannot be an output directory");
+  std::error_code ec;
+  const fs::file_status status = fs::status(out, ec);
+  if (!fs::exists(status)) return out;
+  if (!fs::is_directory(status))
+    throw InvalidInputError(out.string() + ": exists and is not a directory (--out names the output directory)");
+  if (!fs::is_empty(out, ec) && !fs::exists(out / "report.json"))
+    throw InvalidInputError(out.string() +
+                            ": exists and is not a match output (no report.json); remove it or name another --out");
+  return out;
+}
+
+// `out`'s temporary siblings (OUT.tmp-PID, OUT.old-PID) whose process has gone: a run stopped
+// while writing (Ctrl-C, killed) cannot clean up after itself, so the next run does. An .old- is
+// the output that run was replacing: it goes back in place where nothing took its place.
+void remove_stale_siblings(const fs::path& out) {
+  std::error_code ec;
+  const std::string name = out.filename().string();
+  std::vector<std::pair<fs::path, bool>> stale;  // (path, an .old-)
+  for (const auto& entry : fs::directory_iterator(out.parent_path(), ec)) {
+    const std::string sibling = entry.path().filename().string();
+    for (const std::string tag : {".tmp-", ".old-"}) {
+      const std::string prefix = name + tag;
+      if (sibling.size() <= prefix.size() || sibling.compare(0, prefix.size(), prefix) != 0) continue;
+      const std::string digits = sibling.substr(prefix.size());
+      if (digits.find_first_not_of("0123456789") != std::string::npos || digits.size() > 9) continue;
+      const pid_t pid = static_cast<pid_t>(std::stol(digits));
+      if (pid > 0 && (::kill(pid, 0) == 0 || errno != ESRCH)) continue;  // alive (or not ours to judge)
+      stale.emplace_back(entry.path(), tag == ".old-");
+    }
+  }
+  for (const auto& [path, old] : stale) {
+    std::error_code done;
+    if (old && !fs::exists(out)) {
+      fs::rename(path, out, done);
+      if (!done) spdlog::info("{}: put back as {}, left by a run that stopped while replacing it", path.string(), out.string());
+    } else {
+      fs::remove_all(path, done);
+      if (!done) spdlog::info("{}: removed, left by a run that stopped while writing", path.string());
+    }
+  }
+}
+
 // Writes everything into a fresh temporary directory next to `out` and renames it into place,
 // so that a failure never leaves a half-written output directory.
 void publish(const fs::path& tmp, const fs::path& out) {
   std::error_code ec;
   fs::path old;
   if (fs::exists(out)) {
-    old = out.string() + ".old-" + std::to_string(std::random_device{}());
+    output_directory(out.string());  // (still one it may replace)
+    old = out.string() + ".old-" + std::to_string(::getpid());
     fs::rename(out, old, ec);
     if (ec) throw IoError(out.string() + ": cannot replace (" + ec.message() + ")");
   }
@@ -197,6 +251,8 @@ int run_match(const MatchArgs& args) {
   Json seconds = Json::object();
   if (truth_given(args) && !args.checkpoint.empty())
     throw InvalidInputError("--truth* and --checkpoint exclude each other (a diagnostic run is not gone on from)");
+  const fs::path out = output_directory(args.out);
+  remove_stale_siblings(out);
   const MeshPair p = load_pair(args.pair);
 
   CoarseToFineOptions co;
@@ -431,9 +487,9 @@ int run_match(const MatchArgs& args) {
                rr.pockets_closed > 0 ? fmt::format(", {} pockets closed", rr.pockets_closed) : std::string());
 
   stage.reset();
-  fs::path out = fs::absolute(args.out).lexically_normal();
-  if (!out.has_filename()) out = out.parent_path();  // "dir/" names dir
-  const fs::path tmp = out.string() + ".tmp-" + std::to_string(std::random_device{}());
+  const fs::path tmp = out.string() + ".tmp-" + std::to_string(::getpid());
+  std::error_code left;
+  fs::remove_all(tmp, left);  // (left by an earlier process that had this pid: the sweep spares ours)
   fs::create_directories(tmp);
   try {
     write_file_atomic((tmp / "map_x_to_y.txt").string(), lines(maps.x_to_y));
@@ -714,7 +770,7 @@ Action add_match_command(CLI::App& app) {
   // Several matches sharing a machine (a pair table's jobs) each start one thread per CPU by
   // default; fewer each spares the scheduler the oversubscription.
   app.add_option("--threads", a->threads, "host threads (0: every CPU this process may use)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(non_negative_number())
       ->capture_default_str();
   app.add_option("--threshold", a->threshold, "fix LP values above this to 1")
       ->check(CLI::Range(0.0, 1.0))
@@ -742,7 +798,7 @@ Action add_match_command(CLI::App& app) {
          "rounding (default 0.7)");
   app.add_option("--alternatives-below", a->alternatives_below,
                  "variables of a level's LP above which it is rounded once (--alt-thresholds)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(non_negative_number())
       ->capture_default_str();
   app.add_flag("--close-pockets", a->close_pockets,
                "replace each pocket (an edge stretched over a whole star, a tear that A x = b admits) by the star collapsed onto one vertex: continuous, but costs energy");
@@ -756,7 +812,7 @@ Action add_match_command(CLI::App& app) {
   app.add_option("--untangle-max-shift", a->untangle_max_shift,
                  "the most one untangled disc may move the point map's points, summed, divided by sqrt(area) of the "
                  "other shape and by the vertex count: about what one disc may add to the mean geodesic error")
-      ->check(CLI::NonNegativeNumber)
+      ->check(non_negative_number())
       ->capture_default_str();
   app.add_option("--fractional-batch", a->fractional_batch,
                  "where no LP value exceeds the threshold, fix the largest of up to this fraction of the open faces "
@@ -772,48 +828,48 @@ Action add_match_command(CLI::App& app) {
   app.add_option("--exact-pivots-per-column", a->exact_pivots_per_column,
                  "stop Clp after this many pivots per column of a later round's part (at least 1 000 columns' worth) "
                  "and give the part to PDHG (0: no cap)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(non_negative_number())
       ->capture_default_str();
   app.add_option("--exact-part-seconds", a->exact_part_seconds,
                  "stop Clp after this many seconds on a later round's part and give it to PDHG, with the parts of "
                  "its size or larger for the rest of that rounding (0: no limit)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(non_negative_number())
       ->capture_default_str();
   app.add_option("--exact-below", a->exact_below,
                  "solve a later round's parts under this many columns by Clp's dual simplex, the others by the "
                  "first-order solver (0: all by it)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(non_negative_number())
       ->capture_default_str();
   app.add_option("--feasibility-first", a->feasibility_first,
                  "before a refined level's first LP, solve it without costs for at most N PDHG iterations: an "
                  "infeasible one is proved there (0: off)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(non_negative_number())
       ->capture_default_str();
   app.add_option("--feasibility-later", a->feasibility_later,
                  "in the later rounds, solve each part PDHG would solve without costs first for at most N "
                  "iterations: an infeasible one is proved there (0: off)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(non_negative_number())
       ->capture_default_str();
   app.add_option("--feasibility-skip-below", a->feasibility_skip_below,
                  "with --feasibility-later, run each part's costed solve first for N iterations: a part optimal "
                  "by then skips its zero-cost solve (0: every part has it first)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(non_negative_number())
       ->capture_default_str();
   app.add_option("--feasibility-skip-residual", a->feasibility_skip_residual,
                  "with --feasibility-skip-below: skip the zero-cost solve only where the costed one ended with its "
                  "relative primal residual at most this (0: any)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(non_negative_number())
       ->capture_default_str();
   app.add_option("--feasibility-skip-row", a->feasibility_skip_row,
                  "with --feasibility-skip-below: skip the zero-cost solve only where the costed one ended with no "
                  "row off by more than this (0: any)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(non_negative_number())
       ->capture_default_str();
   app.add_option("--feasibility-tol", a->feasibility_tol,
                  "the tolerance of the zero-cost solves (--feasibility-first, --feasibility-later, the re-proof of "
                  "a part proved infeasible): a part counts as feasible there only with its relative residual "
                  "under it (0: --tol's)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(non_negative_number())
       ->capture_default_str();
   app.add_option("--release-after-trims", a->release_after_trims,
                  "where a part's LP has failed after this many trims of the last fixing in a row, release the "
@@ -823,7 +879,7 @@ Action add_match_command(CLI::App& app) {
   app.add_option("--search-below", a->search_below,
                  "where rounding stalls on at most this many free variables, finish each part by depth-first "
                  "search over exact LPs, releasing the fixings around a part without a binary solution (0: never)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(non_negative_number())
       ->capture_default_str();
   app.add_flag("--search-backjump,!--no-search-backjump", a->search_backjump,
                "where both values of a search's branch have failed, go back to the deepest decision that the "
@@ -834,12 +890,12 @@ Action add_match_command(CLI::App& app) {
   app.add_option("--release-reach-cap", a->release_reach_cap,
                  "where the same part fails again and the next release around it would reach beyond this many LP "
                  "steps, call the rounding stuck there (coarse to fine widens around it) instead (0: no cap)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(non_negative_number())
       ->capture_default_str();
   app.add_option("--later-round-iterations", a->later_round_iterations,
                  "LP iterations of a rounding round after the first, at most this many times the first LP's (at "
                  "least 2000; then it fixes from its iterate); 0: no limit")
-      ->check(CLI::NonNegativeNumber)
+      ->check(non_negative_number())
       ->capture_default_str();
   app.add_flag("--carry-round-weights,!--no-carry-round-weights", a->carry_round_weights,
                "rounding rounds after the first start each PDHG part from the primal weight its columns' last "
@@ -848,12 +904,12 @@ Action add_match_command(CLI::App& app) {
   app.add_option("--greedy-above", a->greedy_above,
                  "where a round's candidates clash and its LP has more free variables than this, fix each candidate "
                  "that does not clash with larger ones (below: fix the larger half and solve again); 0: always")
-      ->check(CLI::NonNegativeNumber)
+      ->check(non_negative_number())
       ->capture_default_str();
   app.add_option("--greedy-margin", a->greedy_margin,
                  "those rounds fix only candidates with no undecided variable (valued in (0.1, 0.9)) in their rows "
                  "or within this many - 1 closedness steps of them; 0: every candidate")
-      ->check(CLI::NonNegativeNumber)
+      ->check(non_negative_number())
       ->capture_default_str();
   app.add_option("--greedy-fallback", a->greedy_fallback,
                  "where no candidate of such a round stands away from the undecided part, fix the largest of each "
@@ -868,14 +924,14 @@ Action add_match_command(CLI::App& app) {
                "release the fixings of any round that carry it instead of trimming the last (default on)");
   app.add_flag("--whole-lp", a->whole_lp,
                "solve each rounding LP after the first as one, not as its independent parts (small parts exactly)");
-  app.add_option("--tol", a->tolerance, "LP tolerance")->capture_default_str();
+  app.add_option("--tol", a->tolerance, "LP tolerance")->check(positive_number())->capture_default_str();
   app.add_option("--coarse-tol", a->coarse_tolerance, "LP tolerance of the levels below the finest (0: --tol)")
       ->check(CLI::Range(0.0, 0.5))
       ->capture_default_str();
-  app.add_option("--time-limit", a->time_limit, "time limit of each LP solve, seconds");
+  app.add_option("--time-limit", a->time_limit, "time limit of each LP solve, seconds")->check(positive_number());
   app.add_option("--cold-primal-weight", a->cold_primal_weight,
                  "PDHG's primal weight ω for LPs solved from a cold start (0: PDHG's own)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(non_negative_number())
       ->capture_default_str();
   app.add_option("--cold-restart-artificial", a->cold_restart_artificial,
                  "PDHG restarts at the latest after this fraction of all iterations, in LPs solved from a cold start "
@@ -883,7 +939,7 @@ Action add_match_command(CLI::App& app) {
       ->check(CLI::Range(0.0, 1.0))
       ->capture_default_str();
   app.add_option("--levels", a->hierarchy.levels, "coarse-to-fine levels including the finest (0: from --coarsest-faces)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(non_negative_number())
       ->capture_default_str();
   app.add_option("--level-ratio", a->hierarchy.ratio,
                  "with --levels 0: faces grow by at most this factor from level to level")
@@ -899,7 +955,7 @@ Action add_match_command(CLI::App& app) {
   app.add_option("--second-faces", a->hierarchy.second_faces,
                  "faces of the level above the coarsest, which is also solved over its full product space (the "
                  "lower-energy Γ goes on); 0: off, levels geometric from the coarsest")
-      ->check(CLI::NonNegativeNumber)
+      ->check(non_negative_number())
       ->capture_default_str();
   app.add_option("--lookahead-levels", a->lookahead_levels,
                  "where the second start and the refined Γ both exist, refine both through this many more levels "
@@ -922,7 +978,7 @@ Action add_match_command(CLI::App& app) {
       ->capture_default_str();
   app.add_option("--coarse-ring-faces", a->coarse_ring_faces,
                  "levels below the finest with at most this many faces start at --coarse-ring (0: --ring everywhere)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(non_negative_number())
       ->capture_default_str();
   app.add_option("--neighbourhood", a->neighbourhood,
                  "where rings count: coarse (eq. 17 on the coarse level) or fine (on Y's fine level)")
@@ -947,12 +1003,12 @@ Action add_match_command(CLI::App& app) {
   app.add_option("--rounding-checkpoint-seconds", a->rounding_checkpoint_seconds,
                  "with --checkpoint: save where a level's rounding has got after its rounds, at most this often "
                  "(seconds)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(non_negative_number())
       ->capture_default_str();
   app.add_option("--lp-checkpoint-seconds", a->lp_checkpoint_seconds,
                  "with --checkpoint: save a refined level's first LP's iterate with its attempt at most this often "
                  "(seconds), so that a run gone on from it starts that LP there (0: never)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(non_negative_number())
       ->capture_default_str();
   auto* tr = app.add_option("--truth", a->truth,
                             "a diagnostic: the coarsest level keeps only product triangles near the true map (vertex "
@@ -984,7 +1040,7 @@ Action add_match_command(CLI::App& app) {
       ->capture_default_str();
   app.add_option("--branch-gap", a->branch_gap,
                  "with --branch-depth: dive only where the coarsest gap (energy over bound, relative) is above this")
-      ->check(CLI::NonNegativeNumber)
+      ->check(non_negative_number())
       ->capture_default_str();
   app.add_option("--dump-first-lps", a->dump_first_lps,
                  "write every first LP of a rounding to this directory (level<L>-<NNN>.smlp), to solve it again "
@@ -1003,12 +1059,12 @@ Action add_match_command(CLI::App& app) {
   app.add_option("--max-local-widenings", a->max_local_widenings,
                  "local widenings per level before the ring widens everywhere (those where propagation found the "
                  "contradiction not counted)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(non_negative_number())
       ->capture_default_str();
   app.add_option("--max-suspected-widenings", a->max_suspected_widenings,
                  "widenings in a row at a level on first LPs that the divergence watch stopped (no proof) before "
                  "the level's next first LPs are watched patiently, stopped only by a long climb (0: no limit)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(non_negative_number())
       ->capture_default_str();
   app.add_option("--suspicion-rings", a->suspicion_rings,
                  "where --max-suspected-widenings ends the watch, every X face within this many fine rings of "
@@ -1018,7 +1074,7 @@ Action add_match_command(CLI::App& app) {
   app.add_option("--suspicion-margins", a->suspicion_margins,
                  "at most this many --suspicion-rings margins per ring of a level (0: one at every suspicion "
                  "that ends the watch's trust)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(non_negative_number())
       ->capture_default_str();
   app.add_option("--suspicion-margin-around", a->suspicion_margin_around,
                  "what a --suspicion-rings margin is drawn around: widened (every X face widened so far at the "
@@ -1028,7 +1084,7 @@ Action add_match_command(CLI::App& app) {
   app.add_option("--divergence-bound-factor", a->divergence_bound_factor,
                  "a watched first LP of a refined level also stops as diverging where its dual proves its optimum "
                  "above this many times the coarser level's energy, while a ring is left to widen to (0: off)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(non_negative_number())
       ->capture_default_str();
   app.add_option("--zero-cost-proof-rings", a->zero_cost_proof_rings,
                  "where --feasibility-first proves a level's first LP infeasible for the first time at its ring, "
@@ -1038,7 +1094,7 @@ Action add_match_command(CLI::App& app) {
       ->capture_default_str();
   app.add_option("--max-propagation-widenings", a->max_propagation_widenings,
                  "local widenings per level where unit propagation found the contradiction (before any LP)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(non_negative_number())
       ->capture_default_str();
   app.add_option("--recurring-margin", a->recurring_margin,
                  "where propagation's contradiction comes back in the same π row, the k-th time widen X faces "
@@ -1057,7 +1113,7 @@ Action add_match_command(CLI::App& app) {
   app.add_option("--second-start-budget", a->second_start_budget,
                  "beside a refined Γ, the second start's rounding gives up once its rounds after the first did this "
                  "many times its first LP's work (iterations × variables), the alternative thresholds still trying (0: no budget)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(non_negative_number())
       ->capture_default_str();
   app.add_flag("--watch-resolve", a->watch_resolve,
                "let the divergence watch stop the re-solve after pricing too (off: it starts at the optimum of a "
@@ -1074,12 +1130,12 @@ Action add_match_command(CLI::App& app) {
                  "where the LPs after the rounding's fixings at a refined level keep failing for this many times "
                  "its first LP's seconds, or it runs out of rounds, widen the space around them and solve the level "
                  "again (0: off)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(non_negative_number())
       ->capture_default_str();
   app.add_option("--stuck-stalled", a->stuck_stalled,
                  "with --stuck-after: also where the rounding's free variables reach no new low for this many "
                  "rounds taking that long (0: off)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(non_negative_number())
       ->capture_default_str();
   app.add_flag("--blame-residual", a->blame_residual,
                "where a refined level's first LP stops as diverging, widen also around the rows its stalled "
@@ -1088,7 +1144,7 @@ Action add_match_command(CLI::App& app) {
                  "where a refined level's first LP stops as diverging, look for a proof of infeasibility on a "
                  "relaxation over the X faces around its stalled residual, up to N columns (0: off); a proof widens "
                  "those faces (past --max-ring if need be) and is checked again before the next LP")
-      ->check(CLI::NonNegativeNumber)
+      ->check(non_negative_number())
       ->capture_default_str();
   app.add_option("--local-proof-solver", a->local_proof_solver,
                  "with --local-proof: pdhg-cpu (its dual at zero cost, checked as a Farkas ray) or clp-dual (the "
@@ -1115,11 +1171,11 @@ Action add_match_command(CLI::App& app) {
       ->capture_default_str();
   app.add_option("--price-tolerance", a->price_tolerance,
                  "price the wider space at this looser LP tolerance, then solve on (0: price the optimum)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(non_negative_number())
       ->capture_default_str();
   app.add_option("--price-threshold", a->price_threshold,
                  "with --price-widenings: how far below zero (energy units) a column's reduced cost must be")
-      ->check(CLI::NonNegativeNumber)
+      ->check(non_negative_number())
       ->capture_default_str();
   app.add_option("--y-margin", a->y_margin,
                  "more fine rings on Y around every face's candidates, at every ring (fine neighbourhood)")

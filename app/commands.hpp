@@ -1,5 +1,7 @@
 #pragma once
 // Each subcommand registers its options on the CLI11 app and returns the action to run.
+#include "validators.hpp"
+
 #include <CLI/CLI.hpp>
 #include <functional>
 #include <string>

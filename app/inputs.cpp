@@ -13,23 +13,23 @@ void add_pair_options(CLI::App& app, PairArgs& args) {
   app.add_option("x", args.x, "first mesh (OFF, OBJ, PLY, STL); default: bundled asset");
   app.add_option("y", args.y, "second mesh; default: bundled asset");
   app.add_option("--faces", args.faces, "decimate both meshes to about N faces first (0: keep)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(non_negative_number())
       ->capture_default_str();
   app.add_flag("--keep-scale", args.keep_scale, "do not normalise both shapes to unit area");
   app.add_flag("--close-holes", args.close_holes,
                "close each boundary loop with a fan around a new vertex instead of rejecting an open mesh");
-  app.add_option("--bending", args.bending, "bending weight")->capture_default_str();
+  app.add_option("--bending", args.bending, "bending weight")->check(non_negative_number())->capture_default_str();
   app.add_option("--lame", args.lame, "Lamé parameters λ,μ of the membrane")->delimiter(',')->expected(2);
   app.add_option("--feature-weight", args.feature_weight, "weight μ of the feature term (0: off)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(non_negative_number())
       ->capture_default_str();
   app.add_option("--degenerate-penalty", args.degenerate_penalty,
                  "extra cost per unit area of every degenerate product triangle")
-      ->check(CLI::NonNegativeNumber)
+      ->check(non_negative_number())
       ->capture_default_str();
   app.add_option("--curvature-radius", args.curvature_radius,
                  "average the bending term's mean curvature over this radius, in units of √area (0: per vertex)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(non_negative_number())
       ->capture_default_str();
   app.add_option("--membrane", args.membrane, "membrane energy: compressive (default) or svk (the paper's St. Venant–Kirchhoff)")
       ->check(CLI::IsMember({"svk", "compressive"}))

@@ -2,6 +2,7 @@
 // What `lp` and `match` share: the mesh pair, its preprocessing and the energy options.
 #include "shapematch/geometry.hpp"
 #include "shapematch/matching.hpp"
+#include "validators.hpp"
 
 #include <CLI/CLI.hpp>
 #include <string>

@@ -1,6 +1,7 @@
 #include "json_read.hpp"
 
 #include "shapematch/errors.hpp"
+#include "shapematch/files.hpp"
 
 #include <cctype>
 #include <cstdlib>
@@ -160,8 +161,7 @@ private:
 JsonNode parse_json(const std::string& text, const std::string& path) { return JsonParser(text, path).parse(); }
 
 JsonNode read_json_file(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw IoError(path + ": cannot open");
+  std::ifstream in = open_for_reading(path, std::ios::binary);
   std::ostringstream s;
   s << in.rdbuf();
   return parse_json(s.str(), path);

@@ -5,6 +5,7 @@
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
@@ -49,8 +50,15 @@ int main(int argc, char** argv) {
 
   try {
     cli.parse(argc, argv);
+    app::check_finite_options(cli);
   } catch (const CLI::ParseError& e) {
-    return cli.exit(e);
+    // --help and --version end here too (exit 0). A usage error is an error like any other: one
+    // line in the documented form, exit 1 (CLI11's own codes, 105-114, would be a second scheme).
+    if (e.get_exit_code() == 0) return cli.exit(e);
+    std::string what = e.what();
+    std::replace(what.begin(), what.end(), '\n', ' ');
+    std::cerr << "shapematch: error: " << what << " (see --help)\n";
+    return 1;
   }
   spdlog::set_level(verbose ? spdlog::level::debug : spdlog::level::info);
   try {

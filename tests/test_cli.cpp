@@ -15,6 +15,7 @@
 #include <sstream>
 #include <string>
 #include <sys/wait.h>
+#include <unistd.h>
 #include <vector>
 
 namespace fs = std::filesystem;
@@ -378,6 +379,123 @@ TEST_CASE("cli: match writes a verified, complete output directory, or nothing")
   for (const auto& entry : fs::directory_iterator(out.parent_path()))
     CHECK(entry.path().filename().string().rfind("shapematch_cli_match.tmp", 0) != 0);
   fs::remove_all(out);
+}
+
+// The error is one line in the documented form, stderr's last (after the log, if any), exit 1,
+// nothing on stdout.
+void check_usage_error(const Run& r, const std::string& expect) {
+  CAPTURE(r.err);
+  CHECK(r.code == 1);
+  CHECK(r.out.empty());
+  REQUIRE(!r.err.empty());
+  CHECK(r.err.back() == '\n');
+  const size_t last = r.err.rfind('\n', r.err.size() - 2);
+  const std::string line = r.err.substr(last == std::string::npos ? 0 : last + 1);
+  CHECK(line.rfind("shapematch: error: ", 0) == 0);
+  CHECK(line.find(expect) != std::string::npos);
+  CHECK(r.err.find("shapematch: error: ") == (last == std::string::npos ? 0 : last + 1));  // (only there)
+}
+
+TEST_CASE("cli: match replaces only an earlier output, and sweeps what a stopped run left") {
+  const fs::path base = fs::temp_directory_path() / "shapematch_cli_out";
+  fs::remove_all(base);
+  fs::create_directories(base);
+  const std::string tetra = write_temp("out_tetra.off", kTetra).string();
+  const std::string pair = "match " + tetra + " " + tetra + " --backend cpu ";
+
+  // A directory of the user's own, a file, an empty name, the root: refused before any work,
+  // and left as they were.
+  const fs::path mine = base / "mine";
+  fs::create_directories(mine);
+  { std::ofstream(mine / "thesis.tex") << "x"; }
+  check_usage_error(run(pair + "-o " + mine.string()), mine.string() + ": exists and is not a match output");
+  CHECK(fs::exists(mine / "thesis.tex"));
+  const fs::path file = base / "file";
+  { std::ofstream(file) << "y"; }
+  check_usage_error(run(pair + "-o " + file.string()), file.string() + ": exists and is not a directory");
+  CHECK(fs::is_regular_file(file));
+  check_usage_error(run(pair + "-o ''"), "--out: empty path");
+  check_usage_error(run(pair + "-o /"), "the root cannot be an output directory");
+
+  // An empty directory, then the output it became: replaced.
+  const fs::path out = base / "out";
+  fs::create_directories(out);
+  REQUIRE(run(pair + "-o " + out.string()).code == 0);
+  REQUIRE(fs::exists(out / "report.json"));
+  { std::ofstream(out / "note.txt") << "z"; }
+  REQUIRE(run(pair + "-o " + out.string() + "/").code == 0);
+  CHECK(fs::exists(out / "report.json"));
+  CHECK_FALSE(fs::exists(out / "note.txt"));  // (the whole directory is the run's)
+
+  // What a run stopped while writing leaves (its process gone): its temporary directory is
+  // removed; the output it was replacing goes back in place if nothing took its place.
+  const pid_t child = fork();
+  if (child == 0) _exit(0);
+  REQUIRE(child > 0);
+  waitpid(child, nullptr, 0);  // a process id that is no one's now
+  const std::string gone = std::to_string(child);
+  fs::create_directories(base / ("out.tmp-" + gone));
+  fs::rename(out, base / ("out.old-" + gone));
+  fs::create_directories(base / "out.tmp-notapid");  // (not of the pattern: kept)
+  REQUIRE(run(pair + "-o " + (base / "other").string()).code == 0);  // (another output's run sweeps none of them)
+  CHECK(fs::exists(base / ("out.tmp-" + gone)));
+  CHECK(fs::exists(base / ("out.old-" + gone)));
+  const Run again = run(pair + "-o " + out.string());
+  REQUIRE(again.code == 0);
+  CHECK(again.err.find("put back as " + out.string()) != std::string::npos);
+  CHECK(again.err.find("out.tmp-" + gone + ": removed") != std::string::npos);
+  CHECK_FALSE(fs::exists(base / ("out.tmp-" + gone)));
+  CHECK_FALSE(fs::exists(base / ("out.old-" + gone)));
+  CHECK(fs::exists(base / "out.tmp-notapid"));
+  CHECK(fs::exists(out / "report.json"));
+  for (const auto& entry : fs::directory_iterator(base))  // nothing of this run's own left beside it
+    CHECK(entry.path().filename().string().rfind("out.tmp-" + std::to_string(::getpid()), 0) != 0);
+  fs::remove_all(base);
+}
+
+TEST_CASE("cli: usage errors are one documented line with exit 1") {
+  const std::string tetra = write_temp("usage_tetra.off", kTetra).string();
+  const std::string pair = "match " + tetra + " " + tetra + " --backend cpu -o /nonexistent/never ";
+  check_usage_error(run(""), "A subcommand is required");
+  check_usage_error(run("match --no-such-option"), "--no-such-option");
+  check_usage_error(run(pair + "--tol -1"), "--tol: must be positive, not -1");
+  check_usage_error(run(pair + "--tol 0"), "--tol: must be positive, not 0");
+  check_usage_error(run(pair + "--faces -5"), "--faces: must not be negative, not -5");
+  check_usage_error(run(pair + "--bending nan"), "--bending: must be a finite number, not nan");
+  check_usage_error(run(pair + "--lame 1,inf"), "--lame: must be a finite number, not inf");
+  check_usage_error(run(pair + "--time-limit -inf"), "--time-limit: must be positive");
+  check_usage_error(run("lp --max-iter -3"), "--max-iter: must be positive, not -3");
+  check_usage_error(run("lp --time-limit 0"), "--time-limit: must be positive, not 0");
+  CHECK(run("match --help").code == 0);
+  CHECK(run("--version").code == 0);
+  // +∞ is a limit that means none.
+  const Run unlimited = run("lp " + tetra + " " + tetra + " --solver clp-dual --time-limit inf");
+  CHECK(unlimited.code == 0);
+  // A limit below the solver's set-up: an error naming the option, not rounds of nothing.
+  const fs::path limited = fs::temp_directory_path() / "shapematch_cli_time_limited";
+  fs::remove_all(limited);
+  const Run tiny = run("match --faces 30 --backend cpu --time-limit 1e-9 -o " + limited.string());
+  check_usage_error(tiny, "reached its time limit (1e-09 s) before its first iteration; allow more time per LP (--time-limit)");
+  CHECK_FALSE(fs::exists(limited));
+
+  // Paths that are directories where a file is wanted: one line naming them, not a crash.
+  const fs::path folder = fs::temp_directory_path() / "shapematch_cli_folder";
+  fs::create_directories(folder);
+  check_usage_error(run("checkpoint " + folder.string()), folder.string() + ": is a directory, not a file");
+  check_usage_error(run("lp --from " + folder.string()), folder.string() + ": is a directory, not a file");
+  check_usage_error(run(pair + "--checkpoint " + folder.string()), folder.string() + ": is a directory, not a file");
+
+  // bench match checks the options for its runs before the first one.
+  const fs::path pairs = write_temp("usage_pairs.txt", tetra + " " + tetra + " identity\n");
+  const fs::path bench = fs::temp_directory_path() / "shapematch_cli_bench_usage";
+  fs::remove_all(bench);
+  const std::string b = "bench match --pairs " + pairs.string() + " --faces 30 --out " + bench.string() + " -- ";
+  check_usage_error(run(b + "-o elsewhere"), "bench match: -o after `--` is set by the benchmark for each run");
+  check_usage_error(run(b + "--faces 10"), "bench match: --faces after `--` is set by the benchmark");
+  check_usage_error(run(b + "--checkpoint=c"), "bench match: --checkpoint after `--`");
+  check_usage_error(run(b + "--bogus"), "bench match: the match options after `--`: The following argument was not expected: --bogus");
+  check_usage_error(run(b + "--lame nan,1"), "the match options after `--`: --lame: must be a finite number, not nan");
+  CHECK_FALSE(fs::exists(bench));
 }
 
 // Every coarser level's map is written in input vertices and scored by eval: a shape matched

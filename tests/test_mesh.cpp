@@ -262,15 +262,47 @@ TEST_CASE("mesh: malformed inputs are rejected with a one-line message") {
   SUBCASE("index out of range") {
     check_invalid(dir.file("range.off", kTetraHeader + "3 0 1 2\n3 0 3 1\n3 0 2 7\n3 1 3 2\n"),
                   "face 2 refers to vertex 7, out of range");
-    check_invalid(dir.file("range.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 0\n"), "face 0 refers to vertex -1");
+    check_invalid(dir.file("range.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 0\n"),
+                  "line 4: face index 0 (OBJ counts vertices from 1)");
+    check_invalid(dir.file("range2.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n"), "face 0 refers to vertex 3");
   }
   SUBCASE("malformed text") {
     check_invalid(dir.file("header.off", "OFF\nfour 4 0\n"), "expected the vertex and face counts");
     check_invalid(dir.file("short.off", std::string("OFF\n4 4 0\n") + kTetraVertices + "3 0 1 2\n"),
                   "file ends after 1 of 4 faces");
     check_invalid(dir.file("word.off", std::string("OFF\n4 4 0\n1 1 one\n") + kTetraFaces),
-                  "vertex 0 needs three numbers");
+                  "line 3: vertex 0 needs three numbers, got '1 1 one'");
+    // Out of a double's range: named, not taken for a missing number.
+    check_invalid(dir.file("e400.off", std::string("OFF\n4 4 0\n1 1 1e400\n") + kTetraFaces), "got '1 1 1e400'");
     check_invalid(dir.file("notoff.off", "PLY\n"), "missing OFF header");
+  }
+  SUBCASE("counts that do not match the file") {
+    // One vertex too many declared: the first face line would be read as a fifth vertex.
+    check_invalid(dir.file("more.off", std::string("OFF\n5 3 0\n") + kTetraVertices + kTetraFaces),
+                  "line 7: vertex 4 has 4 numbers, not 3 (is the header's vertex count, 5, right?)");
+    // One face too few declared: the last face would be dropped (and the mesh reported open).
+    check_invalid(dir.file("fewer.off", std::string("OFF\n4 3 0\n") + kTetraVertices + kTetraFaces),
+                  "line 10: more data after the 3 faces the header declares");
+    // A COFF vertex carries its colour: extra numbers are its fields there, not a miscount.
+    REQUIRE_NOTHROW(load_mesh(dir.file("colour.off", std::string("COFF\n4 4 0\n") +
+                                                         "1 1 1 255 0 0 255\n1 -1 -1 0 255 0 255\n"
+                                                         "-1 1 -1 0 0 255 255\n-1 -1 1 9 9 9 255\n" +
+                                                         kTetraFaces)));
+    // Face colours after the indices, comments and blank lines after the faces are fine.
+    REQUIRE_NOTHROW(load_mesh(dir.file("facecolour.off", kTetraHeader + "3 0 1 2 1 0 0\n3 0 3 1\n3 0 2 3\n"
+                                                                        "3 1 3 2\n\n# end\n")));
+  }
+  SUBCASE("huge coordinates whose areas would overflow") {
+    check_invalid(dir.file("far.off", std::string("OFF\n4 4 0\n1e200 1 1\n1 -1 -1\n-1 1 -1\n-1 -1 1\n") + kTetraFaces),
+                  "vertex 0 has a coordinate beyond ±1e+75");
+    // Large but computable: accepted (areas are normalised after loading).
+    REQUIRE_NOTHROW(load_mesh(dir.file("large.off", std::string("OFF\n4 4 0\n1e70 1e70 1e70\n1e70 -1e70 -1e70\n"
+                                                                    "-1e70 1e70 -1e70\n-1e70 -1e70 1e70\n") +
+                                                        kTetraFaces)));
+  }
+  SUBCASE("a directory named as a mesh") {
+    fs::create_directories(dir / "folder.off");
+    CHECK_THROWS_WITH_AS(load_mesh(dir / "folder.off"), doctest::Contains("is a directory"), IoError);
   }
   SUBCASE("huge counts that would overflow int indices") {
     check_invalid(dir.file("huge.off", "OFF\n3000000000 1 0\n"), "too large");

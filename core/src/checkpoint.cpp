@@ -301,8 +301,7 @@ void detail::save_checkpoint_as(const std::string& path, const LevelCheckpoint& 
 }
 
 LevelCheckpoint load_checkpoint(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw IoError(path + ": cannot open the checkpoint");
+  std::ifstream in = open_for_reading(path, std::ios::binary);
   std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   if (in.bad()) throw IoError(path + ": cannot read the checkpoint");
   if (bytes.compare(0, sizeof kMagic - 1, kMagic) != 0) throw IoError(path + ": not a shapematch checkpoint");

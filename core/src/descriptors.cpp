@@ -1,6 +1,7 @@
 #include "shapematch/descriptors.hpp"
 
 #include "shapematch/errors.hpp"
+#include "shapematch/files.hpp"
 #include "shapematch/geometry.hpp"
 
 #include <Eigen/Eigenvalues>
@@ -206,10 +207,7 @@ namespace {
 }
 
 std::string read_file(const std::string& path) {
-  std::error_code ec;
-  if (std::filesystem::is_directory(path, ec)) throw IoError(path + ": is a directory");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw IoError(path + ": cannot open (" + std::strerror(errno) + ")");
+  std::ifstream in = open_for_reading(path, std::ios::binary);
   std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   if (in.bad()) throw IoError(path + ": read error");
   return bytes;

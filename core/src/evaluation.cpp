@@ -1,6 +1,7 @@
 #include "shapematch/evaluation.hpp"
 
 #include "shapematch/errors.hpp"
+#include "shapematch/files.hpp"
 #include "shapematch/geodesic.hpp"
 #include "shapematch/geometry.hpp"
 #include "shapematch/system.hpp"
@@ -21,8 +22,7 @@ namespace {
 
 // The lines of a text file without their line ends; trailing blank lines dropped.
 std::vector<std::string> read_lines(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw IoError(path + ": cannot open");
+  std::ifstream in = open_for_reading(path);
   std::vector<std::string> lines;
   for (std::string line; std::getline(in, line);) {
     if (!line.empty() && line.back() == '\r') line.pop_back();

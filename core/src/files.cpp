@@ -46,4 +46,12 @@ void write_file_atomic(const std::string& path, const std::string& text) {
   write_file_atomic(path, [&](std::ostream& out) { out << text; });
 }
 
+std::ifstream open_for_reading(const std::string& path, std::ios::openmode mode) {
+  std::error_code ec;
+  if (fs::is_directory(path, ec)) throw IoError(path + ": is a directory, not a file");
+  std::ifstream in(path, mode | std::ios::in);
+  if (!in) throw IoError(path + ": cannot open for reading (" + std::strerror(errno) + ")");
+  return in;
+}
+
 }  // namespace shapematch

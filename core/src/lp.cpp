@@ -157,8 +157,7 @@ void write_lp(const LpProblem& p, const std::string& path) {
 }
 
 LpProblem read_lp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw IoError(path + ": cannot read (" + std::strerror(errno) + ")");
+  std::ifstream in = open_for_reading(path, std::ios::binary);
   auto bad = [&](const std::string& what) { throw InvalidInputError(path + ": " + what); };
   auto get = [&](auto* data, size_t count) {
     in.read(reinterpret_cast<char*>(data), static_cast<std::streamsize>(count * sizeof(*data)));

@@ -36,6 +36,8 @@ namespace fs = std::filesystem;
 // directed edges and corners.
 constexpr int64_t kMaxVertices = INT_MAX;
 constexpr int64_t kMaxFaces = INT_MAX / 3;
+// Beyond this a coordinate's fourth power (a squared area) overflows a double.
+constexpr double kMaxCoordinate = 1e75;
 
 [[noreturn]] void fail(const std::string& name, const std::string& problem) {
   throw InvalidInputError(name + ": " + problem);
@@ -86,9 +88,7 @@ bool parse(std::string_view s, int64_t& x) {
 // Reads a text file line by line, dropping '#' comments and blank lines.
 class LineReader {
 public:
-  explicit LineReader(const std::string& path) : path_(path), in_(path) {
-    if (!in_) throw IoError(path + ": cannot open for reading");
-  }
+  explicit LineReader(const std::string& path) : path_(path), in_(open_for_reading(path)) {}
   // The next non-blank line as tokens (views into an internal buffer valid until the next call).
   bool next(std::vector<std::string_view>& tokens) {
     while (std::getline(in_, line_)) {
@@ -117,6 +117,10 @@ RawMesh read_off(const std::string& path) {
   const std::string_view key = t[0];
   if (key.size() < 3 || key.substr(key.size() - 3) != "OFF") fail(path, "missing OFF header");
   if (key.find_first_of("4n") != std::string_view::npos) fail(path, "only 3D OFF files are supported");
+  // A plain OFF vertex is three numbers and nothing else: more on its line is most often a face
+  // read as a vertex because the header's count is too large. (COFF, NOFF, STOFF… add fields.)
+  // (Decided now: `key` views the reader's line, which the next line replaces.)
+  const bool plain = key == "OFF";
   if (t.size() > 1 && t[1] == "BINARY") fail(path, "binary OFF is not supported");
   size_t first = 1;
   if (t.size() == 1) {
@@ -131,11 +135,23 @@ RawMesh read_off(const std::string& path) {
   RawMesh raw;
   // Headers can lie: do not let one trigger a huge allocation.
   raw.vertices.reserve(std::min<int64_t>(nv, 1 << 20));
+  const auto vertex_tokens = [](const std::vector<std::string_view>& tokens) {
+    std::string s;
+    for (std::string_view token : tokens) {
+      if (!s.empty()) s += ' ';
+      s.append(token.substr(0, 24));
+    }
+    return s;
+  };
   for (int64_t i = 0; i < nv; ++i) {
     if (!reader.next(t)) fail(path, fmt::format("file ends after {} of {} vertices", i, nv));
     Eigen::Vector3d p;
     if (t.size() < 3 || !parse(t[0], p.x()) || !parse(t[1], p.y()) || !parse(t[2], p.z()))
-      fail(path, fmt::format("line {}: vertex {} needs three numbers", reader.line_number(), i));
+      fail(path, fmt::format("line {}: vertex {} needs three numbers, got '{}'", reader.line_number(), i,
+                             vertex_tokens(t)));
+    if (plain && t.size() > 3)
+      fail(path, fmt::format("line {}: vertex {} has {} numbers, not 3 (is the header's vertex count, {}, right?)",
+                             reader.line_number(), i, t.size(), nv));
     raw.vertices.push_back(p);
   }
   for (int64_t f = 0; f < nf; ++f) {
@@ -150,6 +166,8 @@ RawMesh read_off(const std::string& path) {
     }
     raw.end_polygon();
   }
+  if (reader.next(t))
+    fail(path, fmt::format("line {}: more data after the {} faces the header declares", reader.line_number(), nf));
   return raw;
 }
 
@@ -171,9 +189,9 @@ RawMesh read_obj(const std::string& path) {
         int64_t index = 0;
         if (!parse(t[k].substr(0, t[k].find('/')), index))
           fail(path, fmt::format("line {}: malformed face", reader.line_number()));
+        if (index == 0) fail(path, fmt::format("line {}: face index 0 (OBJ counts vertices from 1)", reader.line_number()));
         if (index > 0) raw.indices.push_back(index - 1);
-        else if (index < 0) raw.indices.push_back(static_cast<int64_t>(raw.vertices.size()) + index);
-        else raw.indices.push_back(-1);  // 0 names no vertex: reported as out of range
+        else raw.indices.push_back(static_cast<int64_t>(raw.vertices.size()) + index);
       }
       raw.end_polygon();
       if (static_cast<int64_t>(raw.num_polygons()) > kMaxFaces)
@@ -257,8 +275,7 @@ private:
 // The number of triangles an STL file declares: OpenMesh's reader merges coincident points and
 // then skips triangles that became degenerate, which would otherwise go unnoticed.
 int64_t stl_declared_triangles(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw IoError(path + ": cannot open for reading");
+  std::ifstream in = open_for_reading(path, std::ios::binary);
   const std::string data((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   if (data.size() >= 84) {
     uint32_t n = 0;
@@ -510,6 +527,10 @@ int validate_mesh(const Mesh& mesh) {
     const Eigen::Vector3d& p = mesh.vertices[i];
     if (!p.allFinite())
       fail(name, fmt::format("vertex {} has a non-finite coordinate ({}, {}, {})", i, p.x(), p.y(), p.z()));
+    // (Areas multiply four coordinates: past this they overflow, and every face looks degenerate.)
+    if (p.cwiseAbs().maxCoeff() > kMaxCoordinate)
+      fail(name, fmt::format("vertex {} has a coordinate beyond ±{:g} ({}, {}, {}): too large to compute areas with",
+                             i, kMaxCoordinate, p.x(), p.y(), p.z()));
   }
   for (int64_t f = 0; f < nf; ++f) {
     const auto& t = mesh.faces[f];
@@ -636,7 +657,7 @@ Mesh load_mesh(const std::string& path, const LoadOptions& options, MeshReport* 
   const std::string ext = lower_extension(path);
   if (ext != ".off" && ext != ".obj" && ext != ".ply" && ext != ".stl")
     fail(path, fmt::format("unknown extension '{}' (expected .off, .obj, .ply or .stl)", ext));
-  if (!std::ifstream(path)) throw IoError(path + ": cannot open for reading");
+  open_for_reading(path);  // (throws where it cannot be read)
   if (fs::file_size(path, ec) == 0 && !ec) fail(path, "empty file");
 
   const RawMesh raw = ext == ".off" ? read_off(path) : ext == ".obj" ? read_obj(path) : read_with_openmesh(path, ext);

@@ -1,6 +1,7 @@
 #include "shapematch/point_map.hpp"
 
 #include "shapematch/errors.hpp"
+#include "shapematch/files.hpp"
 #include "shapematch/hierarchy.hpp"
 
 #include "pinches.hpp"
@@ -837,8 +838,7 @@ std::string point_map_text(const std::vector<SurfacePoint>& map) {
 }
 
 std::vector<SurfacePoint> read_point_map(const std::string& path, const Mesh& target) {
-  std::ifstream in(path);
-  if (!in) throw IoError(path + ": cannot open");
+  std::ifstream in = open_for_reading(path);
   std::vector<std::string> lines;
   for (std::string line; std::getline(in, line);) lines.push_back(line);
   if (in.bad()) throw IoError(path + ": read error");

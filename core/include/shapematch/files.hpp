@@ -1,6 +1,7 @@
 #pragma once
 // Output files are written next to their target and renamed over it, so that no reader (and no
 // failed run) ever sees a half-written file.
+#include <fstream>
 #include <functional>
 #include <ostream>
 #include <string>
@@ -11,5 +12,10 @@ namespace shapematch {
 // path; the temporary is removed on failure.
 void write_file_atomic(const std::string& path, const std::function<void(std::ostream&)>& write);
 void write_file_atomic(const std::string& path, const std::string& text);
+
+// `path` opened for reading, or an IoError naming it and why not ("is a directory", the
+// system's reason): a directory opens as a stream that fails only at its first read, which
+// readers would report as a truncated or malformed file.
+std::ifstream open_for_reading(const std::string& path, std::ios::openmode mode = std::ios::in);
 
 }  // namespace shapematch
