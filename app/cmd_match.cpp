@@ -164,7 +164,11 @@ std::string solver_for(const MatchArgs& a) {
   try {
     const DeviceInfo d = choose_device(a.device);
     if (d.type == "discrete" || d.type == "integrated") return "pdhg-vulkan";
+    if (a.device >= 0)  // (asked for by index, yet not a GPU: say why it is not used)
+      spdlog::warn("--device {} is {} ({}), not a GPU: --backend auto uses the CPU (--backend vulkan runs on it)",
+                   a.device, d.name, d.type);
   } catch (const DeviceError&) {
+    if (a.device >= 0) throw;  // a device asked for by index that is not there is an error, not a fallback
   }
   return "pdhg-cpu";
 }

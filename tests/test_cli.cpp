@@ -455,7 +455,9 @@ TEST_CASE("cli: match replaces only an earlier output, and sweeps what a stopped
 
 TEST_CASE("cli: usage errors are one documented line with exit 1") {
   const std::string tetra = write_temp("usage_tetra.off", kTetra).string();
-  const std::string pair = "match " + tetra + " " + tetra + " --backend cpu -o /nonexistent/never ";
+  const fs::path never = fs::temp_directory_path() / "shapematch_cli_usage_never";  // (no run gets to write it)
+  fs::remove_all(never);
+  const std::string pair = "match " + tetra + " " + tetra + " --backend cpu -o " + never.string() + " ";
   check_usage_error(run(""), "A subcommand is required");
   check_usage_error(run("match --no-such-option"), "--no-such-option");
   check_usage_error(run(pair + "--tol -1"), "--tol: must be positive, not -1");
@@ -466,6 +468,11 @@ TEST_CASE("cli: usage errors are one documented line with exit 1") {
   check_usage_error(run(pair + "--time-limit -inf"), "--time-limit: must be positive");
   check_usage_error(run("lp --max-iter -3"), "--max-iter: must be positive, not -3");
   check_usage_error(run("lp --time-limit 0"), "--time-limit: must be positive, not 0");
+  // A device asked for by index that is not there: an error, not a quiet fall back to the CPU.
+  const Run device = run("match " + tetra + " " + tetra + " --backend auto --device 99 -o " + never.string());
+  check_usage_error(device, "");
+  CHECK((device.err.find("device 99 does not exist") != std::string::npos ||
+         device.err.find("Vulkan") != std::string::npos));  // (or no Vulkan at all on this machine)
   CHECK(run("match --help").code == 0);
   CHECK(run("--version").code == 0);
   // +∞ is a limit that means none.
@@ -496,6 +503,7 @@ TEST_CASE("cli: usage errors are one documented line with exit 1") {
   check_usage_error(run(b + "--bogus"), "bench match: the match options after `--`: The following argument was not expected: --bogus");
   check_usage_error(run(b + "--lame nan,1"), "the match options after `--`: --lame: must be a finite number, not nan");
   CHECK_FALSE(fs::exists(bench));
+  CHECK_FALSE(fs::exists(never));
 }
 
 // Every coarser level's map is written in input vertices and scored by eval: a shape matched
