@@ -243,6 +243,9 @@ TEST_CASE("cli: malformed inputs give one clear line and a non-zero exit") {
        "OFF\n5 5 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n0 0 -1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n3 0 1 4\n", "manifold"},
       {"empty.off", "", "empty"},
       {"index.off", "OFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 9\n3 1 2 3\n", "range"},
+      // OpenMesh's reader says why on its own stream: in the one line, not on a line before it.
+      {"flat.ply", "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nend_header\n1\n2\n",
+       "openmesh could not parse the file (only vertex dimension 3 is supported.)"},
   };
   for (const auto& c : cases) {
     CAPTURE(c.file);

@@ -7,6 +7,7 @@
 #include <OpenMesh/Core/IO/MeshIO.hh>
 #include <OpenMesh/Core/IO/importer/BaseImporter.hh>
 #include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
+#include <OpenMesh/Core/System/omstream.hh>
 #include <OpenMesh/Tools/Decimater/DecimaterT.hh>
 #include <OpenMesh/Tools/Decimater/ModNormalFlippingT.hh>
 #include <OpenMesh/Tools/Decimater/ModQuadricT.hh>
@@ -23,8 +24,11 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iostream>
 #include <map>
+#include <mutex>
 #include <numeric>
+#include <sstream>
 #include <string_view>
 
 namespace shapematch {
@@ -287,12 +291,50 @@ int64_t stl_declared_triangles(const std::string& path) {
   return count;
 }
 
+// OpenMesh's readers say why they fail on its omerr stream (stderr by default): taken from there
+// while one reads, so that the error stays one line and says what OpenMesh found. (The stream is
+// global: one reader at a time.)
+class OpenMeshMessages {
+public:
+  OpenMeshMessages() : lock_(mutex()) {
+    ::omerr().disconnect(std::cerr);
+    ::omerr().connect(text_);
+  }
+  ~OpenMeshMessages() {
+    ::omerr().flush();
+    ::omerr().disconnect(text_);
+    ::omerr().connect(std::cerr);
+  }
+  OpenMeshMessages(const OpenMeshMessages&) = delete;
+  OpenMeshMessages& operator=(const OpenMeshMessages&) = delete;
+  // The first message, without OpenMesh's "[Reader] : " tag; empty if none.
+  std::string first() {
+    ::omerr().flush();
+    std::string line = text_.str();
+    line = line.substr(0, line.find('\n'));
+    if (const size_t tag = line.find("] : "); line.rfind('[', 0) == 0 && tag != std::string::npos) line.erase(0, tag + 4);
+    while (!line.empty() && std::isspace(static_cast<unsigned char>(line.back()))) line.pop_back();
+    return line;
+  }
+
+private:
+  static std::mutex& mutex() {
+    static std::mutex m;
+    return m;
+  }
+  std::lock_guard<std::mutex> lock_;
+  std::ostringstream text_;
+};
+
 RawMesh read_with_openmesh(const std::string& path, const std::string& extension) {
   RawMesh raw;
   RawImporter importer(raw);
   OpenMesh::IO::Options options;
-  if (!OpenMesh::IO::IOManager().read(path, importer, options))
-    fail(path, "OpenMesh could not parse the file");
+  OpenMeshMessages messages;
+  if (!OpenMesh::IO::IOManager().read(path, importer, options)) {
+    const std::string why = messages.first();
+    fail(path, "OpenMesh could not parse the file" + (why.empty() ? std::string() : " (" + why + ")"));
+  }
   if (extension == ".stl") {
     const int64_t declared = stl_declared_triangles(path);
     const int64_t read = static_cast<int64_t>(raw.num_polygons());
