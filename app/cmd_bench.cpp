@@ -580,6 +580,8 @@ std::vector<std::string> match_command(const BenchMatchArgs& args, const std::st
 // The options after `--`, checked once before any run: a typo would otherwise fail every pair in
 // turn, each row "failed" and bench's exit 0. Those the benchmark sets itself are refused.
 void check_match_args(const std::vector<std::string>& args) {
+  if (std::find(args.begin(), args.end(), "--") != args.end())
+    throw InvalidInputError("bench match: a second `--` among the match options (everything after the first is theirs)");
   for (const std::string& a : args)
     for (const std::string own : {"-o", "--out", "--faces", "--checkpoint"})
       if (a == own || a.rfind(own + "=", 0) == 0 || (own == "-o" && a.size() > 2 && a.rfind("-o", 0) == 0))
@@ -590,6 +592,8 @@ void check_match_args(const std::vector<std::string>& args) {
   try {
     probe.parse(reversed);
     check_finite_options(probe);
+  } catch (const CLI::Success&) {  // (--help: the match options are `shapematch match --help`'s)
+    throw InvalidInputError("bench match: --help after `--`: the options there are those of `shapematch match --help`");
   } catch (const CLI::ParseError& e) {
     throw InvalidInputError(fmt::format("bench match: the match options after `--`: {}", e.what()));
   }

@@ -1,11 +1,13 @@
 // `shapematch match X Y`: the whole pipeline — load, LP, rounding, verification, outputs.
 #include "commands.hpp"
 #include "inputs.hpp"
+#include "json_read.hpp"
 #include "shapematch/coarse_to_fine.hpp"
 #include "shapematch/device.hpp"
 #include "shapematch/errors.hpp"
 #include "shapematch/json.hpp"
 #include "shapematch/evaluation.hpp"
+#include "shapematch/files.hpp"
 #include "shapematch/matching.hpp"
 #include "shapematch/point_map.hpp"
 #include "shapematch/render.hpp"
@@ -179,71 +181,132 @@ std::string lines(const std::vector<int>& values) {
   return s;
 }
 
+// Marker files that tell a later run what a sibling of the output directory is, so that only
+// shapematch's own leftovers are ever removed: a temporary output holds kWriting until it is
+// renamed into place; an output being replaced gets kReplaced before it is moved aside.
+constexpr const char* kWriting = ".shapematch-writing";
+constexpr const char* kReplaced = ".shapematch-replaced";
+
+// Whether `dir` holds a match output: its report.json parses with match's keys, and the map is
+// there (a folder of the user's with a report.json of its own is not one).
+bool is_match_output(const fs::path& dir) {
+  std::error_code ec;
+  if (!fs::is_regular_file(dir / "report.json", ec) || !fs::is_regular_file(dir / "map_x_to_y.txt", ec)) return false;
+  try {
+    const JsonNode report = read_json_file((dir / "report.json").string());
+    return report.get("energy") && report.get("verified") && report.get("levels");
+  } catch (const Error&) {
+    return false;
+  }
+}
+
 // The output directory --out names, absolute. Refused (before any work) unless it does not
-// exist yet, is empty, or is an earlier match's output (it has a report.json): publish replaces
-// it whole, and a mistyped -o must not remove a user's own files.
+// exist yet, is empty, or is an earlier match's output: publish replaces it whole, and a
+// mistyped -o must not remove a user's own files.
 fs::path output_directory(const std::string& arg) {
   if (arg.empty()) throw InvalidInputError("--out: empty path");
   fs::path out = fs::absolute(arg).lexically_normal();
   if (!out.has_filename()) out = out.parent_path();  // "dir/" names dir
   if (out == out.root_path()) throw InvalidInputError(out.string() + ": the root cannot be an output directory");
   std::error_code ec;
-  const fs::file_status status = fs::status(out, ec);
+  if (const fs::path cwd = fs::current_path(ec); !ec) {
+    const fs::path inside = cwd.lexically_relative(out);
+    if (!inside.empty() && *inside.begin() != "..")
+      throw InvalidInputError(out.string() + ": is the current directory or holds it (it would be moved away)");
+  }
+  const fs::file_status status = fs::symlink_status(out, ec);
+  if (fs::is_symlink(status))
+    throw InvalidInputError(out.string() + ": is a symbolic link; name the directory it points to");
   if (!fs::exists(status)) return out;
   if (!fs::is_directory(status))
     throw InvalidInputError(out.string() + ": exists and is not a directory (--out names the output directory)");
-  if (!fs::is_empty(out, ec) && !fs::exists(out / "report.json"))
-    throw InvalidInputError(out.string() +
-                            ": exists and is not a match output (no report.json); remove it or name another --out");
+  const bool empty = fs::is_empty(out, ec);
+  if (ec) throw IoError(out.string() + ": cannot read (" + ec.message() + ")");
+  if (!empty && !is_match_output(out))
+    throw InvalidInputError(out.string() + ": exists and is not a match output (no report.json and map of "
+                                           "shapematch's); remove it or name another --out");
   return out;
 }
 
-// `out`'s temporary siblings (OUT.tmp-PID, OUT.old-PID) whose process has gone: a run stopped
-// while writing (Ctrl-C, killed) cannot clean up after itself, so the next run does. An .old- is
-// the output that run was replacing: it goes back in place where nothing took its place.
+// `out`'s siblings left by a run stopped while writing (Ctrl-C, killed), which cannot clean up
+// after itself: OUT.tmp-PID with kWriting (removed) and OUT.old-PID with kReplaced (put back where
+// no `out` took its place, the newest if several; else removed), whose process has gone. This
+// run's own pid counts as gone (nothing of it exists yet); anything without its marker is left.
 void remove_stale_siblings(const fs::path& out) {
   std::error_code ec;
   const std::string name = out.filename().string();
-  std::vector<std::pair<fs::path, bool>> stale;  // (path, an .old-)
-  for (const auto& entry : fs::directory_iterator(out.parent_path(), ec)) {
-    const std::string sibling = entry.path().filename().string();
+  std::vector<fs::path> writing, replaced;
+  for (auto it = fs::directory_iterator(out.parent_path(), ec); !ec && it != fs::directory_iterator();
+       it.increment(ec)) {
+    const std::string sibling = it->path().filename().string();
     for (const std::string tag : {".tmp-", ".old-"}) {
       const std::string prefix = name + tag;
       if (sibling.size() <= prefix.size() || sibling.compare(0, prefix.size(), prefix) != 0) continue;
       const std::string digits = sibling.substr(prefix.size());
       if (digits.find_first_not_of("0123456789") != std::string::npos || digits.size() > 9) continue;
       const pid_t pid = static_cast<pid_t>(std::stol(digits));
-      if (pid > 0 && (::kill(pid, 0) == 0 || errno != ESRCH)) continue;  // alive (or not ours to judge)
-      stale.emplace_back(entry.path(), tag == ".old-");
+      if (pid != ::getpid() && (::kill(pid, 0) == 0 || errno != ESRCH)) continue;  // alive (or not ours to judge)
+      std::error_code marked;
+      if (tag == ".tmp-" && fs::exists(it->path() / kWriting, marked)) writing.push_back(it->path());
+      if (tag == ".old-" && fs::exists(it->path() / kReplaced, marked)) replaced.push_back(it->path());
     }
   }
-  for (const auto& [path, old] : stale) {
-    std::error_code done;
-    if (old && !fs::exists(out)) {
-      fs::rename(path, out, done);
-      if (!done) spdlog::info("{}: put back as {}, left by a run that stopped while replacing it", path.string(), out.string());
-    } else {
-      fs::remove_all(path, done);
-      if (!done) spdlog::info("{}: removed, left by a run that stopped while writing", path.string());
+  const auto written = [](const fs::path& dir) {
+    std::error_code e;
+    return fs::last_write_time(dir / kReplaced, e);
+  };
+  std::sort(replaced.begin(), replaced.end(), [&](const fs::path& a, const fs::path& b) { return written(a) > written(b); });
+  std::error_code none;
+  if (!replaced.empty() && !fs::exists(fs::symlink_status(out, none))) {
+    std::error_code back;
+    fs::rename(replaced.front(), out, back);
+    if (!back) {
+      fs::remove(out / kReplaced, back);
+      spdlog::info("{}: put back as {}, left by a run that stopped while replacing it", replaced.front().string(),
+                   out.string());
+      replaced.erase(replaced.begin());
     }
+  }
+  for (const auto& dir : writing) replaced.push_back(dir);
+  for (const auto& dir : replaced) {
+    std::error_code removed;
+    fs::remove_all(dir, removed);
+    if (!removed) spdlog::info("{}: removed, left by a run that stopped while writing", dir.string());
   }
 }
 
-// Writes everything into a fresh temporary directory next to `out` and renames it into place,
-// so that a failure never leaves a half-written output directory.
+// Renames the finished temporary directory `tmp` into place as `out`, so that a failure never
+// leaves a half-written output directory. Where `out` has become something this run may not
+// replace meanwhile, the output is kept as OUT.new-PID and the error names it.
 void publish(const fs::path& tmp, const fs::path& out) {
   std::error_code ec;
   fs::path old;
-  if (fs::exists(out)) {
-    output_directory(out.string());  // (still one it may replace)
+  if (fs::exists(fs::symlink_status(out, ec))) {
+    try {
+      output_directory(out.string());
+    } catch (const Error& e) {
+      const fs::path kept = out.string() + ".new-" + std::to_string(::getpid());
+      fs::rename(tmp, kept, ec);
+      if (ec) throw;
+      fs::remove(kept / kWriting, ec);
+      throw IoError(std::string(e.what()) + " (it changed while this run worked; its output is in " + kept.string() + ")");
+    }
+    write_file_atomic((out / kReplaced).string(), std::to_string(::getpid()) + "\n");
     old = out.string() + ".old-" + std::to_string(::getpid());
     fs::rename(out, old, ec);
-    if (ec) throw IoError(out.string() + ": cannot replace (" + ec.message() + ")");
+    if (ec) {
+      fs::remove(out / kReplaced, ec);
+      throw IoError(out.string() + ": cannot replace (" + ec.message() + ")");
+    }
   }
+  fs::remove(tmp / kWriting, ec);
   fs::rename(tmp, out, ec);
   if (ec) {
     std::error_code restore;
-    if (!old.empty()) fs::rename(old, out, restore);
+    if (!old.empty()) {
+      fs::rename(old, out, restore);
+      fs::remove(out / kReplaced, restore);
+    }
     throw IoError(out.string() + ": " + ec.message());
   }
   if (!old.empty() && (fs::remove_all(old, ec), ec))
@@ -492,10 +555,11 @@ int run_match(const MatchArgs& args) {
 
   stage.reset();
   const fs::path tmp = out.string() + ".tmp-" + std::to_string(::getpid());
-  std::error_code left;
-  fs::remove_all(tmp, left);  // (left by an earlier process that had this pid: the sweep spares ours)
+  if (std::error_code there; fs::exists(fs::symlink_status(tmp, there)))  // (the sweep removed any of ours)
+    throw IoError(tmp.string() + ": exists, and is not a run's temporary output; remove it");
   fs::create_directories(tmp);
   try {
+    write_file_atomic((tmp / kWriting).string(), std::to_string(::getpid()) + "\n");
     write_file_atomic((tmp / "map_x_to_y.txt").string(), lines(maps.x_to_y));
     write_file_atomic((tmp / "map_y_to_x.txt").string(), lines(maps.y_to_x));
     write_file_atomic((tmp / "map_x_to_y_points.txt").string(), point_map_text(points.x_to_y));

@@ -430,16 +430,22 @@ TEST_CASE("cli: match replaces only an earlier output, and sweeps what a stopped
   CHECK(fs::exists(out / "report.json"));
   CHECK_FALSE(fs::exists(out / "note.txt"));  // (the whole directory is the run's)
 
-  // What a run stopped while writing leaves (its process gone): its temporary directory is
-  // removed; the output it was replacing goes back in place if nothing took its place.
+  // What a run stopped while writing leaves (its process gone, its marker inside): its temporary
+  // directory is removed; the output it was replacing goes back in place if nothing took its
+  // place. Folders of the same names without the markers are the user's: left alone.
   const pid_t child = fork();
   if (child == 0) _exit(0);
   REQUIRE(child > 0);
   waitpid(child, nullptr, 0);  // a process id that is no one's now
   const std::string gone = std::to_string(child);
   fs::create_directories(base / ("out.tmp-" + gone));
+  { std::ofstream(base / ("out.tmp-" + gone) / ".shapematch-writing") << gone << "\n"; }
+  { std::ofstream(out / ".shapematch-replaced") << gone << "\n"; }
   fs::rename(out, base / ("out.old-" + gone));
-  fs::create_directories(base / "out.tmp-notapid");  // (not of the pattern: kept)
+  for (const char* user : {"out.tmp-notapid", "out.old-2023", "out.tmp-2024"}) {
+    fs::create_directories(base / user);
+    std::ofstream(base / user / "mine.txt") << "keep";
+  }
   REQUIRE(run(pair + "-o " + (base / "other").string()).code == 0);  // (another output's run sweeps none of them)
   CHECK(fs::exists(base / ("out.tmp-" + gone)));
   CHECK(fs::exists(base / ("out.old-" + gone)));
@@ -447,12 +453,33 @@ TEST_CASE("cli: match replaces only an earlier output, and sweeps what a stopped
   REQUIRE(again.code == 0);
   CHECK(again.err.find("put back as " + out.string()) != std::string::npos);
   CHECK(again.err.find("out.tmp-" + gone + ": removed") != std::string::npos);
-  CHECK_FALSE(fs::exists(base / ("out.tmp-" + gone)));
-  CHECK_FALSE(fs::exists(base / ("out.old-" + gone)));
-  CHECK(fs::exists(base / "out.tmp-notapid"));
   CHECK(fs::exists(out / "report.json"));
-  for (const auto& entry : fs::directory_iterator(base))  // nothing of this run's own left beside it
-    CHECK(entry.path().filename().string().rfind("out.tmp-" + std::to_string(::getpid()), 0) != 0);
+  CHECK_FALSE(fs::exists(out / ".shapematch-replaced"));
+  CHECK_FALSE(fs::exists(out / ".shapematch-writing"));
+  std::vector<std::string> siblings;  // of the output, left beside it
+  for (const auto& entry : fs::directory_iterator(base)) {
+    const std::string name = entry.path().filename().string();
+    if (name.rfind("out.", 0) == 0) siblings.push_back(name);
+  }
+  std::sort(siblings.begin(), siblings.end());
+  CHECK(siblings == std::vector<std::string>{"out.old-2023", "out.tmp-2024", "out.tmp-notapid"});
+  for (const char* user : {"out.tmp-notapid", "out.old-2023", "out.tmp-2024"}) CHECK(fs::exists(base / user / "mine.txt"));
+
+  // A folder of the user's with a report.json of its own is not a match output.
+  const fs::path report_only = base / "report_only";
+  fs::create_directories(report_only);
+  { std::ofstream(report_only / "report.json") << "{\"title\": \"my report\"}\n"; }
+  check_usage_error(run(pair + "-o " + report_only.string()), report_only.string() + ": exists and is not a match output");
+  CHECK(fs::exists(report_only / "report.json"));
+  // A symbolic link, the current directory: refused too.
+  fs::create_directory_symlink(out, base / "link");
+  check_usage_error(run(pair + "-o " + (base / "link").string()), "is a symbolic link");
+  const fs::path here = base / "here";
+  fs::create_directories(here);
+  const std::string in_here = "cd " + here.string() + " && " + SHAPEMATCH_CLI + " " + pair;
+  check_usage_error(shapematch::test::run_command(in_here + "-o ."), here.string() + ": is the current directory or holds it");
+  check_usage_error(shapematch::test::run_command(in_here + "-o .."), base.string() + ": is the current directory or holds it");
+  CHECK(fs::is_empty(here));
   fs::remove_all(base);
 }
 
@@ -503,6 +530,8 @@ TEST_CASE("cli: usage errors are one documented line with exit 1") {
   check_usage_error(run(b + "-o elsewhere"), "bench match: -o after `--` is set by the benchmark for each run");
   check_usage_error(run(b + "--faces 10"), "bench match: --faces after `--` is set by the benchmark");
   check_usage_error(run(b + "--checkpoint=c"), "bench match: --checkpoint after `--`");
+  check_usage_error(run(b + "--help"), "bench match: --help after `--`: the options there are those of `shapematch match --help`");
+  check_usage_error(run(b + "--backend cpu -- x y"), "bench match: a second `--` among the match options");
   check_usage_error(run(b + "--bogus"), "bench match: the match options after `--`: The following argument was not expected: --bogus");
   check_usage_error(run(b + "--lame nan,1"), "the match options after `--`: --lame: must be a finite number, not nan");
   CHECK_FALSE(fs::exists(bench));

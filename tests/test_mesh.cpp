@@ -277,12 +277,25 @@ TEST_CASE("mesh: malformed inputs are rejected with a one-line message") {
     check_invalid(dir.file("notoff.off", "PLY\n"), "missing OFF header");
   }
   SUBCASE("counts that do not match the file") {
-    // One vertex too many declared: the first face line would be read as a fifth vertex.
+    // One vertex too many declared: the first face line is read as a fifth vertex, and the
+    // faces then end in the wrong place; the error names the line that tells why.
     check_invalid(dir.file("more.off", std::string("OFF\n5 3 0\n") + kTetraVertices + kTetraFaces),
-                  "line 7: vertex 4 has 4 numbers, not 3 (is the header's vertex count, 5, right?)");
+                  "not closed: 3 boundary edges (edges with only one face), e.g. (0, 1) (line 7 gave vertex 4 4 "
+                  "numbers: is the header's vertex count, 5, too large?)");
+    check_invalid(dir.file("more2.off", std::string("OFF\n5 2 0\n") + kTetraVertices + kTetraFaces),
+                  "line 10: more data after the 2 faces the header declares (line 7 gave vertex 4 4 numbers");
+    check_invalid(dir.file("more4.off", std::string("OFF\n5 4 0\n") + kTetraVertices + kTetraFaces),
+                  "file ends after 3 of 4 faces (line 7 gave vertex 4 4 numbers");
     // One face too few declared: the last face would be dropped (and the mesh reported open).
     check_invalid(dir.file("fewer.off", std::string("OFF\n4 3 0\n") + kTetraVertices + kTetraFaces),
                   "line 10: more data after the 3 faces the header declares");
+    // Extra numbers on plain vertex lines where the counts hold (colours some writers add): read,
+    // the rest ignored (with a warning).
+    const Mesh coloured = load_mesh(dir.file("plaincolour.off", std::string("OFF\n4 4 0\n1 1 1 255 0 0\n1 -1 -1\n"
+                                                                              "-1 1 -1\n-1 -1 1\n") +
+                                                                  kTetraFaces),
+                                     LoadOptions{.normalize_area = false});
+    CHECK(coloured.vertices[0] == Eigen::Vector3d(1, 1, 1));
     // A COFF vertex carries its colour: extra numbers are its fields there, not a miscount.
     REQUIRE_NOTHROW(load_mesh(dir.file("colour.off", std::string("COFF\n4 4 0\n") +
                                                          "1 1 1 255 0 0 255\n1 -1 -1 0 255 0 255\n"

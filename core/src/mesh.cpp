@@ -57,6 +57,9 @@ struct RawMesh {
   std::vector<Eigen::Vector3d> vertices;
   std::vector<int64_t> indices;    // all polygons' vertex indices, concatenated
   std::vector<size_t> offsets{0};  // polygon p is indices[offsets[p], offsets[p + 1])
+  // What the reader found odd but could parse (OFF: a plain vertex line with more than three
+  // numbers): added to a validation error, which it may explain, else a warning.
+  std::string oddity;
 
   size_t num_polygons() const { return offsets.size() - 1; }
   void end_polygon() { offsets.push_back(indices.size()); }
@@ -121,8 +124,9 @@ RawMesh read_off(const std::string& path) {
   const std::string_view key = t[0];
   if (key.size() < 3 || key.substr(key.size() - 3) != "OFF") fail(path, "missing OFF header");
   if (key.find_first_of("4n") != std::string_view::npos) fail(path, "only 3D OFF files are supported");
-  // A plain OFF vertex is three numbers and nothing else: more on its line is most often a face
-  // read as a vertex because the header's count is too large. (COFF, NOFF, STOFF… add fields.)
+  // A plain OFF vertex is three numbers: more on its line is most often a face read as a vertex
+  // because the header's count is too large, which then fails in the faces, and the error says so.
+  // (Some writers put colours there all the same. COFF, NOFF, STOFF… add fields of their own.)
   // (Decided now: `key` views the reader's line, which the next line replaces.)
   const bool plain = key == "OFF";
   if (t.size() > 1 && t[1] == "BINARY") fail(path, "binary OFF is not supported");
@@ -147,31 +151,44 @@ RawMesh read_off(const std::string& path) {
     }
     return s;
   };
+  int64_t wide_line = 0, wide_vertex = -1;  // the first plain vertex line with more than three numbers
+  size_t wide_count = 0;
   for (int64_t i = 0; i < nv; ++i) {
     if (!reader.next(t)) fail(path, fmt::format("file ends after {} of {} vertices", i, nv));
     Eigen::Vector3d p;
     if (t.size() < 3 || !parse(t[0], p.x()) || !parse(t[1], p.y()) || !parse(t[2], p.z()))
       fail(path, fmt::format("line {}: vertex {} needs three numbers, got '{}'", reader.line_number(), i,
                              vertex_tokens(t)));
-    if (plain && t.size() > 3)
-      fail(path, fmt::format("line {}: vertex {} has {} numbers, not 3 (is the header's vertex count, {}, right?)",
-                             reader.line_number(), i, t.size(), nv));
+    if (plain && t.size() > 3 && wide_vertex < 0) {
+      wide_line = reader.line_number();
+      wide_vertex = i;
+      wide_count = t.size();
+    }
     raw.vertices.push_back(p);
   }
+  const auto fail_faces = [&](const std::string& problem) {
+    fail(path, wide_vertex < 0 ? problem
+                               : fmt::format("{} (line {} gave vertex {} {} numbers: is the header's vertex count, {}, "
+                                             "too large?)",
+                                             problem, wide_line, wide_vertex, wide_count, nv));
+  };  // (RawMesh::oddity says the same where the faces parse)
   for (int64_t f = 0; f < nf; ++f) {
-    if (!reader.next(t)) fail(path, fmt::format("file ends after {} of {} faces", f, nf));
+    if (!reader.next(t)) fail_faces(fmt::format("file ends after {} of {} faces", f, nf));
     int64_t n = 0;
     if (!parse(t[0], n) || n < 0 || static_cast<int64_t>(t.size()) < n + 1)
-      fail(path, fmt::format("line {}: malformed face {}", reader.line_number(), f));
+      fail_faces(fmt::format("line {}: malformed face {}", reader.line_number(), f));
     for (int64_t k = 1; k <= n; ++k) {
       int64_t index = 0;
-      if (!parse(t[k], index)) fail(path, fmt::format("line {}: malformed face {}", reader.line_number(), f));
+      if (!parse(t[k], index)) fail_faces(fmt::format("line {}: malformed face {}", reader.line_number(), f));
       raw.indices.push_back(index);
     }
     raw.end_polygon();
   }
   if (reader.next(t))
-    fail(path, fmt::format("line {}: more data after the {} faces the header declares", reader.line_number(), nf));
+    fail_faces(fmt::format("line {}: more data after the {} faces the header declares", reader.line_number(), nf));
+  if (wide_vertex >= 0)
+    raw.oddity = fmt::format("line {} gave vertex {} {} numbers: is the header's vertex count, {}, too large?",
+                             wide_line, wide_vertex, wide_count, nv);
   return raw;
 }
 
@@ -704,10 +721,18 @@ Mesh load_mesh(const std::string& path, const LoadOptions& options, MeshReport* 
 
   const RawMesh raw = ext == ".off" ? read_off(path) : ext == ".obj" ? read_obj(path) : read_with_openmesh(path, ext);
   int triangulated = 0;
-  Mesh mesh = triangulate(raw, path, options.allow_polygons, triangulated);
-  const int closed = options.close_holes ? close_boundary_loops(mesh) : 0;
+  int closed = 0, genus = 0;
+  Mesh mesh;
+  try {
+    mesh = triangulate(raw, path, options.allow_polygons, triangulated);
+    closed = options.close_holes ? close_boundary_loops(mesh) : 0;
+    genus = validate_mesh(mesh);
+  } catch (const InvalidInputError& e) {
+    if (raw.oddity.empty()) throw;
+    throw InvalidInputError(std::string(e.what()) + " (" + raw.oddity + ")");
+  }
+  if (!raw.oddity.empty()) spdlog::warn("{}: {}; the extra numbers are ignored", path, raw.oddity);
   if (closed > 0) spdlog::warn("{}: closed {} boundary loops with a vertex each", path, closed);
-  const int genus = validate_mesh(mesh);
   mesh.build_edges();
   if (signed_volume(mesh) < 0) {
     spdlog::warn("{}: faces are clockwise seen from outside; reversing all of them", path);

@@ -2354,10 +2354,12 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
     };
     JoinedSolve joined;
     double round_one_weight = 0.0;  // the ω round 1's (first) solve was asked to start from
+    bool round_one_cold = false;     // round 1's solve starts from nothing (not a warm start, a checkpoint)
     int64_t pretest_iterations = 0;  // round 1's solve at zero cost (feasibility_iterations)
     double pretest_seconds = 0.0;
     if (!after_fixing) {
       round_one_weight = params.initial_primal_weight;
+      round_one_cold = params.initial_x.empty() && options.resumed_iterations == 0;
       if (options.first_lp) options.first_lp(red.lp);
       // Round 1's solve (not its pre-test) over the whole LP, for a checkpoint (first_snapshot).
       // (Set below, after the pre-test's parameters are taken; reset after the solve.)
@@ -2713,9 +2715,10 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
         waited = false;
       }
     }
-    // A time limit below the solver's set-up leaves round 1 no iterate to round: each round would
-    // then fix one variable from nothing (measured: match --time-limit 0.01, 268 rounds in 30 s).
-    if (round == 1 && r.status == LpStatus::TimeLimit && r.iterations == 0)
+    // A time limit below the solver's set-up leaves a cold round 1 no iterate to round: each round
+    // would then fix one variable from nothing (measured: match --time-limit 0.01, 268 rounds in
+    // 30 s). (A warm start's iterate, e.g. from a checkpoint, is one.)
+    if (round == 1 && round_one_cold && r.status == LpStatus::TimeLimit && r.iterations == 0)
       throw SolverError(fmt::format("rounding: round {}'s LP reached its time limit ({:g} s) before its first "
                                     "iteration; allow more time per LP (--time-limit)",
                                     round, options.lp.time_limit));
