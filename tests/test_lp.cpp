@@ -88,6 +88,19 @@ TEST_CASE("lp: the certified lower bound holds for arbitrary duals") {
   }
 }
 
+TEST_CASE("lp: with costs all non-negative the certified bound is never below 0") {
+  // x0 + x1 = 1 in the box, costs 1 and 2: optimum 1. L(y) = y + min(0, 1 − y) + min(0, 2 − y).
+  const LpProblem costs = dense_lp({{1, 1}}, {1}, {1, 2});
+  CHECK(certified_lower_bound(costs, {1.0}) == doctest::Approx(1.0));  // the optimum's dual
+  CHECK(certified_lower_bound(costs, {0.5}) == doctest::Approx(0.5));
+  CHECK(certified_lower_bound(costs, {-5.0}) == 0.0);  // L = −5
+  CHECK(certified_lower_bound(costs, {4.0}) == 0.0);   // L = 4 − 3 − 2 = −1
+  // A negative cost: 0 bounds nothing, L(y) as it is.
+  const LpProblem negative = dense_lp({{1, 1}}, {1}, {1, -2});
+  CHECK(certified_lower_bound(negative, {-5.0}) == doctest::Approx(-5.0));  // −5 + min(0, 6) + min(0, 3)
+  CHECK(std::isnan(certified_lower_bound(costs, {std::nan("")})));
+}
+
 TEST_CASE("lp: the Farkas rate is positive along an infeasible LP's ray and never on a feasible LP") {
   // x0 + x1 = 3 in the box: d = 1 gives 3 − 2 = 1 > 0; Clp's ray likewise.
   const LpProblem bad = dense_lp({{1, 1, 0, 0}, {0, 0, 1, 1}, {0, 0, 1, -1}}, {3, 1, 0}, {1, 1, 1, 2});

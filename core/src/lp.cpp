@@ -65,7 +65,9 @@ double lagrangian(const LpProblem& p, const std::vector<double>& y, bool costs) 
 
 double certified_lower_bound(const LpProblem& p, const std::vector<double>& y) {
   if (y.size() != size_t(p.rows())) return -std::numeric_limits<double>::infinity();
-  return p.objective_scale * lagrangian(p, y, true);
+  const double bound = p.objective_scale * lagrangian(p, y, true);
+  const bool nonnegative = p.objective_scale >= 0.0 && std::all_of(p.c.begin(), p.c.end(), [](double c) { return c >= 0.0; });
+  return nonnegative ? std::max(bound, 0.0) : bound;
 }
 
 double farkas_rate(const LpProblem& p, const std::vector<double>& d) {
