@@ -1,5 +1,6 @@
 #include "shapematch/constraints.hpp"
 #include "shapematch/shapes.hpp"
+#include "shapematch/system.hpp"
 #include "test_helpers.hpp"
 
 #include "sorted_index.hpp"
@@ -208,4 +209,29 @@ TEST_CASE("constraints: a reduced space gives the same rows by the bitmap as by 
     }
     CHECK(cs.closedness_rows < whole.closedness_rows);
   }
+}
+
+TEST_CASE("constraints: an LP larger than the memory available is refused in one line naming the meshes") {
+  const Mesh x = shapes::icosphere(1), y = shapes::octahedron();
+  const int64_t n = ProductSpace::full_size(x, y);
+  // Enough, or unknown (0): no check.
+  CHECK_NOTHROW(check_lp_memory(x, y, n, n * kLpBytesPerVariable));
+  CHECK_NOTHROW(check_lp_memory(x, y, n, 0));
+  // One byte short.
+  try {
+    check_lp_memory(x, y, n, n * kLpBytesPerVariable - 1);
+    FAIL("no exception");
+  } catch (const InvalidInputError& e) {
+    const std::string what = e.what();
+    CAPTURE(what);
+    CHECK(what.rfind(x.name + " × " + y.name + " (" + std::to_string(x.num_faces()) + " × " +
+                         std::to_string(y.num_faces()) + " faces): the LP over " + std::to_string(n) +
+                         " product triangles needs about",
+                     0) == 0);
+    CHECK(what.find("more than the") != std::string::npos);
+    CHECK(what.find('\n') == std::string::npos);
+  }
+  // build_constraints checks against this machine's memory, which Linux reports.
+  CHECK(available_memory_bytes() > 0);
+  CHECK_NOTHROW(build_constraints(ProductSpace::full(x, y)));
 }

@@ -2,7 +2,10 @@
 
 #include "parallel.hpp"
 #include "shapematch/errors.hpp"
+#include "shapematch/system.hpp"
 #include "sorted_index.hpp"
+
+#include <spdlog/fmt/fmt.h>
 
 #include <algorithm>
 
@@ -55,11 +58,23 @@ int64_t full_product_edge_count(const Mesh& x, const Mesh& y) {
   return 2 * ex * ey + vx * ey + ex * vy;
 }
 
+void check_lp_memory(const Mesh& x, const Mesh& y, int64_t variables, uint64_t available_bytes) {
+  const double needed = double(variables) * double(kLpBytesPerVariable);
+  if (available_bytes == 0 || needed <= double(available_bytes)) return;
+  throw InvalidInputError(fmt::format(
+      "{} × {} ({} × {} faces): the LP over {} product triangles needs about {:.1f} GB, more than the {:.1f} GB "
+      "this machine has available; decimate (--faces) or free memory",
+      x.name, y.name, x.num_faces(), y.num_faces(), variables, needed / 1e9, double(available_bytes) / 1e9));
+}
+
 ConstraintSystem build_constraints(const ProductSpace& space) {
   const Mesh& X = space.x();
   const Mesh& Y = space.y();
   const int64_t n = space.size();
-  if (n >= (int64_t(1) << 31)) throw InvalidInputError("product space too large: " + std::to_string(n) + " variables");
+  if (n >= (int64_t(1) << 31))
+    throw InvalidInputError(fmt::format("{} × {} ({} × {} faces): product space too large: {} variables (at most 2³¹)",
+                                        X.name, Y.name, X.num_faces(), Y.num_faces(), n));
+  check_lp_memory(X, Y, n, available_memory_bytes());
 
   // Pass 1: boundary edges of every variable (ids and signs) and the π rows it touches.
   std::vector<int64_t> edge_id(3 * n);

@@ -3,6 +3,8 @@
 #include "shapematch/product_space.hpp"
 #include "shapematch/sparse.hpp"
 
+#include <cstdint>
+
 namespace shapematch {
 
 // A product edge (u1->u2 on X, w1->w2 on Y) in canonical orientation, encoded as one integer
@@ -26,7 +28,19 @@ struct ConstraintSystem {
   std::vector<int64_t> row_edge; // product-edge id of each closedness row
 };
 
-// Assembles A, Aᵀ and b for the given product space. Multi-threaded over variables.
+// What an LP over one product triangle takes in memory, about: its assembly, A and Aᵀ, and a
+// native PDHG solve's vectors. Measured with `lp --max-iter 1 --solver pdhg-cpu` on TOSCA_r
+// horse0-horse5 decimated to 200 and 400 faces (0.88 M and 3.52 M variables): 148 and 558 MiB
+// peak, 162 bytes per variable more.
+inline constexpr uint64_t kLpBytesPerVariable = 160;
+
+// Throws InvalidInputError naming both meshes where an LP of `variables` product triangles would
+// need more than `available_bytes` (0: unknown, no check): a huge input gets a one-line error
+// rather than the kernel's out-of-memory kill half way through.
+void check_lp_memory(const Mesh& x, const Mesh& y, int64_t variables, uint64_t available_bytes);
+
+// Assembles A, Aᵀ and b for the given product space. Multi-threaded over variables. Checks the
+// memory first (check_lp_memory, against what the system has available now).
 ConstraintSystem build_constraints(const ProductSpace& space);
 
 }  // namespace shapematch

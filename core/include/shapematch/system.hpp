@@ -1,11 +1,16 @@
 #pragma once
 // Process-level measurements shared by the command line, the reports and the benchmarks.
 #include <chrono>
+#include <cstdint>
 
 namespace shapematch {
 
 // Peak resident set size of this process so far, in MiB.
 double peak_rss_mb();
+
+// Memory the system can give without swapping (MemAvailable of /proc/meminfo), in bytes; 0 where
+// it cannot be read.
+uint64_t available_memory_bytes();
 
 // Threads of this process's parallel loops (assembly, pricing, the native PDHG kernels): the
 // CPUs it may run on (its affinity mask, so `taskset` limits it), or fewer where
