@@ -159,6 +159,8 @@ std::vector<int> true_map(const MatchArgs& args, const MeshPair& p, std::string&
 
 // auto: a GPU if there is one, else the native solver (lavapipe is for testing, not speed).
 std::string solver_for(const MatchArgs& a) {
+  if (a.device >= 0 && a.backend != "auto" && a.backend != "vulkan")
+    spdlog::warn("--device {} is for the Vulkan backend; --backend {} does not use it", a.device, a.backend);
   if (a.backend == "cpu") return "pdhg-cpu";
   if (a.backend == "cpu-f32") return "pdhg-cpu-f32";
   if (a.backend == "vulkan") return "pdhg-vulkan";

@@ -503,6 +503,13 @@ TEST_CASE("cli: usage errors are one documented line with exit 1") {
   check_usage_error(device, "");
   CHECK((device.err.find("device 99 does not exist") != std::string::npos ||
          device.err.find("Vulkan") != std::string::npos));  // (or no Vulkan at all on this machine)
+  // … and with a backend that uses no device, a warning that it is not used.
+  const fs::path unused = fs::temp_directory_path() / "shapematch_cli_usage_unused_device";
+  fs::remove_all(unused);
+  const Run cpu = run("match " + tetra + " " + tetra + " --backend cpu --device 3 -o " + unused.string());
+  CHECK(cpu.code == 0);
+  CHECK(cpu.err.find("--device 3 is for the Vulkan backend; --backend cpu does not use it") != std::string::npos);
+  fs::remove_all(unused);
   CHECK(run("match --help").code == 0);
   CHECK(run("--version").code == 0);
   // +∞ is a limit that means none.
