@@ -488,16 +488,22 @@ TEST_CASE("cli: usage errors are one documented line with exit 1") {
   const fs::path never = fs::temp_directory_path() / "shapematch_cli_usage_never";  // (no run gets to write it)
   fs::remove_all(never);
   const std::string pair = "match " + tetra + " " + tetra + " --backend cpu -o " + never.string() + " ";
-  check_usage_error(run(""), "A subcommand is required");
-  check_usage_error(run("match --no-such-option"), "--no-such-option");
-  check_usage_error(run(pair + "--tol -1"), "--tol: must be positive, not -1");
-  check_usage_error(run(pair + "--tol 0"), "--tol: must be positive, not 0");
-  check_usage_error(run(pair + "--faces -5"), "--faces: must not be negative, not -5");
-  check_usage_error(run(pair + "--bending nan"), "--bending: must be a finite number, not nan");
-  check_usage_error(run(pair + "--lame 1,inf"), "--lame: must be a finite number, not inf");
-  check_usage_error(run(pair + "--time-limit -inf"), "--time-limit: must be positive");
-  check_usage_error(run("lp --max-iter -3"), "--max-iter: must be positive, not -3");
-  check_usage_error(run("lp --time-limit 0"), "--time-limit: must be positive, not 0");
+  const std::vector<std::pair<std::string, std::string>> refused = {  // (arguments, the error says)
+      {"", "A subcommand is required"},
+      {"match --no-such-option", "--no-such-option"},
+      {pair + "--tol -1", "--tol: must be positive, not -1"},
+      {pair + "--tol 0", "--tol: must be positive, not 0"},
+      {pair + "--faces -5", "--faces: must not be negative, not -5"},
+      {pair + "--bending nan", "--bending: must be a finite number, not nan"},
+      {pair + "--lame 1,inf", "--lame: must be a finite number, not inf"},
+      {pair + "--time-limit -inf", "--time-limit: must be positive"},
+      {"lp --max-iter -3", "--max-iter: must be positive, not -3"},
+      {"lp --time-limit 0", "--time-limit: must be positive, not 0"},
+  };
+  for (const auto& [args, expect] : refused) {
+    CAPTURE(args);
+    check_usage_error(run(args), expect);
+  }
   // A device asked for by index that is not there: an error, not a quiet fall back to the CPU.
   const Run device = run("match " + tetra + " " + tetra + " --backend auto --device 99 -o " + never.string());
   check_usage_error(device, "");
@@ -534,13 +540,19 @@ TEST_CASE("cli: usage errors are one documented line with exit 1") {
   const fs::path bench = fs::temp_directory_path() / "shapematch_cli_bench_usage";
   fs::remove_all(bench);
   const std::string b = "bench match --pairs " + pairs.string() + " --faces 30 --out " + bench.string() + " -- ";
-  check_usage_error(run(b + "-o elsewhere"), "bench match: -o after `--` is set by the benchmark for each run");
-  check_usage_error(run(b + "--faces 10"), "bench match: --faces after `--` is set by the benchmark");
-  check_usage_error(run(b + "--checkpoint=c"), "bench match: --checkpoint after `--`");
-  check_usage_error(run(b + "--help"), "bench match: --help after `--`: the options there are those of `shapematch match --help`");
-  check_usage_error(run(b + "--backend cpu -- x y"), "bench match: a second `--` among the match options");
-  check_usage_error(run(b + "--bogus"), "bench match: the match options after `--`: The following argument was not expected: --bogus");
-  check_usage_error(run(b + "--lame nan,1"), "the match options after `--`: --lame: must be a finite number, not nan");
+  const std::vector<std::pair<std::string, std::string>> refused_by_bench = {  // (arguments, the error says)
+      {b + "-o elsewhere", "bench match: -o after `--` is set by the benchmark for each run"},
+      {b + "--faces 10", "bench match: --faces after `--` is set by the benchmark"},
+      {b + "--checkpoint=c", "bench match: --checkpoint after `--`"},
+      {b + "--help", "bench match: --help after `--`: the options there are those of `shapematch match --help`"},
+      {b + "--backend cpu -- x y", "bench match: a second `--` among the match options"},
+      {b + "--bogus", "bench match: the match options after `--`: The following argument was not expected: --bogus"},
+      {b + "--lame nan,1", "the match options after `--`: --lame: must be a finite number, not nan"},
+  };
+  for (const auto& [args, expect] : refused_by_bench) {
+    CAPTURE(args);
+    check_usage_error(run(args), expect);
+  }
   CHECK_FALSE(fs::exists(bench));
   CHECK_FALSE(fs::exists(never));
 }
