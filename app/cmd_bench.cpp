@@ -364,12 +364,24 @@ std::string plot(const std::string& script_name, const std::string& csv_path, co
   return png_path;
 }
 
+// A benchmark's --out folder (and `sub` in it), made where missing: one line naming it where it
+// cannot be (a file there, no permission), before any run, not "internal error".
+void make_output_folder(const fs::path& out, const fs::path& sub = {}) {
+  const fs::path folder = sub.empty() ? out : out / sub;
+  std::error_code ec;
+  fs::create_directories(folder, ec);
+  if (ec || !fs::is_directory(folder))
+    throw IoError(folder.string() + ": cannot make this output folder (" + (ec ? ec.message() : "a file is there") + ")");
+}
+
 int run_bench_lp(BenchLpArgs args) {
   if (args.pair.empty()) args.pair = default_bench_lp_pair();
   std::sort(args.faces.begin(), args.faces.end());  // "timed out, skip larger sizes" needs ascending sizes
-  fs::create_directories(args.out);
+  make_output_folder(args.out);
   const std::string csv_path = (fs::path(args.out) / "bench_lp.csv").string();
   const std::string png_path = (fs::path(args.out) / "bench_lp.png").string();
+  check_writable_file(csv_path);
+  check_writable_file(png_path);
 
   double bandwidth_gbps = kNaN;
   if (args.bandwidth) {
@@ -715,7 +727,7 @@ int run_bench_scaling(const BenchMatchArgs& args) {
   std::stable_sort(sizes.begin(), sizes.end(), [&](const auto& a, const auto& b) { return order(a) < order(b); });
 
   const fs::path out(args.out);
-  fs::create_directories(out / "runs");
+  make_output_folder(out, "runs");
   const std::string csv_path = (out / "bench_match.csv").string();
   std::vector<MatchRow> rows;
   bool gave_up = false;
@@ -1071,7 +1083,7 @@ int run_bench_pairs(const BenchMatchArgs& asked) {
   args.jobs = static_cast<int>(std::clamp<size_t>(pairs.size(), 1, std::max(1, asked.jobs)));
   const std::string faces = args.faces.empty() ? std::string() : std::to_string(faces_value(args.faces[0]));
   const fs::path out(args.out);
-  fs::create_directories(out / "runs");
+  make_output_folder(out, "runs");
   const std::string csv_path = (out / "bench_pairs.csv").string(), md_path = (out / "bench_pairs.md").string();
   // Names and directories first, in the file's order, so that they do not depend on which run
   // ends first.

@@ -19,8 +19,10 @@
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
+#include <map>
 #include <optional>
 #include <random>
+#include <set>
 
 namespace fs = std::filesystem;
 
@@ -95,7 +97,11 @@ void plot(const std::string& csv_path, const std::string& png_path, const std::s
   }
   const std::string cmd = python + " " + shell_quote(script.string()) + " " + shell_quote(csv_path) + " " +
                           shell_quote(png_path) + " " + shell_quote(label) + " >&2";
-  if (std::system(cmd.c_str()) != 0) spdlog::warn("plotting failed ({})", cmd);
+  if (std::system(cmd.c_str()) != 0) {
+    spdlog::warn("plotting failed ({})", cmd);
+    std::error_code ec;
+    fs::remove(png_path + ".tmp", ec);  // (plot_pck.py's, where savefig wrote it and the rename failed)
+  }
 }
 
 // Per ground-truth pair (0-based input vertices): X's vertex, its true image, the map's image and
@@ -138,10 +144,42 @@ std::vector<std::array<uint8_t, 3>> error_colors(const Mesh& x, const GroundTrut
   return colors;
 }
 
+// The files eval is asked to write, checked before any geodesic is solved (a full-resolution
+// evaluation takes minutes): each writable, no two the same, none a file it reads (the match
+// directory's own files, the ground truth, the meshes given).
+void check_outputs(const EvalArgs& args, const fs::path& dir) {
+  const std::vector<std::pair<const char*, const std::string*>> outputs = {
+      {"--pck-csv", &args.pck_csv}, {"--pck-png", &args.pck_png}, {"--errors-csv", &args.errors_csv},
+      {"--errors-ply", &args.errors_ply}};
+  std::set<fs::path> inputs;
+  const auto key = [](const std::string& path) {
+    std::error_code ec;
+    const fs::path p = fs::weakly_canonical(path, ec);
+    return ec ? fs::absolute(path).lexically_normal() : p;
+  };
+  for (const fs::path& folder : {dir, dir / "levels"}) {
+    std::error_code ec;
+    for (auto it = fs::directory_iterator(folder, ec); !ec && it != fs::directory_iterator(); it.increment(ec))
+      if (it->is_regular_file()) inputs.insert(key(it->path().string()));
+  }
+  for (const std::string* in : {&args.gt_x, &args.gt_y, &args.gt_y_sym, &args.gt_map, &args.x_mesh, &args.y_mesh})
+    if (!in->empty()) inputs.insert(key(*in));
+  std::map<fs::path, const char*> seen;
+  for (const auto& [option, path] : outputs) {
+    if (path->empty()) continue;
+    check_writable_file(*path);
+    const fs::path k = key(*path);
+    if (inputs.count(k)) throw InvalidInputError(*path + ": " + option + " would overwrite a file eval reads");
+    if (const auto [at, fresh] = seen.emplace(k, option); !fresh)
+      throw InvalidInputError(*path + ": named by both " + at->second + " and " + option);
+  }
+}
+
 int run_eval(const EvalArgs& args) {
   Stopwatch total;
   const fs::path dir(args.dir);
   if (!fs::is_directory(dir)) throw IoError(args.dir + ": not a directory (expected an output of `shapematch match`)");
+  check_outputs(args, dir);
   const fs::path report_path = dir / "report.json";
   const JsonNode report = read_json_file(report_path.string());
   auto field = [&](const std::string& side, const std::string& key, JsonNode::Kind kind) -> const JsonNode& {
@@ -445,7 +483,9 @@ Action add_eval_command(CLI::App& app) {
           },
           "POSITIVE"))
       ->capture_default_str();
-  app.add_option("--threads", a->threads, "geodesic solves in parallel (0: all cores)")->capture_default_str();
+  app.add_option("--threads", a->threads, "geodesic solves in parallel (0: all cores)")
+      ->check(non_negative_number())
+      ->capture_default_str();
   return [a] { return run_eval(*a); };
 }
 

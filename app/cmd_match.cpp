@@ -322,10 +322,20 @@ int run_match(const MatchArgs& args) {
     throw InvalidInputError("--truth* and --checkpoint exclude each other (a diagnostic run is not gone on from)");
   const fs::path out = output_directory(args.out);
   remove_stale_siblings(out);
+  // The device first: a missing driver or device is an error before minutes of loading and assembly.
+  if (args.backend == "vulkan") choose_device(args.device);
   const MeshPair p = load_pair(args.pair);
 
   CoarseToFineOptions co;
   co.hierarchy = args.hierarchy;
+  // Shapes both at or below the coarsest size would repeat the same level (each level the same
+  // full product space): one level does that work once.
+  if (co.hierarchy.levels != 1 && p.x.num_faces() <= co.hierarchy.coarsest_faces &&
+      p.y.num_faces() <= co.hierarchy.coarsest_faces) {
+    spdlog::warn("both shapes have at most --coarsest-faces {} faces ({} and {}): one level", co.hierarchy.coarsest_faces,
+                 p.x.num_faces(), p.y.num_faces());
+    co.hierarchy.levels = 1;
+  }
   if (co.hierarchy.second_faces > 0 && co.hierarchy.second_faces <= co.hierarchy.coarsest_faces)
     spdlog::warn("--second-faces {} is not above --coarsest-faces {}: no second start", co.hierarchy.second_faces,
                  co.hierarchy.coarsest_faces);

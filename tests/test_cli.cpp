@@ -516,6 +516,22 @@ TEST_CASE("cli: usage errors are one documented line with exit 1") {
   CHECK(cpu.code == 0);
   CHECK(cpu.err.find("--device 3 is for the Vulkan backend; --backend cpu does not use it") != std::string::npos);
   fs::remove_all(unused);
+  // The Vulkan driver before the meshes: a missing one is an error before any loading.
+  const Run no_driver = shapematch::test::run_command("VK_ICD_FILENAMES=/nonexistent.json " + std::string(SHAPEMATCH_CLI) +
+                                                      " match " + tetra + " " + tetra + " --backend vulkan -o " +
+                                                      never.string());
+  check_usage_error(no_driver, "Vulkan");
+  CHECK(no_driver.err.find("info X: ") == std::string::npos);
+  // bench's output folder where a file is: one line, before any run.
+  check_usage_error(run("bench lp --out " + tetra), tetra + ": cannot make this output folder");
+  // Both shapes at or below the coarsest size: one level, not the same level three times.
+  const fs::path small = fs::temp_directory_path() / "shapematch_cli_usage_small";
+  fs::remove_all(small);
+  const Run one = run("match --faces 30 --levels 3 --backend cpu -o " + small.string());
+  CHECK(one.code == 0);
+  CHECK(one.err.find("both shapes have at most --coarsest-faces 100 faces (30 and 30): one level") != std::string::npos);
+  CHECK(one.err.find("level 1/1:") != std::string::npos);
+  fs::remove_all(small);
   CHECK(run("match --help").code == 0);
   CHECK(run("--version").code == 0);
   // +∞ is a limit that means none.

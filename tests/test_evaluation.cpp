@@ -775,3 +775,37 @@ TEST_CASE("evaluation: a true map at the matched resolution takes the nearest gr
   CHECK_THROWS_AS(truth_at(m, m, ids, ids, {}), InvalidInputError);
   CHECK_THROWS_AS(truth_at(m, m, ids, ids, {{m.num_vertices(), 0}}), InvalidInputError);
 }
+
+TEST_CASE("evaluation: shapematch eval checks its output files before scoring") {
+  const fs::path dir = scratch("cli_outputs");
+  const fs::path out = dir / "match";
+  REQUIRE(run_cli("match --faces 30 --backend cpu -o " + out.string()).code == 0);
+  const std::string eval = "eval " + out.string() + " --gt identity ";
+  fs::create_directories(dir / "folder");
+  struct Case {
+    std::string options, error;
+  };
+  const std::vector<Case> refused = {
+      {"--errors-csv " + (dir / "same.csv").string() + " --pck-csv " + (dir / "same.csv").string(),
+       (dir / "same.csv").string() + ": named by both --pck-csv and --errors-csv"},
+      {"--pck-csv " + (out / "report.json").string(), (out / "report.json").string() + ": --pck-csv would overwrite a file eval reads"},
+      {"--errors-csv " + (out / "map_x_to_y.txt").string(), "would overwrite a file eval reads"},
+      {"--errors-csv " + (dir / "folder").string(), (dir / "folder").string() + ": is a directory, not a file"},
+      {"--pck-png " + (dir / "missing" / "p.png").string(), "its folder " + (dir / "missing").string() + " does not exist"},
+      {"--threads -1", "--threads: must not be negative"},
+  };
+  for (const auto& c : refused) {
+    CAPTURE(c.options);
+    const Run r = run_cli(eval + c.options);
+    CHECK(r.code == 1);
+    CHECK(r.out.empty());  // before any scoring: no JSON
+    CHECK(r.err.find(c.error) != std::string::npos);
+    CHECK(r.err.find("geodesic") == std::string::npos);  // (nothing solved)
+  }
+  CHECK(fs::exists(out / "report.json"));
+  CHECK_FALSE(fs::exists(dir / "same.csv"));
+  // A new file inside the match directory is fine.
+  const Run ok = run_cli(eval + "--pck-csv " + (out / "pck.csv").string());
+  CHECK(ok.code == 0);
+  CHECK(fs::exists(out / "pck.csv"));
+}

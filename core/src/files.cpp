@@ -46,6 +46,16 @@ void write_file_atomic(const std::string& path, const std::string& text) {
   write_file_atomic(path, [&](std::ostream& out) { out << text; });
 }
 
+void check_writable_file(const std::string& path) {
+  std::error_code ec;
+  if (path.empty()) throw IoError("an output file's path is empty");
+  if (fs::is_directory(path, ec)) throw IoError(path + ": is a directory, not a file");
+  fs::path folder = fs::absolute(path, ec).parent_path();
+  if (!fs::is_directory(folder, ec)) throw IoError(path + ": cannot write: its folder " + folder.string() + " does not exist");
+  if (::access(folder.c_str(), W_OK) != 0)
+    throw IoError(path + ": cannot write in " + folder.string() + " (" + std::strerror(errno) + ")");
+}
+
 std::ifstream open_for_reading(const std::string& path, std::ios::openmode mode) {
   std::error_code ec;
   if (fs::is_directory(path, ec)) throw IoError(path + ": is a directory, not a file");

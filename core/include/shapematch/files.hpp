@@ -18,4 +18,8 @@ void write_file_atomic(const std::string& path, const std::string& text);
 // readers would report as a truncated or malformed file.
 std::ifstream open_for_reading(const std::string& path, std::ios::openmode mode = std::ios::in);
 
+// Throws IoError naming `path` where a file could not be written there (it is a directory, its
+// folder is missing or not writable): checked before the work whose result it is to hold.
+void check_writable_file(const std::string& path);
+
 }  // namespace shapematch
