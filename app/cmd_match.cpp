@@ -324,6 +324,7 @@ int run_match(const MatchArgs& args) {
   remove_stale_siblings(out);
   // The device first: a missing driver or device is an error before minutes of loading and assembly.
   if (args.backend == "vulkan") choose_device(args.device);
+  const std::string solver = solver_for(args);
   const MeshPair p = load_pair(args.pair);
 
   CoarseToFineOptions co;
@@ -404,7 +405,7 @@ int run_match(const MatchArgs& args) {
   if (!truth_given(args) && args.truth_rings != defaults.truth_rings)
     spdlog::warn("--truth-rings without --truth, --truth-x or --truth-map: no effect");
   RoundingOptions& ro = co.rounding;
-  ro.solver = solver_for(args);
+  ro.solver = solver;
   ro.threshold = args.threshold;
   ro.alternative_thresholds = args.alternative_thresholds;
   ro.alternatives_below = args.alternatives_below;

@@ -507,6 +507,7 @@ TEST_CASE("cli: usage errors are one documented line with exit 1") {
   // A device asked for by index that is not there: an error, not a quiet fall back to the CPU.
   const Run device = run("match " + tetra + " " + tetra + " --backend auto --device 99 -o " + never.string());
   check_usage_error(device, "");
+  CHECK(device.err.find("info X: ") == std::string::npos);  // (before any mesh is loaded)
   CHECK((device.err.find("device 99 does not exist") != std::string::npos ||
          device.err.find("Vulkan") != std::string::npos));  // (or no Vulkan at all on this machine)
   // … and with a backend that uses no device, a warning that it is not used.
