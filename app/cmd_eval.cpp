@@ -191,6 +191,14 @@ int run_eval(const EvalArgs& args) {
   };
   const int x_input = static_cast<int>(field("x", "vertices_input", JsonNode::Kind::Number).number);
   const int y_input = static_cast<int>(field("y", "vertices_input", JsonNode::Kind::Number).number);
+  // The files' own vertices, which ground truth indexes: with --close-holes the fans' vertices
+  // come after them and have no truth (outputs from before this field: the same count).
+  const auto file_vertices = [&](const std::string& side, int input) {
+    const JsonNode* s = report.get(side);
+    const JsonNode* v = s ? s->get("vertices_file") : nullptr;
+    return v && v->kind == JsonNode::Kind::Number ? std::min(static_cast<int>(v->number), input) : input;
+  };
+  const int x_file_vertices = file_vertices("x", x_input), y_file_vertices = file_vertices("y", y_input);
 
   // The meshes as matched: their own scale, the indices of the maps refer to them.
   LoadOptions as_matched;
@@ -256,19 +264,19 @@ int run_eval(const EvalArgs& args) {
   GroundTruth truth;
   std::string truth_name;
   if (!args.gt_map.empty()) {
-    truth = read_map_ground_truth(args.gt_map, x_input, y_input);
+    truth = read_map_ground_truth(args.gt_map, x_file_vertices, y_file_vertices);
     truth_name = args.gt_map;
   } else if (!args.gt_x.empty()) {
-    truth = read_vts_ground_truth(args.gt_x, args.gt_y, x_input, y_input);
+    truth = read_vts_ground_truth(args.gt_x, args.gt_y, x_file_vertices, y_file_vertices);
     truth_name = args.gt_x + " <-> " + args.gt_y;
   } else {
-    truth = identity_ground_truth(x_input, y_input);
+    truth = identity_ground_truth(x_file_vertices, y_file_vertices);
     truth_name = "identity";
   }
   // Intrinsic symmetries make a left-right swapped map as good as the direct one to the energy
   // and to WKS; benchmarks on these data sets score the better of the two.
   GroundTruth symmetric_truth;
-  if (!args.gt_y_sym.empty()) symmetric_truth = read_vts_ground_truth(args.gt_x, args.gt_y_sym, x_input, y_input);
+  if (!args.gt_y_sym.empty()) symmetric_truth = read_vts_ground_truth(args.gt_x, args.gt_y_sym, x_file_vertices, y_file_vertices);
 
   // φ on the input vertices of X; those that decimation removed have no image.
   std::vector<int> phi(x_input, -1);

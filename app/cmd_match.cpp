@@ -634,16 +634,17 @@ int run_match(const MatchArgs& args) {
                       .set("search_proof_released", r.search_proof_released)
                       .set("seconds", r.seconds));
     Json report = Json::object();
-    auto shape = [](const std::string& file, int input_vertices, const Mesh& mesh) {
+    auto shape = [](const std::string& file, int file_vertices, int input_vertices, const Mesh& mesh) {
       return Json::object()
           .set("file", file)
+          .set("vertices_file", file_vertices)
           .set("vertices_input", input_vertices)
           .set("vertices", mesh.num_vertices())
           .set("faces", mesh.num_faces());
     };
     // Absolute, so that `shapematch eval DIR` finds the inputs from any working directory.
-    report.set("x", shape(fs::absolute(p.x_file).lexically_normal().string(), p.x_input_vertices, x));
-    report.set("y", shape(fs::absolute(p.y_file).lexically_normal().string(), p.y_input_vertices, y));
+    report.set("x", shape(fs::absolute(p.x_file).lexically_normal().string(), p.x_file_vertices, p.x_input_vertices, x));
+    report.set("y", shape(fs::absolute(p.y_file).lexically_normal().string(), p.y_file_vertices, p.y_input_vertices, y));
     report.set("variables", m.lp.cols()).set("constraints", m.lp.rows()).set("nonzeros", m.lp.nonzeros());
     report.set("backend", ro.solver).set("device", rr.first_lp.device).set("threads", worker_threads());
     report.set("energy", rr.energy).set("lower_bound", rr.lower_bound).set("gap", rr.gap);

@@ -44,6 +44,31 @@ void add_pair_options(CLI::App& app, PairArgs& args) {
       ->capture_default_str();
 }
 
+namespace {
+
+// `rows` (one per vertex of the file) extended by a row for each vertex closing a hole (those
+// after the file's, each the centre of its hole's fan): the mean of its neighbours' rows.
+Eigen::MatrixXd with_fan_rows(const Eigen::MatrixXd& rows, const Mesh& mesh) {
+  const int file = static_cast<int>(rows.rows()), n = mesh.num_vertices();
+  if (file == n) return rows;
+  Eigen::MatrixXd all = Eigen::MatrixXd::Zero(n, rows.cols());
+  all.topRows(file) = rows;
+  std::vector<int> count(n, 0);
+  for (const auto& f : mesh.faces)
+    for (int k = 0; k < 3; ++k)
+      if (f[k] >= file)
+        for (int other : {f[(k + 1) % 3], f[(k + 2) % 3]})
+          if (other < file) {  // (each ring vertex is in two of the fan's faces: counted twice, evenly)
+            all.row(f[k]) += rows.row(other);
+            ++count[f[k]];
+          }
+  for (int v = file; v < n; ++v)
+    if (count[v] > 0) all.row(v) /= count[v];
+  return all;
+}
+
+}  // namespace
+
 MeshPair load_pair(const PairArgs& args) {
   if (args.x.empty() != args.y.empty()) throw InvalidInputError("give both meshes X and Y, or neither");
   MeshPair p;
@@ -52,17 +77,20 @@ MeshPair load_pair(const PairArgs& args) {
   LoadOptions load;
   load.normalize_area = !args.keep_scale;
   load.close_holes = args.close_holes;
-  auto load_one = [&](const std::string& file) {
+  auto load_one = [&](const std::string& file, int& file_vertices) {
     try {
-      return load_mesh(file, load);
+      MeshReport report;
+      Mesh mesh = load_mesh(file, load, &report);
+      file_vertices = mesh.num_vertices() - report.closed_holes;  // (each closed hole added one vertex, last)
+      return mesh;
     } catch (const InvalidInputError& e) {
       const std::string what = e.what();
       if (what.find(": not closed:") == std::string::npos) throw;
       throw InvalidInputError(what + "; --close-holes fills each hole with a fan");
     }
   };
-  p.x = load_one(p.x_file);
-  p.y = load_one(p.y_file);
+  p.x = load_one(p.x_file, p.x_file_vertices);
+  p.y = load_one(p.y_file, p.y_file_vertices);
   if (args.features_x.empty() != args.features_y.empty())
     throw InvalidInputError("give both --features-x and --features-y, or neither");
   const bool user = !args.features_x.empty();
@@ -71,8 +99,9 @@ MeshPair load_pair(const PairArgs& args) {
     spdlog::warn("features given but --feature-weight is 0: the feature term is off");
   Stopwatch clock;
   if (args.feature_weight > 0 && user) {
-    p.features_x = load_features(args.features_x, p.x.num_vertices());
-    p.features_y = load_features(args.features_y, p.y.num_vertices());
+    // One row per vertex of the file; a closed hole's fan vertex gets the mean of its ring's rows.
+    p.features_x = with_fan_rows(load_features(args.features_x, p.x_file_vertices), p.x);
+    p.features_y = with_fan_rows(load_features(args.features_y, p.y_file_vertices), p.y);
     if (p.features_x.cols() != p.features_y.cols())
       throw InvalidInputError(fmt::format("{} has {} columns but {} has {}", args.features_x, p.features_x.cols(),
                                           args.features_y, p.features_y.cols()));

@@ -39,7 +39,8 @@ void add_pair_options(CLI::App& app, PairArgs& args);
 
 struct MeshPair {
   Mesh x, y;
-  int x_input_vertices = 0, y_input_vertices = 0;
+  int x_input_vertices = 0, y_input_vertices = 0;  // as matched (with --close-holes, the fans' vertices too)
+  int x_file_vertices = 0, y_file_vertices = 0;    // in the files (what ground truth and user features index)
   std::vector<int> x_ids, y_ids;  // each vertex's index in its input file (decimation keeps a subset)
   Eigen::MatrixXd features_x, features_y;  // one row per vertex of x and y; empty without a feature term
   std::string features;                    // "wks", "user" or "none"

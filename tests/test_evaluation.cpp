@@ -809,3 +809,40 @@ TEST_CASE("evaluation: shapematch eval checks its output files before scoring") 
   CHECK(ok.code == 0);
   CHECK(fs::exists(out / "pck.csv"));
 }
+
+TEST_CASE("evaluation: a match with --close-holes keeps the file's vertices for ground truth and user features") {
+  // One face removed from an icosphere: the file has 42 vertices, the matched mesh 43 (the fan's).
+  const fs::path dir = scratch("close_holes_match");
+  Mesh open = shapes::icosphere(1);
+  open.faces.pop_back();
+  std::string text = "OFF\n" + std::to_string(open.num_vertices()) + " " + std::to_string(open.num_faces()) + " 0\n";
+  for (const auto& p : open.vertices) text += fmt::format("{} {} {}\n", p.x(), p.y(), p.z());
+  for (const auto& f : open.faces) text += fmt::format("3 {} {} {}\n", f[0], f[1], f[2]);
+  write(dir / "open.off", text);
+  const int file = open.num_vertices();
+  std::string features;  // one row per vertex of the file, as a user has them
+  for (int v = 0; v < file; ++v) features += fmt::format("{} {}\n", open.vertices[v].x(), open.vertices[v].z());
+  write(dir / "f.txt", features);
+  const fs::path out = dir / "match";
+  const std::string mesh = (dir / "open.off").string(), f = (dir / "f.txt").string();
+  Run r = run_cli("match " + mesh + " " + mesh + " --close-holes --backend cpu --features-x " + f + " --features-y " + f +
+                  " -o " + out.string());
+  REQUIRE_MESSAGE(r.code == 0, r.err);
+  std::ifstream in(out / "report.json");
+  const std::string report((std::istreambuf_iterator<char>(in)), {});
+  CHECK(json_number(report, "vertices_file") == file);
+  CHECK(json_number(report, "vertices_input") == file + 1);
+  // Scored over the file's vertices: the fan's vertex has no truth.
+  r = run_cli("eval " + out.string() + " --gt identity");
+  REQUIRE_MESSAGE(r.code == 0, r.err);
+  CHECK(json_number(r.out, "ground_truth_pairs") == file);
+  CHECK(json_number(r.out, "points") == file);
+  // A ground-truth file that names the fan's vertex is refused, as for the open file itself.
+  std::string vts;
+  for (int v = 1; v <= file + 1; ++v) vts += std::to_string(v) + "\n";
+  write(dir / "all.vts", vts);
+  r = run_cli("eval " + out.string() + " --gt-x " + (dir / "all.vts").string() + " --gt-y " + (dir / "all.vts").string());
+  CHECK(r.code == 1);
+  CHECK(r.err.find(fmt::format("vertex {} is not in 1..{}", file + 1, file)) != std::string::npos);
+  fs::remove_all(dir);
+}
