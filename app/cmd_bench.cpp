@@ -1097,6 +1097,7 @@ int run_bench_pairs(const BenchMatchArgs& asked) {
     // reordered; a pair that comes again (e.g. with other ground truth) is counted: X-Y.2, X-Y.3.
     const int seen = ++times_seen[row.name];
     dirs[i] = out / "runs" / (seen == 1 ? row.name : fmt::format("{}.{}", row.name, seen));
+    row.name = dirs[i].filename().string();  // (the tables' rows named as their runs: X-Y.2 too)
   }
   // The tables list the rows finished so far, in the file's order, rewritten as each one ends.
   std::vector<char> finished(pairs.size(), 0);
@@ -1120,6 +1121,15 @@ int run_bench_pairs(const BenchMatchArgs& asked) {
       spdlog::info("pair {} of {}: {} (resumed from {}.run.json)", i + 1, pairs.size(), row.name, dirs[i].string());
     } else {
       spdlog::info("pair {} of {}: {}", i + 1, pairs.size(), row.name);
+      // Ground truth that is not there fails the row before its match (a missing mesh fails the
+      // match at once; a missing .vts would be found only by eval, after the whole match).
+      for (size_t k = 1; k < pair.truth.size(); ++k)
+        if (pair.truth[k - 1].rfind("--gt-", 0) == 0 && !fs::is_regular_file(pair.truth[k])) {
+          row.run.status = "failed: " + pair.truth[k] + ": ground truth not found";
+          spdlog::warn("{}: {}", row.name, row.run.status);
+          finish(i);
+          return;
+        }
       // With --resume, a checkpoint, so that a run stopped in a fine level loses only that level.
       const fs::path checkpoint = args.resume ? fs::path(dirs[i].string() + ".ckpt") : fs::path();
       // A run killed while saving its checkpoint leaves the temporary file (files.hpp, one per

@@ -230,6 +230,32 @@ fs::path output_directory(const std::string& arg) {
   return out;
 }
 
+// Whether the process a leftover's name ends in (its pid, digits) has gone: this run's own pid
+// counts as gone (nothing of this run exists yet when it sweeps); a pid it may not signal, or a
+// name that is no pid, as not.
+bool process_gone(const std::string& digits) {
+  if (digits.empty() || digits.size() > 9 || digits.find_first_not_of("0123456789") != std::string::npos) return false;
+  const pid_t pid = static_cast<pid_t>(std::stol(digits));
+  return pid == ::getpid() || (pid > 0 && ::kill(pid, 0) != 0 && errno == ESRCH);
+}
+
+// A checkpoint's temporary files (CKPT.tmp-PID, files.hpp) left by a run killed while saving it:
+// nothing reads them.
+void remove_stale_checkpoint_files(const fs::path& checkpoint) {
+  std::error_code ec;
+  const fs::path folder = fs::absolute(checkpoint, ec).parent_path();
+  const std::string prefix = checkpoint.filename().string() + ".tmp-";
+  std::vector<fs::path> stale;
+  for (auto it = fs::directory_iterator(folder, ec); !ec && it != fs::directory_iterator(); it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    if (name.rfind(prefix, 0) == 0 && process_gone(name.substr(prefix.size())) && it->is_regular_file()) stale.push_back(it->path());
+  }
+  for (const auto& file : stale) {
+    std::error_code removed;
+    if (fs::remove(file, removed)) spdlog::info("{}: removed, left by a run killed while saving its checkpoint", file.string());
+  }
+}
+
 // `out`'s siblings left by a run stopped while writing (Ctrl-C, killed), which cannot clean up
 // after itself: OUT.tmp-PID with kWriting (removed) and OUT.old-PID with kReplaced (put back where
 // no `out` took its place, the newest if several; else removed), whose process has gone. This
@@ -244,10 +270,7 @@ void remove_stale_siblings(const fs::path& out) {
     for (const std::string tag : {".tmp-", ".old-"}) {
       const std::string prefix = name + tag;
       if (sibling.size() <= prefix.size() || sibling.compare(0, prefix.size(), prefix) != 0) continue;
-      const std::string digits = sibling.substr(prefix.size());
-      if (digits.find_first_not_of("0123456789") != std::string::npos || digits.size() > 9) continue;
-      const pid_t pid = static_cast<pid_t>(std::stol(digits));
-      if (pid != ::getpid() && (::kill(pid, 0) == 0 || errno != ESRCH)) continue;  // alive (or not ours to judge)
+      if (!process_gone(sibling.substr(prefix.size()))) continue;
       std::error_code marked;
       if (tag == ".tmp-" && fs::exists(it->path() / kWriting, marked)) writing.push_back(it->path());
       if (tag == ".old-" && fs::exists(it->path() / kReplaced, marked)) replaced.push_back(it->path());
@@ -322,6 +345,7 @@ int run_match(const MatchArgs& args) {
     throw InvalidInputError("--truth* and --checkpoint exclude each other (a diagnostic run is not gone on from)");
   const fs::path out = output_directory(args.out);
   remove_stale_siblings(out);
+  if (!args.checkpoint.empty()) remove_stale_checkpoint_files(args.checkpoint);
   // The device first: a missing driver or device is an error before minutes of loading and assembly.
   if (args.backend == "vulkan") choose_device(args.device);
   const std::string solver = solver_for(args);

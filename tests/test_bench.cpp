@@ -254,7 +254,7 @@ TEST_CASE("cli: bench match --pairs matches and evaluates each pair and adds a r
   for (size_t i = 0; i < 2; ++i) {
     const auto& row = rows[i];
     CAPTURE(i);
-    CHECK(row.at("pair") == "finger_straight-finger_bent");
+    CHECK(row.at("pair") == (i == 0 ? "finger_straight-finger_bent" : "finger_straight-finger_bent.2"));  // (as its run)
     CHECK(row.at("status") == "ok");
     CHECK(row.at("faces_x") == "20");
     CHECK(std::stod(row.at("lower_bound")) <= std::stod(row.at("energy")) * (1 + 1e-9));
@@ -305,24 +305,29 @@ TEST_CASE("cli: bench match --pairs records a pair that fails as a row and goes 
   const fs::path err = dir.string() + "_stderr.txt";
   const std::string x = kAssets + "/finger_straight.off", y = kAssets + "/finger_bent.off";
   std::ofstream(dir / "pairs.txt") << "missing.off " << y << "\n"
-                                   << x << " " << y << " no_such_x.vts no_such_y.vts\n";
+                                   << x << " " << y << " no_such_x.vts no_such_y.vts\n"
+                                   << x << " " << y << " identity\n";
   REQUIRE(run_cli("bench match --pairs " + (dir / "pairs.txt").string() + " --faces 12 --out " + (dir / "out").string() +
                       " -- --backend cpu",
                   err) == 0);
   const auto [header, rows] = read_csv(dir / "out" / "bench_pairs.csv");
-  REQUIRE(rows.size() == 3);
+  REQUIRE(rows.size() == 4);
   CHECK(rows[0].at("pair") == "missing-finger_bent");
   // The child's one-line error, naming the file.
   CHECK(rows[0].at("status").rfind("failed: ", 0) == 0);
   CHECK(rows[0].at("status").find("missing.off") != std::string::npos);
   CHECK(rows[0].at("energy").empty());
-  // The match ran; its ground truth is what is missing.
-  CHECK(rows[1].at("status").rfind("eval failed: ", 0) == 0);
-  CHECK(rows[1].at("status").find("no_such_x.vts") != std::string::npos);
-  CHECK(!rows[1].at("energy").empty());
-  CHECK(rows[1].at("mean_geodesic_error").empty());
-  CHECK(rows[2].at("status") == "0 of 2 ok");
-  CHECK(rows[2].at("seconds").empty());
+  // Its ground truth is missing: the row fails before the match (no run, no energy).
+  CHECK(rows[1].at("status").rfind("failed: ", 0) == 0);
+  CHECK(rows[1].at("status").find("no_such_x.vts: ground truth not found") != std::string::npos);
+  CHECK(rows[1].at("energy").empty());
+  CHECK_FALSE(fs::exists(dir / "out" / "runs" / "finger_straight-finger_bent" / "report.json"));
+  // The same pair again: its row is named as its run, X-Y.2.
+  CHECK(rows[1].at("pair") == "finger_straight-finger_bent");
+  CHECK(rows[2].at("pair") == "finger_straight-finger_bent.2");
+  CHECK(rows[2].at("status") == "ok");
+  CHECK(fs::exists(dir / "out" / "runs" / "finger_straight-finger_bent.2" / "report.json"));
+  CHECK(rows[3].at("status") == "1 of 3 ok");
   fs::remove_all(dir);
 }
 

@@ -449,8 +449,12 @@ TEST_CASE("cli: match replaces only an earlier output, and sweeps what a stopped
   REQUIRE(run(pair + "-o " + (base / "other").string()).code == 0);  // (another output's run sweeps none of them)
   CHECK(fs::exists(base / ("out.tmp-" + gone)));
   CHECK(fs::exists(base / ("out.old-" + gone)));
-  const Run again = run(pair + "-o " + out.string());
+  { std::ofstream(base / ("c.ckpt.tmp-" + gone)) << "half"; }  // a checkpoint being saved when its run was killed
+  const Run again = run(pair + "--checkpoint " + (base / "c.ckpt").string() + " -o " + out.string());
   REQUIRE(again.code == 0);
+  CHECK_FALSE(fs::exists(base / ("c.ckpt.tmp-" + gone)));
+  CHECK(again.err.find("c.ckpt.tmp-" + gone + ": removed, left by a run killed while saving its checkpoint") != std::string::npos);
+  fs::remove(base / "c.ckpt");
   CHECK(again.err.find("put back as " + out.string()) != std::string::npos);
   CHECK(again.err.find("out.tmp-" + gone + ": removed") != std::string::npos);
   CHECK(fs::exists(out / "report.json"));
