@@ -1090,14 +1090,19 @@ int run_bench_pairs(const BenchMatchArgs& asked) {
   std::vector<MatchRow> rows(pairs.size());
   std::vector<fs::path> dirs(pairs.size());
   std::map<std::string, int> times_seen;
+  std::set<std::string> taken;
   for (size_t i = 0; i < pairs.size(); ++i) {
     MatchRow& row = rows[i];
     row.name = fs::path(pairs[i].x).stem().string() + "-" + fs::path(pairs[i].y).stem().string();
     // Named after the pair, so that --resume finds a run again in a list that grew or was
-    // reordered; a pair that comes again (e.g. with other ground truth) is counted: X-Y.2, X-Y.3.
+    // reordered; a pair that comes again (e.g. with other ground truth) is counted: X-Y.2, X-Y.3
+    // (past any name taken already, e.g. by a pair whose own stem ends in .2).
     const int seen = ++times_seen[row.name];
-    dirs[i] = out / "runs" / (seen == 1 ? row.name : fmt::format("{}.{}", row.name, seen));
-    row.name = dirs[i].filename().string();  // (the tables' rows named as their runs: X-Y.2 too)
+    std::string name = seen == 1 ? row.name : fmt::format("{}.{}", row.name, seen);
+    while (taken.count(name)) name = fmt::format("{}.{}", row.name, ++times_seen[row.name]);
+    taken.insert(name);
+    dirs[i] = out / "runs" / name;
+    row.name = name;  // (the tables' rows named as their runs: X-Y.2 too)
   }
   // The tables list the rows finished so far, in the file's order, rewritten as each one ends.
   std::vector<char> finished(pairs.size(), 0);
@@ -1148,7 +1153,11 @@ int run_bench_pairs(const BenchMatchArgs& asked) {
         });
       };
       attempt();
-      if (before.levels > 0 && row.run.status.rfind("failed", 0) == 0) {  // the checkpoint's fault, maybe (another build)
+      // The checkpoint's fault, maybe (another build): once more afresh. Not for other failures
+      // (an LP refused for the memory available would fail at the same level again, and the
+      // checkpoint holds the levels before it).
+      if (before.levels > 0 && row.run.status.rfind("failed", 0) == 0 &&
+          row.run.status.find("checkpoint") != std::string::npos) {
         spdlog::warn("{}: failed going on from its checkpoint ({}); once more afresh", row.name, row.run.status);
         fs::remove(checkpoint);
         before = {0, 0};

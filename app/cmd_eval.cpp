@@ -146,8 +146,9 @@ std::vector<std::array<uint8_t, 3>> error_colors(const Mesh& x, const GroundTrut
 
 // The files eval is asked to write, checked before any geodesic is solved (a full-resolution
 // evaluation takes minutes): each writable, no two the same, none a file it reads (the match
-// directory's own files, the ground truth, the meshes given).
-void check_outputs(const EvalArgs& args, const fs::path& dir) {
+// output's own files, the meshes report.json names, the ground truth, the meshes given). Files
+// of its own in the match directory (an earlier eval's) may be written again.
+void check_outputs(const EvalArgs& args, const fs::path& dir, const JsonNode& report) {
   const std::vector<std::pair<const char*, const std::string*>> outputs = {
       {"--pck-csv", &args.pck_csv}, {"--pck-png", &args.pck_png}, {"--errors-csv", &args.errors_csv},
       {"--errors-ply", &args.errors_ply}};
@@ -157,10 +158,17 @@ void check_outputs(const EvalArgs& args, const fs::path& dir) {
     const fs::path p = fs::weakly_canonical(path, ec);
     return ec ? fs::absolute(path).lexically_normal() : p;
   };
-  for (const fs::path& folder : {dir, dir / "levels"}) {
-    std::error_code ec;
-    for (auto it = fs::directory_iterator(folder, ec); !ec && it != fs::directory_iterator(); it.increment(ec))
-      if (it->is_regular_file()) inputs.insert(key(it->path().string()));
+  for (const char* own : {"report.json", "map_x_to_y.txt", "map_x_to_y_points.txt", "map_y_to_x.txt",
+                          "map_y_to_x_points.txt", "x_vertex_ids.txt", "y_vertex_ids.txt", "x.ply", "y.ply",
+                          "graph_surface.txt", "match.png"})
+    inputs.insert(key((dir / own).string()));
+  std::error_code ec;
+  for (auto it = fs::directory_iterator(dir / "levels", ec); !ec && it != fs::directory_iterator(); it.increment(ec))
+    inputs.insert(key(it->path().string()));
+  for (const char* side : {"x", "y"}) {
+    const JsonNode* s = report.get(side);
+    const JsonNode* file = s ? s->get("file") : nullptr;
+    if (file && file->kind == JsonNode::Kind::String) inputs.insert(key(file->text));
   }
   for (const std::string* in : {&args.gt_x, &args.gt_y, &args.gt_y_sym, &args.gt_map, &args.x_mesh, &args.y_mesh})
     if (!in->empty()) inputs.insert(key(*in));
@@ -179,9 +187,9 @@ int run_eval(const EvalArgs& args) {
   Stopwatch total;
   const fs::path dir(args.dir);
   if (!fs::is_directory(dir)) throw IoError(args.dir + ": not a directory (expected an output of `shapematch match`)");
-  check_outputs(args, dir);
   const fs::path report_path = dir / "report.json";
   const JsonNode report = read_json_file(report_path.string());
+  check_outputs(args, dir, report);
   auto field = [&](const std::string& side, const std::string& key, JsonNode::Kind kind) -> const JsonNode& {
     const JsonNode* s = report.get(side);
     const JsonNode* v = s ? s->get(key) : nullptr;

@@ -139,15 +139,17 @@ std::vector<int> true_map(const MatchArgs& args, const MeshPair& p, std::string&
   LoadOptions load;
   load.close_holes = args.pair.close_holes;
   const Mesh x = load_mesh(p.x_file, load), y = load_mesh(p.y_file, load);
+  // (Indexing the files' own vertices: with --close-holes a fan's vertex has no truth.)
+  const int xf = p.x_file_vertices, yf = p.y_file_vertices;
   GroundTruth truth;
   if (!args.truth_map.empty()) {
-    truth = read_map_ground_truth(args.truth_map, x.num_vertices(), y.num_vertices());
+    truth = read_map_ground_truth(args.truth_map, xf, yf);
     name = args.truth_map;
   } else if (!args.truth_x.empty()) {
-    truth = read_vts_ground_truth(args.truth_x, args.truth_y, x.num_vertices(), y.num_vertices());
+    truth = read_vts_ground_truth(args.truth_x, args.truth_y, xf, yf);
     name = args.truth_x + " <-> " + args.truth_y;
   } else {
-    truth = identity_ground_truth(x.num_vertices(), y.num_vertices());
+    truth = identity_ground_truth(xf, yf);
     name = "identity";
   }
   try {
@@ -355,7 +357,7 @@ int run_match(const MatchArgs& args) {
   co.hierarchy = args.hierarchy;
   // Shapes both at or below the coarsest size would repeat the same level (each level the same
   // full product space): one level does that work once.
-  if (co.hierarchy.levels != 1 && p.x.num_faces() <= co.hierarchy.coarsest_faces &&
+  if (co.hierarchy.levels > 1 && p.x.num_faces() <= co.hierarchy.coarsest_faces &&
       p.y.num_faces() <= co.hierarchy.coarsest_faces) {
     spdlog::warn("both shapes have at most --coarsest-faces {} faces ({} and {}): one level", co.hierarchy.coarsest_faces,
                  p.x.num_faces(), p.y.num_faces());

@@ -520,6 +520,7 @@ TEST_CASE("cli: usage errors are one documented line with exit 1") {
   const Run cpu = run("match " + tetra + " " + tetra + " --backend cpu --device 3 -o " + unused.string());
   CHECK(cpu.code == 0);
   CHECK(cpu.err.find("--device 3 is for the Vulkan backend; --backend cpu does not use it") != std::string::npos);
+  CHECK(cpu.err.find("one level") == std::string::npos);  // (the default --levels 0 is one level there anyway: no warning)
   fs::remove_all(unused);
   // The Vulkan driver before the meshes: a missing one is an error before any loading.
   const Run no_driver = shapematch::test::run_command("VK_ICD_FILENAMES=/nonexistent.json " + std::string(SHAPEMATCH_CLI) +

@@ -779,7 +779,12 @@ TEST_CASE("evaluation: a true map at the matched resolution takes the nearest gr
 TEST_CASE("evaluation: shapematch eval checks its output files before scoring") {
   const fs::path dir = scratch("cli_outputs");
   const fs::path out = dir / "match";
-  REQUIRE(run_cli("match --faces 30 --backend cpu -o " + out.string()).code == 0);
+  // Copies of the bundled pair: a failing check below would overwrite X.
+  for (const char* name : {"dolphin_straight.off", "dolphin_swimming.off"})
+    fs::copy_file(fs::path(SHAPEMATCH_ASSETS_DIR) / name, dir / name, fs::copy_options::overwrite_existing);
+  REQUIRE(run_cli("match " + (dir / "dolphin_straight.off").string() + " " + (dir / "dolphin_swimming.off").string() +
+                  " --faces 30 --backend cpu -o " + out.string())
+              .code == 0);
   const std::string eval = "eval " + out.string() + " --gt identity ";
   fs::create_directories(dir / "folder");
   struct Case {
@@ -804,10 +809,23 @@ TEST_CASE("evaluation: shapematch eval checks its output files before scoring") 
   }
   CHECK(fs::exists(out / "report.json"));
   CHECK_FALSE(fs::exists(dir / "same.csv"));
-  // A new file inside the match directory is fine.
-  const Run ok = run_cli(eval + "--pck-csv " + (out / "pck.csv").string());
-  CHECK(ok.code == 0);
-  CHECK(fs::exists(out / "pck.csv"));
+  // A new file inside the match directory is fine, and so is writing it again.
+  for (int again = 0; again < 2; ++again) {
+    const Run ok = run_cli(eval + "--pck-csv " + (out / "pck.csv").string());
+    CHECK(ok.code == 0);
+    CHECK(fs::exists(out / "pck.csv"));
+  }
+  // The meshes report.json names (eval reads X's for its regions) are inputs too.
+  const std::string x_file = [&] {
+    std::ifstream in(out / "report.json");
+    const std::string text((std::istreambuf_iterator<char>(in)), {});
+    const size_t at = text.find("\"file\": \"") + 9;
+    return text.substr(at, text.find('"', at) - at);
+  }();
+  REQUIRE(fs::path(x_file) == dir / "dolphin_straight.off");
+  const Run mesh = run_cli(eval + "--errors-ply " + (dir / "x.ply").string() + " --pck-csv " + x_file);
+  CHECK(mesh.code == 1);
+  CHECK(mesh.err.find(x_file + ": --pck-csv would overwrite a file eval reads") != std::string::npos);
 }
 
 TEST_CASE("evaluation: a match with --close-holes keeps the file's vertices for ground truth and user features") {

@@ -101,6 +101,14 @@ TEST_CASE("rounding: a mesh against itself rounds to the identity with zero gap"
   }
 }
 
+TEST_CASE("rounding: the relative gap is relative to a positive bound, else to the energy") {
+  CHECK(relative_gap(2.2, 2.0) == doctest::Approx(0.1));
+  CHECK(relative_gap(0.0, 0.0) == 0.0);          // a shape with itself
+  CHECK(relative_gap(1.0, 1.0 - 1e-12) == 0.0);  // met to rounding error
+  CHECK(relative_gap(5.0, 0.0) == doctest::Approx(1.0));   // a bound of 0 (clamped weak dual): 100 %, not 1e300
+  CHECK(relative_gap(5.0, -1.0) == doctest::Approx(1.2));  // (a bound below 0: relative to the energy too)
+}
+
 TEST_CASE("rounding: a deformed pair rounds to a verified graph surface within the paper's bounds") {
   // Same connectivity, different pose: the bundled finger's generator at low resolution.
   const Mesh x = shapes::bent_finger(10, 5, 6), y = shapes::bent_finger(60, 5, 6);

@@ -8,6 +8,8 @@
 #include <spdlog/fmt/fmt.h>
 
 #include <algorithm>
+#include <cstdlib>
+#include <string>
 
 namespace shapematch {
 namespace {
@@ -63,7 +65,7 @@ void check_lp_memory(const Mesh& x, const Mesh& y, int64_t variables, uint64_t a
   if (available_bytes == 0 || needed <= double(available_bytes)) return;
   throw InvalidInputError(fmt::format(
       "{} × {} ({} × {} faces): the LP over {} product triangles needs about {:.1f} GB, more than the {:.1f} GB "
-      "this machine has available; decimate (--faces) or free memory",
+      "this machine has available; decimate (--faces) or free memory (SHAPEMATCH_MEMORY_CHECK=0 skips this check)",
       x.name, y.name, x.num_faces(), y.num_faces(), variables, needed / 1e9, double(available_bytes) / 1e9));
 }
 
@@ -74,7 +76,9 @@ ConstraintSystem build_constraints(const ProductSpace& space) {
   if (n >= (int64_t(1) << 31))
     throw InvalidInputError(fmt::format("{} × {} ({} × {} faces): product space too large: {} variables (at most 2³¹)",
                                         X.name, Y.name, X.num_faces(), Y.num_faces(), n));
-  check_lp_memory(X, Y, n, available_memory_bytes());
+  // SHAPEMATCH_MEMORY_CHECK=0 skips it (a machine whose swap should take the rest).
+  const char* check = std::getenv("SHAPEMATCH_MEMORY_CHECK");
+  if (!check || std::string(check) != "0") check_lp_memory(X, Y, n, available_memory_bytes());
 
   // Pass 1: boundary edges of every variable (ids and signs) and the π rows it touches.
   std::vector<int64_t> edge_id(3 * n);

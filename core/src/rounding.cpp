@@ -2854,7 +2854,10 @@ double relative_gap(double energy, double bound) {
   // An energy that meets its bound to rounding error has no gap, also when both are ~0 (the
   // identity of a shape with itself), where the relative formula would read 100 %.
   const double slack = energy - bound;
-  return slack <= 1e-9 * std::max(1.0, std::abs(energy)) ? 0.0 : slack / std::max(std::abs(bound), 1e-300);
+  if (slack <= 1e-9 * std::max(1.0, std::abs(energy))) return 0.0;
+  // Relative to the bound where it is positive; a bound of 0 or below (a weak dual: the bound is
+  // clamped at 0 where every cost is >= 0) says nothing of scale: relative to the energy then.
+  return bound > 0.0 ? slack / bound : slack / std::max(std::abs(energy), 1e-300);
 }
 
 GraphSurfaceCheck check_graph_surface(const ProductSpace& space, const std::vector<int64_t>& gamma) {

@@ -19,13 +19,24 @@ double peak_rss_mb() {
 }
 
 uint64_t available_memory_bytes() {
+  uint64_t available = 0;
   std::ifstream in("/proc/meminfo");
   for (std::string key; in >> key;) {
     uint64_t kib = 0;
-    if (key == "MemAvailable:" && in >> kib) return kib * 1024;
+    if (key == "MemAvailable:" && in >> kib) {
+      available = kib * 1024;
+      break;
+    }
     in.ignore(std::numeric_limits<std::streamsize>::max(), '\n');
   }
-  return 0;
+  // In a container the cgroup's limit binds first (v2: memory.max, "max" where there is none).
+  uint64_t limit = 0, used = 0;
+  if (std::ifstream max("/sys/fs/cgroup/memory.max"); max >> limit) {
+    std::ifstream("/sys/fs/cgroup/memory.current") >> used;
+    const uint64_t left = limit > used ? limit - used : 1;  // (1: none left, yet "known")
+    available = available == 0 ? left : std::min(available, left);
+  }
+  return available;
 }
 
 namespace {

@@ -8,8 +8,8 @@ namespace shapematch {
 // Peak resident set size of this process so far, in MiB.
 double peak_rss_mb();
 
-// Memory the system can give without swapping (MemAvailable of /proc/meminfo), in bytes; 0 where
-// it cannot be read.
+// Memory the system can give without swapping (MemAvailable of /proc/meminfo, and at most what a
+// cgroup v2 limit leaves), in bytes; 0 where it cannot be read.
 uint64_t available_memory_bytes();
 
 // Threads of this process's parallel loops (assembly, pricing, the native PDHG kernels): the
