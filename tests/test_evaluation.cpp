@@ -614,17 +614,23 @@ TEST_CASE("evaluation: shapematch eval reads a match directory through the verte
   fs::remove_all(dir);
 }
 
-TEST_CASE("evaluation: shapematch eval closes Y's holes again when the match did") {
-  // An open input (one face removed), matched as closed: the matched meshes have one vertex more.
-  const fs::path dir = scratch("close_holes");
-  const fs::path out = dir / "match";
-  fs::create_directories(out);
+// An icosphere(1) with one face removed, written as OFF: an open input for --close-holes.
+Mesh write_open_icosphere(const fs::path& path) {
   Mesh open = shapes::icosphere(1);
   open.faces.pop_back();
   std::string text = "OFF\n" + std::to_string(open.num_vertices()) + " " + std::to_string(open.num_faces()) + " 0\n";
   for (const auto& p : open.vertices) text += fmt::format("{} {} {}\n", p.x(), p.y(), p.z());
   for (const auto& f : open.faces) text += fmt::format("3 {} {} {}\n", f[0], f[1], f[2]);
-  write(dir / "open.off", text);
+  write(path, text);
+  return open;
+}
+
+TEST_CASE("evaluation: shapematch eval closes Y's holes again when the match did") {
+  // An open input (one face removed), matched as closed: the matched meshes have one vertex more.
+  const fs::path dir = scratch("close_holes");
+  const fs::path out = dir / "match";
+  fs::create_directories(out);
+  const Mesh open = write_open_icosphere(dir / "open.off");
   LoadOptions closing;
   closing.close_holes = true;
   const Mesh closed = load_mesh((dir / "open.off").string(), closing);
@@ -831,12 +837,7 @@ TEST_CASE("evaluation: shapematch eval checks its output files before scoring") 
 TEST_CASE("evaluation: a match with --close-holes keeps the file's vertices for ground truth and user features") {
   // One face removed from an icosphere: the file has 42 vertices, the matched mesh 43 (the fan's).
   const fs::path dir = scratch("close_holes_match");
-  Mesh open = shapes::icosphere(1);
-  open.faces.pop_back();
-  std::string text = "OFF\n" + std::to_string(open.num_vertices()) + " " + std::to_string(open.num_faces()) + " 0\n";
-  for (const auto& p : open.vertices) text += fmt::format("{} {} {}\n", p.x(), p.y(), p.z());
-  for (const auto& f : open.faces) text += fmt::format("3 {} {} {}\n", f[0], f[1], f[2]);
-  write(dir / "open.off", text);
+  const Mesh open = write_open_icosphere(dir / "open.off");
   const int file = open.num_vertices();
   std::string features;  // one row per vertex of the file, as a user has them
   for (int v = 0; v < file; ++v) features += fmt::format("{} {}\n", open.vertices[v].x(), open.vertices[v].z());
