@@ -232,13 +232,21 @@ fs::path output_directory(const std::string& arg) {
   return out;
 }
 
-// Whether the process a leftover's name ends in (its pid, digits) has gone: this run's own pid
-// counts as gone (nothing of this run exists yet when it sweeps); a pid it may not signal, or a
-// name that is no pid, as not.
-bool process_gone(const std::string& digits) {
-  if (digits.empty() || digits.size() > 9 || digits.find_first_not_of("0123456789") != std::string::npos) return false;
-  const pid_t pid = static_cast<pid_t>(std::stol(digits));
-  return pid == ::getpid() || (pid > 0 && ::kill(pid, 0) != 0 && errno == ESRCH);
+// The entries of `folder` named PREFIX + PID whose process has gone: what a run stopped while
+// writing (Ctrl-C, killed) leaves and cannot clean up itself. This run's own pid counts as gone
+// (nothing of it exists yet when it sweeps); a pid it may not signal, or a name that is no pid, not.
+std::vector<fs::path> leftovers(const fs::path& folder, const std::string& prefix) {
+  std::vector<fs::path> found;
+  std::error_code ec;
+  for (auto it = fs::directory_iterator(folder, ec); !ec && it != fs::directory_iterator(); it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    if (name.size() <= prefix.size() || name.compare(0, prefix.size(), prefix) != 0) continue;
+    const std::string digits = name.substr(prefix.size());
+    if (digits.size() > 9 || digits.find_first_not_of("0123456789") != std::string::npos) continue;
+    const pid_t pid = static_cast<pid_t>(std::stol(digits));
+    if (pid == ::getpid() || (pid > 0 && ::kill(pid, 0) != 0 && errno == ESRCH)) found.push_back(it->path());
+  }
+  return found;
 }
 
 // A checkpoint's temporary files (CKPT.tmp-PID, files.hpp) left by a run killed while saving it:
@@ -246,38 +254,27 @@ bool process_gone(const std::string& digits) {
 void remove_stale_checkpoint_files(const fs::path& checkpoint) {
   std::error_code ec;
   const fs::path folder = fs::absolute(checkpoint, ec).parent_path();
-  const std::string prefix = checkpoint.filename().string() + ".tmp-";
-  std::vector<fs::path> stale;
-  for (auto it = fs::directory_iterator(folder, ec); !ec && it != fs::directory_iterator(); it.increment(ec)) {
-    const std::string name = it->path().filename().string();
-    if (name.rfind(prefix, 0) == 0 && process_gone(name.substr(prefix.size())) && it->is_regular_file()) stale.push_back(it->path());
-  }
-  for (const auto& file : stale) {
+  for (const auto& file : leftovers(folder, checkpoint.filename().string() + ".tmp-")) {
     std::error_code removed;
-    if (fs::remove(file, removed)) spdlog::info("{}: removed, left by a run killed while saving its checkpoint", file.string());
+    if (fs::is_regular_file(file, removed) && fs::remove(file, removed))
+      spdlog::info("{}: removed, left by a run killed while saving its checkpoint", file.string());
   }
 }
 
-// `out`'s siblings left by a run stopped while writing (Ctrl-C, killed), which cannot clean up
-// after itself: OUT.tmp-PID with kWriting (removed) and OUT.old-PID with kReplaced (put back where
-// no `out` took its place, the newest if several; else removed), whose process has gone. This
-// run's own pid counts as gone (nothing of it exists yet); anything without its marker is left.
+// `out`'s leftovers: OUT.tmp-PID with kWriting (removed) and OUT.old-PID with kReplaced (put back
+// where no `out` took its place, the newest if several; else removed). Anything without its
+// marker is left alone.
 void remove_stale_siblings(const fs::path& out) {
-  std::error_code ec;
+  const auto marked = [](std::vector<fs::path> dirs, const char* marker) {
+    std::erase_if(dirs, [&](const fs::path& dir) {
+      std::error_code ec;
+      return !fs::exists(dir / marker, ec);
+    });
+    return dirs;
+  };
   const std::string name = out.filename().string();
-  std::vector<fs::path> writing, replaced;
-  for (auto it = fs::directory_iterator(out.parent_path(), ec); !ec && it != fs::directory_iterator();
-       it.increment(ec)) {
-    const std::string sibling = it->path().filename().string();
-    for (const std::string tag : {".tmp-", ".old-"}) {
-      const std::string prefix = name + tag;
-      if (sibling.size() <= prefix.size() || sibling.compare(0, prefix.size(), prefix) != 0) continue;
-      if (!process_gone(sibling.substr(prefix.size()))) continue;
-      std::error_code marked;
-      if (tag == ".tmp-" && fs::exists(it->path() / kWriting, marked)) writing.push_back(it->path());
-      if (tag == ".old-" && fs::exists(it->path() / kReplaced, marked)) replaced.push_back(it->path());
-    }
-  }
+  const std::vector<fs::path> writing = marked(leftovers(out.parent_path(), name + ".tmp-"), kWriting);
+  std::vector<fs::path> replaced = marked(leftovers(out.parent_path(), name + ".old-"), kReplaced);
   const auto written = [](const fs::path& dir) {
     std::error_code e;
     return fs::last_write_time(dir / kReplaced, e);

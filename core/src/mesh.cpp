@@ -151,27 +151,20 @@ RawMesh read_off(const std::string& path) {
     }
     return s;
   };
-  int64_t wide_line = 0, wide_vertex = -1;  // the first plain vertex line with more than three numbers
-  size_t wide_count = 0;
   for (int64_t i = 0; i < nv; ++i) {
     if (!reader.next(t)) fail(path, fmt::format("file ends after {} of {} vertices", i, nv));
     Eigen::Vector3d p;
     if (t.size() < 3 || !parse(t[0], p.x()) || !parse(t[1], p.y()) || !parse(t[2], p.z()))
       fail(path, fmt::format("line {}: vertex {} needs three numbers, got '{}'", reader.line_number(), i,
                              vertex_tokens(t)));
-    if (plain && t.size() > 3 && wide_vertex < 0) {
-      wide_line = reader.line_number();
-      wide_vertex = i;
-      wide_count = t.size();
-    }
+    if (plain && t.size() > 3 && raw.oddity.empty())  // (the first such line)
+      raw.oddity = fmt::format("line {} gave vertex {} {} numbers: is the header's vertex count, {}, too large?",
+                               reader.line_number(), i, t.size(), nv);
     raw.vertices.push_back(p);
   }
   const auto fail_faces = [&](const std::string& problem) {
-    fail(path, wide_vertex < 0 ? problem
-                               : fmt::format("{} (line {} gave vertex {} {} numbers: is the header's vertex count, {}, "
-                                             "too large?)",
-                                             problem, wide_line, wide_vertex, wide_count, nv));
-  };  // (RawMesh::oddity says the same where the faces parse)
+    fail(path, raw.oddity.empty() ? problem : problem + " (" + raw.oddity + ")");
+  };
   for (int64_t f = 0; f < nf; ++f) {
     if (!reader.next(t)) fail_faces(fmt::format("file ends after {} of {} faces", f, nf));
     int64_t n = 0;
@@ -186,9 +179,6 @@ RawMesh read_off(const std::string& path) {
   }
   if (reader.next(t))
     fail_faces(fmt::format("line {}: more data after the {} faces the header declares", reader.line_number(), nf));
-  if (wide_vertex >= 0)
-    raw.oddity = fmt::format("line {} gave vertex {} {} numbers: is the header's vertex count, {}, too large?",
-                             wide_line, wide_vertex, wide_count, nv);
   return raw;
 }
 
