@@ -727,6 +727,18 @@ TEST_CASE("cli: match --checkpoint goes on after the levels a stopped run finish
   r = run("checkpoint " + dolphin);
   CHECK(r.code == 1);
   CHECK(r.err.find(dolphin + ": not a shapematch checkpoint") != std::string::npos);
+  // A byte changed on disk: refused as damaged (its checksum), by match and checkpoint alike,
+  // before any work; the file is kept.
+  std::string bytes = read_file(ckpt);
+  bytes[bytes.size() / 2] = char(bytes[bytes.size() / 2] ^ 1);
+  std::ofstream(ckpt, std::ios::binary) << bytes;
+  for (const std::string& cmd : {"checkpoint " + ckpt, "match " + dolphin + " " + swimming + args + (tmp.path / "damaged").string()}) {
+    r = run(cmd);
+    CHECK(r.code == 1);
+    CHECK(r.err.find(ckpt + ": the checkpoint is damaged (its checksum does not match") != std::string::npos);
+  }
+  CHECK_FALSE(fs::exists(tmp.path / "damaged"));
+  CHECK(read_file(ckpt) == bytes);
 }
 
 TEST_CASE("cli: checkpoint shows both chains of a run stopped inside lookahead") {

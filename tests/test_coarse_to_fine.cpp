@@ -1860,8 +1860,38 @@ TEST_CASE("coarse to fine: a run gone on from an attempt of a level in progress 
     bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
   }
   const size_t at = std::string("shapematch level checkpoint\n").size();
-  REQUIRE(bytes[at] == 17);
-  bytes[at] = 18;  // a later version than this build's
+  REQUIRE(bytes[at] == 18);
+  {  // Version 18's checksum: any byte changed, or the file cut short, is refused as damaged.
+    auto refused = [&](const std::string& damaged) {
+      std::ofstream(file, std::ios::binary) << damaged;
+      std::string what;
+      try {
+        load_checkpoint(file);
+      } catch (const IoError& e) {
+        what = e.what();
+      }
+      return what;
+    };
+    for (size_t i : {at + 4, bytes.size() / 3, bytes.size() / 2, bytes.size() - 9, bytes.size() - 1}) {
+      std::string damaged = bytes;
+      damaged[i] = char(damaged[i] ^ 0x10);
+      CHECK_MESSAGE(refused(damaged).find("checksum does not match") != std::string::npos, "byte " << i);
+    }
+    CHECK(refused(bytes.substr(0, bytes.size() - 1)).find("checksum") != std::string::npos);
+    CHECK(refused(bytes.substr(0, bytes.size() - 8)).find("checksum") != std::string::npos);
+    CHECK(refused(bytes.substr(0, at + 6)).find("cut short") != std::string::npos);
+    // Two words swapped (same bytes, other order) differ too.
+    std::string swapped = bytes;
+    const size_t mid = (bytes.size() / 16) * 8;
+    std::swap_ranges(swapped.begin() + mid - 8, swapped.begin() + mid, swapped.begin() + mid);
+    REQUIRE(swapped != bytes);
+    CHECK(refused(swapped).find("checksum") != std::string::npos);
+    CHECK(refused(bytes).empty());  // (and the file as written loads)
+    // Version 17 has no checksum: read as it is, its last byte no checksum's.
+    detail::save_checkpoint_as(file, marked, 17);
+    CHECK(load_checkpoint(file).levels.back().gamma == marked.levels.back().gamma);
+  }
+  bytes[at] = 19;  // a later version than this build's
   std::ofstream(file, std::ios::binary) << bytes;
   CHECK_THROWS_AS(load_checkpoint(file), IoError);
   {  // The fifteenth: a carried start's rounding without a bound (NaN); the fourteenth has 15's layout.
@@ -1892,7 +1922,7 @@ TEST_CASE("coarse to fine: a run gone on from an attempt of a level in progress 
   CHECK(v3.attempt.report.widened_faces == a.report.widened_faces);
   CHECK(v3.attempt.report.stuck_restarts == 0);
   CHECK(v3.levels.back().gamma == last.levels.back().gamma);
-  CHECK_THROWS_AS(detail::save_checkpoint_as(file, marked, 18), InvalidInputError);
+  CHECK_THROWS_AS(detail::save_checkpoint_as(file, marked, 19), InvalidInputError);
 }
 
 // The saves of a run made inside the first LP of level `level` (lp_checkpoint_seconds).
