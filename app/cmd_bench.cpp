@@ -60,7 +60,7 @@ constexpr double kInf = std::numeric_limits<double>::infinity();
 // Bandwidth
 
 struct BandwidthOptions {
-  int threads = 0;              // 0 = all hardware threads, as the native PDHG backend uses
+  int threads = 0;              // 0 = all CPUs this process may use, as the native PDHG backend does
   int64_t elements = 1 << 24;   // per array: 3 × 128 MiB, far beyond any last-level cache
   int repeats = 10;             // best of, so that a neighbour's burst on a shared machine does not count
 };
@@ -68,8 +68,14 @@ struct BandwidthOptions {
 // STREAM triad a = b + s·c on all threads, each on the slice it touched first (so its pages are
 // local). Bytes are counted STREAM's way, 24 per element without write-allocate, the same
 // convention as pdhg_bytes_per_iteration.
+// The threads it runs: at most the CPUs this process may use (more only share them, and
+// thousands fail to start), as match's --threads.
+int bandwidth_threads(const BandwidthOptions& options) {
+  return options.threads > 0 ? std::min(options.threads, worker_threads()) : worker_threads();
+}
+
 double measure_bandwidth_gbps(const BandwidthOptions& options) {
-  const int threads = options.threads > 0 ? options.threads : worker_threads();
+  const int threads = bandwidth_threads(options);
   const int64_t n = options.elements;
   std::unique_ptr<double[]> a(new double[n]), b(new double[n]), c(new double[n]);
   std::barrier sync(threads + 1);
@@ -1279,9 +1285,12 @@ Action add_bench_command(CLI::App& app) {
       check_match_args(m->match_args);
       return m->pairs_file.empty() ? run_bench_scaling(*m) : run_bench_pairs(*m);
     }
+    if (bw->threads > bandwidth_threads(*bw))
+      spdlog::warn("bench bandwidth: --threads {} is more than the {} CPUs this process may use: {} threads",
+                   bw->threads, worker_threads(), bandwidth_threads(*bw));
     const double gbps = measure_bandwidth_gbps(*bw);
     Json out = Json::object();
-    out.set("threads", bw->threads > 0 ? bw->threads : worker_threads());
+    out.set("threads", bandwidth_threads(*bw));
     out.set("array_mib", double(bw->elements) * 8.0 / (1 << 20));
     out.set("gbps", gbps);
     std::cout << out.dump() << std::endl;

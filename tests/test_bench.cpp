@@ -108,6 +108,21 @@ const std::string kAssets = SHAPEMATCH_ASSETS_DIR;
 
 }  // namespace
 
+TEST_CASE("cli: bench bandwidth runs on at most the CPUs it may use") {
+  // --threads past the CPUs is capped (a warning; thousands of threads had been started as asked),
+  // and the JSON says how many ran; a bandwidth is a positive number.
+  const fs::path err = fs::temp_directory_path() / "shapematch_bandwidth_stderr.txt";
+  const fs::path out = fs::temp_directory_path() / "shapematch_bandwidth_stdout.txt";
+  REQUIRE(run_cli("bench bandwidth --threads 100000 --repeats 1", err, out) == 0);
+  const std::string json = read_text(out);
+  CHECK(shapematch::test::json_number(json, "threads") == shapematch::worker_threads());
+  CHECK(shapematch::test::json_number(json, "gbps") > 0.0);
+  CHECK(read_text(err).find("--threads 100000 is more than the") != std::string::npos);
+  REQUIRE(run_cli("bench bandwidth --threads 1 --repeats 1", err, out) == 0);
+  CHECK(shapematch::test::json_number(read_text(out), "threads") == 1);
+  CHECK(read_text(err).find("more than the") == std::string::npos);
+}
+
 TEST_CASE("cli: bench lp writes one CSV row per solver and size, and the solvers agree") {
   const fs::path dir = fs::temp_directory_path() / "shapematch_bench_test";
   fs::remove_all(dir);

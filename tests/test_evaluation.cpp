@@ -344,6 +344,13 @@ TEST_CASE("evaluation: ground-truth readers parse the data set formats and rejec
   CHECK(map[0].y == 2);
   CHECK(map[1].x == 1);
   CHECK(map[1].y == 1);
+  // A header and comments, blank lines: skipped; a pair given twice is two samples.
+  const GroundTruth commented =
+      read_map_ground_truth(write(dir / "commented.txt", "# x y\n1 3\n\n  # again\n1 3\n2 2\n").string(), 2, 3);
+  REQUIRE(commented.size() == 3);
+  CHECK(commented[0].x == 0);
+  CHECK(commented[1].y == 2);
+  CHECK(commented[2].y == 1);
 
   const std::vector<int> zero_based = read_vertex_list(write(dir / "ids.txt", "0\n4\n").string(), false, 5);
   CHECK(zero_based == std::vector<int>{0, 4});
@@ -379,6 +386,8 @@ TEST_CASE("evaluation: ground-truth readers parse the data set formats and rejec
       {"one.txt", "1 1\n2\n", "line 2: expected 2 vertex indices, got 1"},
       {"ycol.txt", "1 1\n2 4\n", "line 2: vertex 4 is not in 1..3"},
       {"xcol.txt", "3 1\n", "line 1: vertex 3 is not in 1..2"},
+      {"later.txt", "# x y\n\n1 1\n1 x\n", "line 4: 'x' is not a vertex index"},  // (the file's line numbers)
+      {"comments.txt", "# x y\n# nothing\n", "no vertex pairs (only comments)"},
   };
   for (const Bad& c : bad_maps) {
     CAPTURE(c.name);

@@ -56,14 +56,17 @@ int parse_vertex(const std::string& token, int base, int num_vertices, const std
   return static_cast<int>(value - base);
 }
 
-// Rows of `columns` indices each; a blank line inside the file would shift the "line k ↔ line k"
-// pairing, so it is an error rather than skipped.
+// Rows of `columns` indices each. In a list (.vts) a blank line inside the file would shift the
+// "line k ↔ line k" pairing, so it is an error rather than skipped; a file of pairs holds each
+// pair on its line, and skips blank lines and `#` comments (a header written by hand).
 std::vector<std::vector<int>> read_rows(const std::string& path, int columns, int base,
-                                        const std::vector<int>& num_vertices) {
+                                        const std::vector<int>& num_vertices, bool pairs = false) {
   const std::vector<std::string> lines = read_lines(path);
   std::vector<std::vector<int>> rows;
   rows.reserve(lines.size());
   for (size_t i = 0; i < lines.size(); ++i) {
+    const size_t first = lines[i].find_first_not_of(" \t");
+    if (pairs && (first == std::string::npos || lines[i][first] == '#')) continue;
     const std::vector<std::string> tokens = split(lines[i]);
     if (static_cast<int>(tokens.size()) != columns)
       throw InvalidInputError(where(path, i) + "expected " + std::to_string(columns) + " vertex ind" +
@@ -144,8 +147,9 @@ GroundTruth read_vts_ground_truth(const std::string& x_path, const std::string& 
 
 GroundTruth read_vertex_pairs(const std::string& path, bool one_based, int x_vertices, int y_vertices) {
   GroundTruth gt;
-  for (const auto& row : read_rows(path, 2, one_based ? 1 : 0, {x_vertices, y_vertices}))
+  for (const auto& row : read_rows(path, 2, one_based ? 1 : 0, {x_vertices, y_vertices}, true))
     gt.push_back({row[0], row[1]});
+  if (gt.empty()) throw InvalidInputError(path + ": no vertex pairs (only comments)");
   return gt;
 }
 
