@@ -484,6 +484,47 @@ TEST_CASE("cli: match replaces only an earlier output, and sweeps what a stopped
   check_usage_error(shapematch::test::run_command(in_here + "-o ."), here.string() + ": is the current directory or holds it");
   check_usage_error(shapematch::test::run_command(in_here + "-o .."), base.string() + ": is the current directory or holds it");
   CHECK(fs::is_empty(here));
+
+  // -o DIR made by the user while the run wrote its output: the run is stopped (SIGSTOP) while
+  // its temporary output exists, DIR made with a file of the user's, and the run let go on. Its
+  // output is kept beside as DIR.new-PID, named in the error; DIR is left as the user made it.
+  // (Where the run got past publishing before it was stopped, mkdir fails: tried again.)
+  const fs::path raced = base / "raced";
+  const fs::path script = base / "race.sh";
+  {
+    std::ofstream sh(script);
+    sh << "cd " << base.string() << "\n"
+       << "for i in $(seq 20); do\n"
+       << "  rm -rf raced raced.*\n"
+       << "  " << SHAPEMATCH_CLI << " " << pair << "-o raced >/dev/null 2>race.err & p=$!\n"
+       << "  while [ ! -e raced.tmp-$p/.shapematch-writing ] && kill -0 $p 2>/dev/null; do :; done\n"
+       << "  kill -STOP $p 2>/dev/null\n"
+       << "  if mkdir raced 2>/dev/null; then echo mine > raced/mine.txt; kill -CONT $p; wait $p; "
+          "echo \"$? $p\"; exit 0; fi\n"
+       << "  kill -CONT $p 2>/dev/null; wait $p\n"
+       << "done\n"
+       << "echo missed\n";
+  }
+  const Run race = shapematch::test::run_command("bash " + script.string());
+  std::istringstream said(race.out);
+  int race_code = -1;
+  std::string race_pid;
+  said >> race_code >> race_pid;
+  REQUIRE_MESSAGE(!race_pid.empty(), race.out);  // (caught while writing within 20 tries)
+  const std::string race_err = read_file(base / "race.err");
+  CHECK(race_code == 1);
+  const fs::path kept = base / ("raced.new-" + race_pid);
+  CHECK(race_err.find(raced.string() + ": exists and is not a match output") != std::string::npos);
+  CHECK(race_err.find("it changed while this run worked; its output is in " + kept.string()) != std::string::npos);
+  CHECK(read_file(raced / "mine.txt") == "mine\n");
+  CHECK_FALSE(fs::exists(raced / "report.json"));
+  CHECK(fs::exists(kept / "report.json"));
+  CHECK(fs::exists(kept / "map_x_to_y.txt"));
+  CHECK_FALSE(fs::exists(kept / ".shapematch-writing"));
+  CHECK_FALSE(fs::exists(base / ("raced.tmp-" + race_pid)));
+  // A later run leaves both alone: DIR is the user's, DIR.new-PID no leftover to sweep.
+  check_usage_error(run(pair + "-o " + raced.string()), raced.string() + ": exists and is not a match output");
+  CHECK(fs::exists(kept / "report.json"));
   fs::remove_all(base);
 }
 
