@@ -75,6 +75,37 @@ std::vector<int> input_ids(const fs::path& dir, const std::string& side, int mat
   return ids;
 }
 
+// Whether `file` (loaded as `input`) is the mesh the match read for this side: decimation keeps
+// the vertices it keeps where they were, so the matched mesh's vertices are the input's vertices
+// `ids`, up to match's shift and scale. Compared after taking out each one's centroid and RMS
+// radius: the file the match read agrees to rounding (TOSCA_r dog0-dog8: 9e-16), another pose or
+// shape with the same vertex count does not (dog0 or dog3 for dog8: 2.1, 2.6), and would have
+// been scored as if it were Y.
+void check_same_mesh(const Mesh& matched, const std::vector<int>& ids, const Mesh& input, const std::string& file,
+                     const std::string& side, const fs::path& report) {
+  const auto normalised = [](auto point, size_t n) {
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    for (size_t k = 0; k < n; ++k) mean += point(k);
+    mean /= double(n);
+    double square = 0.0;
+    for (size_t k = 0; k < n; ++k) square += (point(k) - mean).squaredNorm();
+    const double rms = std::sqrt(square / double(n));
+    return std::pair{mean, rms > 0.0 ? rms : 1.0};
+  };
+  const size_t n = ids.size();
+  const auto [mm, ms] = normalised([&](size_t k) { return matched.vertices[k]; }, n);
+  const auto [im, is] = normalised([&](size_t k) { return input.vertices[ids[k]]; }, n);
+  double worst = 0.0;
+  for (size_t k = 0; k < n; ++k)
+    worst = std::max(worst, ((matched.vertices[k] - mm) / ms - (input.vertices[ids[k]] - im) / is).norm());
+  // (PLY is written to 17 digits; a margin for files written with fewer.)
+  if (!(worst <= 1e-4))
+    throw InvalidInputError(fmt::format("{}: is not the {} mesh the match read (its vertices differ from {}'s by up to "
+                                        "{:.3g} of the shape's RMS radius); give the file `match` was run on",
+                                        file, side == "x" ? "X" : "Y", (report.parent_path() / (side + ".ply")).string(),
+                                        worst));
+}
+
 // A coarser level's vertex map (match writes levels/level_K.txt): `x y` per line, 0-based input
 // vertices of X and Y; φ over the input vertices of X, -1 where that level has no vertex.
 std::vector<int> read_level_map(const fs::path& path, int x_input, int y_input) {
@@ -235,6 +266,7 @@ int run_eval(const EvalArgs& args) {
   if (y_full.num_vertices() != y_input)
     throw InvalidInputError(fmt::format("{}: {} vertices, but Y had {} when it was matched", y_file,
                                         y_full.num_vertices(), y_input));
+  check_same_mesh(ym, y_ids, y_full, y_file, "y", report_path);
 
   // X's input mesh, for error_regions only (eval needs Y otherwise): report.json's or --x-mesh;
   // loaded and checked before any geodesic is solved. Its own coordinates: --errors-ply writes it.
@@ -263,6 +295,7 @@ int run_eval(const EvalArgs& args) {
     if (x.num_vertices() != x_input)
       throw InvalidInputError(fmt::format("{}: {} vertices, but X had {} when it was matched", x_file, x.num_vertices(),
                                           x_input));
+    check_same_mesh(xm, x_ids, x, x_file, "x", report_path);
     x_full = std::move(x);
   } catch (const Error& e) {
     if (x_needed) throw;

@@ -594,6 +594,23 @@ TEST_CASE("evaluation: shapematch eval reads a match directory through the verte
   r = run_cli("eval " + out.string() + " --gt-y-sym " + (dir / "a.vts").string(), dir);
   CHECK(r.code != 0);
 
+  // Another mesh of as many vertices as Y (the finger bent the other way) named as Y: refused,
+  // before anything is scored, rather than scored as if it were Y; as X too.
+  for (const std::string& option : {"--y-mesh ", "--x-mesh "}) {
+    const fs::path other = dir / (option == "--y-mesh " ? "x_in.off" : "y_in.off");
+    r = run_cli("eval " + out.string() + " " + option + other.string(), dir);
+    CHECK(r.code == 1);
+    CHECK(r.err.find(other.string() + ": is not the " + (option == "--y-mesh " ? "Y" : "X") + " mesh the match read") !=
+          std::string::npos);
+    CHECK(r.out.empty());
+  }
+  // Y's own file scaled and moved is still Y (match's shift and scale are taken out).
+  Mesh moved = y;
+  for (auto& p : moved.vertices) p = 3.0 * p + Eigen::Vector3d(1, 2, 3);
+  save_mesh(moved, (dir / "y_moved.off").string());
+  r = run_cli("eval " + out.string() + " --y-mesh " + (dir / "y_moved.off").string(), dir);
+  CHECK_MESSAGE(r.code == 0, r.err);
+
   // Malformed inputs: exit 1 and one line naming the file.
   write(dir / "bad.vts", "1\n2\nx\n");
   r = run_cli("eval " + out.string() + " --gt-x " + (dir / "a.vts").string() + " --gt-y " + (dir / "bad.vts").string(),
@@ -605,13 +622,23 @@ TEST_CASE("evaluation: shapematch eval reads a match directory through the verte
   CHECK(r.code == 1);
   CHECK(r.err.find("y_vertex_ids.txt: 1 lines, but y.ply has") != std::string::npos);
 
-  // Without the id files the matched meshes are taken as the inputs themselves: the shuffle then
-  // shows up as error (and the same vertex counts make that allowed).
+  // Without the id files the matched meshes are taken as the inputs themselves: here they are
+  // shuffled, so the inputs are not what was matched: refused (it had been scored, as error).
   fs::remove(out / "x_vertex_ids.txt");
   fs::remove(out / "y_vertex_ids.txt");
   r = run_cli("eval " + out.string(), dir);
+  CHECK(r.code == 1);
+  CHECK(r.err.find("y_in.off: is not the Y mesh the match read") != std::string::npos);
+  save_mesh(y, (out / "y.ply").string());  // (as an output from before the id files: the inputs themselves)
+  save_mesh(x, (out / "x.ply").string());
+  write(out / "map_x_to_y.txt", [&] {
+    std::string identity;
+    for (int v = 0; v < n; ++v) identity += std::to_string(v) + "\n";
+    return identity;
+  }());
+  r = run_cli("eval " + out.string(), dir);
   REQUIRE_MESSAGE(r.code == 0, r.err);
-  CHECK(json_number(r.out, "mean_geodesic_error") > 0.1);
+  CHECK(json_number(r.out, "mean_geodesic_error") == 0.0);
 
   write(out / "report.json", "{\"x\": {\"file\": 3}");
   r = run_cli("eval " + out.string(), dir);
