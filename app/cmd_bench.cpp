@@ -354,7 +354,7 @@ SolveRecord solve_repeated(const LpProblem& lp, const std::string& solver, const
 // tools/<script> with Debian's Python, which has matplotlib; a missing matplotlib is a warning,
 // not a failed benchmark. Returns the PNG path, or "" when there is none.
 std::string plot(const std::string& script_name, const std::string& csv_path, const std::string& png_path) {
-  const fs::path script = fs::path(SHAPEMATCH_ASSETS_DIR).parent_path() / "tools" / script_name;
+  const fs::path script = fs::path(data_dir()) / "tools" / script_name;
   const std::string python = "/usr/bin/python3";
   if (std::system((python + " -c 'import matplotlib' >/dev/null 2>&1").c_str()) != 0) {
     spdlog::warn("{} cannot import matplotlib (apt install python3-matplotlib); no plot, the CSV is {}", python,

@@ -120,7 +120,7 @@ std::vector<int> read_level_map(const fs::path& path, int x_input, int y_input) 
 // Runs tools/plot_pck.py with Debian's Python (which has matplotlib); a missing matplotlib is a
 // warning, not a failed evaluation.
 void plot(const std::string& csv_path, const std::string& png_path, const std::string& label) {
-  const fs::path script = fs::path(SHAPEMATCH_ASSETS_DIR).parent_path() / "tools" / "plot_pck.py";
+  const fs::path script = fs::path(data_dir()) / "tools" / "plot_pck.py";
   const std::string python = "/usr/bin/python3";
   if (std::system((python + " -c 'import matplotlib' >/dev/null 2>&1").c_str()) != 0) {
     spdlog::warn("{} cannot import matplotlib (apt install python3-matplotlib); no plot written", python);

@@ -154,7 +154,7 @@ Action add_checkpoint_command(CLI::App& app) {
 }
 
 Action add_generate_assets_command(CLI::App& app) {
-  auto dir = std::make_shared<std::string>(SHAPEMATCH_ASSETS_DIR);
+  auto dir = std::make_shared<std::string>(data_dir() + "/assets");
   app.add_option("--out", *dir, "output directory")->capture_default_str();
   return [dir] {
     shapes::write_bundled_assets(*dir);

@@ -19,6 +19,9 @@ Action add_bench_command(CLI::App& app);
 Action add_eval_command(CLI::App& app);
 Action add_checkpoint_command(CLI::App& app);
 
+// Where the bundled meshes (assets/) and plotting scripts (tools/) are: an installed binary's
+// share/shapematch beside its bin/ (`cmake --install`), else the source tree it was built from.
+std::string data_dir();
 // The bundled demo pair (assets/), used when a command is given no meshes.
 std::string default_mesh_x();
 std::string default_mesh_y();

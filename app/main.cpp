@@ -14,11 +14,21 @@
 
 namespace shapematch::app {
 
-std::string default_mesh_x() { return std::string(SHAPEMATCH_ASSETS_DIR) + "/dolphin_straight.off"; }
-std::string default_mesh_y() { return std::string(SHAPEMATCH_ASSETS_DIR) + "/dolphin_swimming.off"; }
+std::string data_dir() {
+  // (Looked up from the executable's own path, so that an installed tree works wherever it is
+  // put and after the source tree is gone; the build tree's binary finds none and uses the source.)
+  std::error_code ec;
+  const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", ec);
+  if (!ec) {
+    const std::filesystem::path installed = exe.parent_path().parent_path() / "share" / "shapematch";
+    if (std::filesystem::is_directory(installed / "assets", ec)) return installed.string();
+  }
+  return SHAPEMATCH_SOURCE_DIR;
+}
+std::string default_mesh_x() { return data_dir() + "/assets/dolphin_straight.off"; }
+std::string default_mesh_y() { return data_dir() + "/assets/dolphin_swimming.off"; }
 std::vector<std::string> default_bench_lp_pair() {
-  return {std::string(SHAPEMATCH_ASSETS_DIR) + "/finger_straight.off",
-          std::string(SHAPEMATCH_ASSETS_DIR) + "/finger_bent.off"};
+  return {data_dir() + "/assets/finger_straight.off", data_dir() + "/assets/finger_bent.off"};
 }
 
 }  // namespace shapematch::app

@@ -528,6 +528,35 @@ TEST_CASE("cli: match replaces only an earlier output, and sweeps what a stopped
   fs::remove_all(base);
 }
 
+TEST_CASE("cli: an installed shapematch finds its meshes and scripts in its own share folder") {
+  // `cmake --install` into a prefix of its own: the installed binary's default pair is the
+  // installed copy of the bundled meshes (not the source tree's), and eval's plot script runs
+  // from there where Debian's matplotlib is.
+  shapematch::test::TempDir tmp;
+  const fs::path prefix = tmp.path / "prefix";
+  const Run installed = shapematch::test::run_command("cmake --install " + std::string(SHAPEMATCH_BUILD_DIR) +
+                                                       " --prefix " + prefix.string() + " >/dev/null");
+  REQUIRE_MESSAGE(installed.code == 0, installed.err);
+  const fs::path share = prefix / "share" / "shapematch";
+  for (const fs::path& file : {prefix / "bin" / "shapematch", share / "assets" / "dolphin_straight.off",
+                               share / "assets" / "finger_bent.off", share / "tools" / "plot_pck.py",
+                               share / "tools" / "plot_bench_match.py"})
+    CHECK_MESSAGE(fs::is_regular_file(file), file.string());
+  const std::string bin = (prefix / "bin" / "shapematch").string();
+  const fs::path out = tmp.path / "out";
+  const Run matched = shapematch::test::run_command("cd " + tmp.path.string() + " && " + bin +
+                                                    " match --faces 60 --levels 1 --backend cpu -o " + out.string());
+  REQUIRE_MESSAGE(matched.code == 0, matched.err);
+  CHECK(matched.err.find((share / "assets" / "dolphin_straight.off").string()) != std::string::npos);
+  CHECK(matched.err.find(SHAPEMATCH_ASSETS_DIR) == std::string::npos);
+  const fs::path png = tmp.path / "pck.png";
+  const Run scored = shapematch::test::run_command(bin + " eval " + out.string() + " --gt identity --threads 1 --pck-png " +
+                                                   png.string() + " >/dev/null");
+  REQUIRE_MESSAGE(scored.code == 0, scored.err);
+  if (std::system("/usr/bin/python3 -c 'import matplotlib' >/dev/null 2>&1") == 0)
+    CHECK(fs::file_size(png) > 5000);
+}
+
 TEST_CASE("cli: usage errors are one documented line with exit 1") {
   const std::string tetra = write_temp("usage_tetra.off", kTetra).string();
   const fs::path never = fs::temp_directory_path() / "shapematch_cli_usage_never";  // (no run gets to write it)
