@@ -337,6 +337,56 @@ void publish(const fs::path& tmp, const fs::path& out) {
     spdlog::warn("{}: could not remove the previous output ({})", old.string(), ec.message());
 }
 
+// SIGINT and SIGTERM while a run with a checkpoint solves: the run leaves off where it can be
+// saved (PDHG's next residual check, after a snapshot of its LP where the level keeps one, or
+// its rounding's next round) and exits 128 + the signal; a second signal stops it at once (the
+// default action). Restored when the solve ends: writing the output is not stopped half-way.
+extern "C" void on_stop_signal(int signal) {
+  request_stop(signal);
+  static const char said[] = "\nshapematch: stopping where the run can be saved (once more to stop at once)\n";
+  [[maybe_unused]] const ssize_t n = ::write(STDERR_FILENO, said, sizeof said - 1);
+}
+
+class StopOnSignals {
+public:
+  StopOnSignals() {
+    struct sigaction action {};
+    action.sa_handler = on_stop_signal;
+    sigemptyset(&action.sa_mask);
+    action.sa_flags = SA_RESETHAND;  // (the second signal: the default action)
+    ::sigaction(SIGINT, &action, &old_int_);
+    ::sigaction(SIGTERM, &action, &old_term_);
+  }
+  ~StopOnSignals() {
+    ::sigaction(SIGINT, &old_int_, nullptr);
+    ::sigaction(SIGTERM, &old_term_, nullptr);
+  }
+  StopOnSignals(const StopOnSignals&) = delete;
+  StopOnSignals& operator=(const StopOnSignals&) = delete;
+
+private:
+  struct sigaction old_int_ {}, old_term_ {};
+};
+
+// `solve()` with StopOnSignals where there is a checkpoint to leave off in; a Stopped it throws
+// says what the checkpoint holds.
+template <class Solve>
+auto stoppable(const std::string& checkpoint, Solve&& solve) {
+  if (checkpoint.empty()) return solve();
+  StopOnSignals stops;
+  try {
+    return solve();
+  } catch (const Stopped& e) {
+    const int signal = stop_requested();
+    const std::string name = signal == SIGINT ? "SIGINT" : signal == SIGTERM ? "SIGTERM" : "a stop request";
+    std::error_code ec;
+    throw Stopped(fmt::format("stopped by {} ({}): {}", name, e.what(),
+                              fs::exists(checkpoint, ec)
+                                  ? checkpoint + " holds where the run got; the same command goes on from it"
+                                  : "no checkpoint was written yet (" + checkpoint + ")"));
+  }
+}
+
 int run_match(const MatchArgs& args) {
   Stopwatch total, stage;
   Json seconds = Json::object();
@@ -507,10 +557,11 @@ int run_match(const MatchArgs& args) {
         spdlog::info("checkpoint in level {}{}, before its next attempt (ring {}, {} faces with extra rings): {}",
                      c.done() + 1, chain, a.ring,
                      std::count_if(a.extra.begin(), a.extra.end(), [](int e) { return e > 0; }), args.checkpoint);
+      if (stop_requested()) throw Stopped("after saving its checkpoint");  // (StopOnSignals)
     };
 
   stage.reset();
-  const CoarseToFineResult c2f = matcher.run([&](const LevelReport& level, const RoundingRound& r) {
+  const CoarseToFineResult c2f = stoppable(args.checkpoint, [&] { return matcher.run([&](const LevelReport& level, const RoundingRound& r) {
     const std::string at = matcher.x_levels().size() > 1 ? fmt::format("level {} ", level.level + 1) : std::string();
     const std::string parts = r.parts > 1 ? fmt::format(" in {} parts", r.parts) : std::string();
     if (r.search) {  // a search round (RoundingOptions::search_below)
@@ -544,7 +595,7 @@ int run_match(const MatchArgs& args) {
     spdlog::info("{}round {:>2}: {:>9} variables{}, LP {} in {} it, objective {:.6g}, {}{} ({:.2f} s{})", at, r.round,
                  r.variables, parts, to_string(r.status), r.iterations, r.objective, fixed, undone, r.seconds,
                  zero_cost);
-  }, resume ? &*resume : nullptr, checkpointing);
+  }, resume ? &*resume : nullptr, checkpointing); });
   const MatchingLp& m = c2f.finest;
   const RoundingResult& rr = c2f.rounding;
   // The finest rounding's rounds, with those before a checkpoint inside it that this run went on

@@ -1,11 +1,13 @@
 // shapematch: consistent, orientation-preserving 3D shape matching (Windheuser et al. 2011).
 #include "commands.hpp"
 #include "shapematch/errors.hpp"
+#include "shapematch/system.hpp"
 
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <csignal>
 #include <cstdlib>
 #include <filesystem>
 #include <iostream>
@@ -77,6 +79,10 @@ int main(int argc, char** argv) {
   } catch (const shapematch::Error& e) {
     std::cerr << "shapematch: error: " << e.what() << "\n";
     return 1;
+  } catch (const shapematch::Stopped& e) {  // (match's StopOnSignals)
+    std::cerr << "shapematch: " << e.what() << "\n";
+    const int signal = shapematch::stop_requested();
+    return 128 + (signal > 0 ? signal : SIGINT);
   } catch (const std::bad_alloc&) {
     std::cerr << "shapematch: error: out of memory\n";
     return 1;

@@ -811,6 +811,40 @@ TEST_CASE("cli: match --checkpoint goes on after the levels a stopped run finish
   CHECK(read_file(ckpt) == bytes);
 }
 
+TEST_CASE("cli: SIGINT stops a match with a checkpoint where it can go on from") {
+  // The run is sent SIGINT once its first checkpoint (after level 1) exists: it leaves off in
+  // level 2 (its LP's next residual check, or its rounding's next round) after saving there,
+  // exits 130 with one line naming the checkpoint, writes no output; the same command then goes
+  // on from that checkpoint to a verified result.
+  shapematch::test::TempDir tmp;
+  const std::string dolphin = std::string(SHAPEMATCH_ASSETS_DIR) + "/dolphin_straight.off";
+  const std::string swimming = std::string(SHAPEMATCH_ASSETS_DIR) + "/dolphin_swimming.off";
+  const std::string ckpt = (tmp.path / "c.ckpt").string();
+  const fs::path out = tmp.path / "out";
+  const std::string command = std::string(SHAPEMATCH_CLI) + " match " + dolphin + " " + swimming +
+                              " --faces 300 --levels 2 --backend cpu --threads 1 --checkpoint " + ckpt + " -o " +
+                              out.string();
+  const fs::path script = tmp.path / "stop.sh";
+  std::ofstream(script) << command << " >/dev/null 2>" << (tmp.path / "err.txt").string() << " & p=$!\n"
+                        << "while [ ! -e " << ckpt << " ] && kill -0 $p 2>/dev/null; do sleep 0.01; done\n"
+                        << "kill -INT $p 2>/dev/null\nwait $p\necho $?\n";
+  const Run stopped = shapematch::test::run_command("bash " + script.string());
+  const std::string err = read_file(tmp.path / "err.txt");
+  CHECK_MESSAGE(stopped.out == "130\n", err);
+  CHECK(err.find("shapematch: stopping where the run can be saved") != std::string::npos);
+  CHECK(err.find("shapematch: stopped by SIGINT (") != std::string::npos);
+  CHECK(err.find(ckpt + " holds where the run got; the same command goes on from it") != std::string::npos);
+  CHECK_FALSE(fs::exists(out));
+  const shapematch::LevelCheckpoint left = shapematch::load_checkpoint(ckpt);
+  CHECK(left.done() == 1);
+  CHECK_FALSE(left.attempt.empty());  // (saved inside level 2, not only after level 1)
+  const Run again = run(command.substr(std::string(SHAPEMATCH_CLI).size() + 1));
+  REQUIRE_MESSAGE(again.code == 0, again.err);
+  CHECK(again.err.find("going on from a checkpoint after level 1 of 2") != std::string::npos);
+  CHECK(json_number(read_file(out / "report.json"), "resumed_after_level") == 1);
+  CHECK(read_file(out / "report.json").find("\"verified\": true") != std::string::npos);
+}
+
 TEST_CASE("cli: checkpoint shows both chains of a run stopped inside lookahead") {
   shapematch::test::TempDir tmp;
   const std::string ckpt = (tmp.path / "two.ckpt").string();

@@ -1680,7 +1680,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
           const double gap = options_.rounding_checkpoint_seconds > 0.0
                                  ? std::max(options_.rounding_checkpoint_seconds, 20.0 * last_save_seconds)
                                  : 0.0;
-          if (!attempted || since_saved.seconds() < gap) return;
+          if (!attempted || (since_saved.seconds() < gap && !stop_requested())) return;  // (a stop saves now)
           // Its next round's warm start too (lp_checkpoint_seconds turns the LP's saves on): a run
           // gone on from it starts its round 1 there, not cold.
           save_rounding(ones, steps, r.cap_scale, x, y, 0.0, options_.lp_checkpoint_seconds > 0.0);

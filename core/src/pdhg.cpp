@@ -281,9 +281,11 @@ LpResult PdhgSolver::solve(const LpProblem& problem, const SolverParams& params)
     }
 
     // A point to start this solve again from, for the caller's checkpoint (SolverParams::snapshot).
+    // (At once where a stop is asked for: request_stop.)
     const double wait =
         snapshots == 0 && params.snapshot_first_seconds >= 0.0 ? params.snapshot_first_seconds : params.snapshot_seconds;
-    if (params.snapshot && params.snapshot_seconds > 0.0 && since_snapshot.seconds() >= wait) {
+    const bool stopping = stop_requested() != 0;
+    if (params.snapshot && params.snapshot_seconds > 0.0 && (since_snapshot.seconds() >= wait || stopping)) {
       SolveSnapshot snap;
       backend->read(snap.x, snap.y);
       for (int64_t j = 0; j < n; ++j) snap.x[j] *= d[j];  // (in place: at 30 M columns each copy counts)
@@ -296,6 +298,7 @@ LpResult PdhgSolver::solve(const LpProblem& problem, const SolverParams& params)
       since_snapshot.reset();
       ++snapshots;
     }
+    if (stopping) throw Stopped(fmt::format("stopped in an LP after {} iterations", total));
 
     // Restarts on the fixed-point residual (cuPDLPx): sufficient decay, necessary decay without
     // progress, or a long stretch since the last restart.

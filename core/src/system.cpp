@@ -60,6 +60,14 @@ int worker_threads() {
   return limit > 0 ? std::min(limit, cpus) : cpus;
 }
 
+namespace {
+std::atomic<int> g_stop{0};
+static_assert(std::atomic<int>::is_always_lock_free, "request_stop is called from signal handlers");
+}  // namespace
+
+void request_stop(int signal) noexcept { g_stop.store(signal == 0 ? -1 : signal, std::memory_order_relaxed); }
+int stop_requested() noexcept { return g_stop.load(std::memory_order_relaxed); }
+
 void set_worker_threads(int threads) { g_thread_limit.store(std::max(0, threads), std::memory_order_relaxed); }
 
 }  // namespace shapematch

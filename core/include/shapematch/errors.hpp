@@ -55,4 +55,11 @@ public:
   using Error::Error;
 };
 
+// Thrown where a run leaves off after request_stop (system.hpp), once what could be saved is.
+// Not an Error: nothing retries or works around it (the command line exits 128 + the signal).
+class Stopped : public std::runtime_error {
+public:
+  using std::runtime_error::runtime_error;
+};
+
 }  // namespace shapematch

@@ -21,6 +21,13 @@ int worker_threads();
 // solver keeps the count it started with.
 void set_worker_threads(int threads);
 
+// A stop asked for from outside a run (match's SIGINT/SIGTERM handler, where it has a
+// checkpoint): PDHG checks it at its residual checks and throws Stopped (errors.hpp) there, after
+// its snapshot where it has one, so that a long run leaves off where it can be gone on from.
+// Async-signal-safe. `signal`: what asked (reported back by stop_requested; 0: none asked).
+void request_stop(int signal) noexcept;
+int stop_requested() noexcept;
+
 class Stopwatch {
 public:
   Stopwatch() : start_(std::chrono::steady_clock::now()) {}
