@@ -25,6 +25,8 @@
 #include <optional>
 #include <sstream>
 
+#include <fcntl.h>
+#include <stdio.h>  // (renameat2)
 #include <unistd.h>
 
 namespace fs = std::filesystem;
@@ -299,6 +301,33 @@ void remove_stale_siblings(const fs::path& out) {
   }
 }
 
+// `tmp` kept as OUT.new-PID where `out` became something this run may not replace while it
+// worked; throws the error that says so (`why`), naming it.
+[[noreturn]] void keep_beside(const fs::path& tmp, const fs::path& out, const std::string& why) {
+  std::error_code ec;
+  const fs::path kept = out.string() + ".new-" + std::to_string(::getpid());
+  fs::rename(tmp, kept, ec);
+  if (ec) throw IoError(why + " (it changed while this run worked; its output could not be kept: " + ec.message() + ")");
+  fs::remove(kept / kWriting, ec);
+  throw IoError(why + " (it changed while this run worked; its output is in " + kept.string() + ")");
+}
+
+// `from` renamed to `to` only where `to` does not exist (renameat2's RENAME_NOREPLACE, so that a
+// directory made at `to` just before is never replaced or merged; where the file system cannot,
+// a plain rename, which fails on a non-empty `to`). False where `to` exists.
+bool rename_if_absent(const fs::path& from, const fs::path& to, std::error_code& ec) {
+  ec.clear();
+  if (::renameat2(AT_FDCWD, from.c_str(), AT_FDCWD, to.c_str(), RENAME_NOREPLACE) == 0) return true;
+  if (errno == EEXIST || errno == ENOTEMPTY) return false;
+  if (errno != EINVAL && errno != ENOSYS) {
+    ec = std::error_code(errno, std::generic_category());
+    return true;
+  }
+  if (fs::exists(fs::symlink_status(to, ec))) return false;
+  fs::rename(from, to, ec);
+  return !(ec == std::errc::directory_not_empty || ec == std::errc::file_exists);
+}
+
 // Renames the finished temporary directory `tmp` into place as `out`, so that a failure never
 // leaves a half-written output directory. Where `out` has become something this run may not
 // replace meanwhile, the output is kept as OUT.new-PID and the error names it.
@@ -309,11 +338,7 @@ void publish(const fs::path& tmp, const fs::path& out) {
     try {
       output_directory(out.string());
     } catch (const Error& e) {
-      const fs::path kept = out.string() + ".new-" + std::to_string(::getpid());
-      fs::rename(tmp, kept, ec);
-      if (ec) throw;
-      fs::remove(kept / kWriting, ec);
-      throw IoError(std::string(e.what()) + " (it changed while this run worked; its output is in " + kept.string() + ")");
+      keep_beside(tmp, out, e.what());
     }
     write_file_atomic((out / kReplaced).string(), std::to_string(::getpid()) + "\n");
     old = out.string() + ".old-" + std::to_string(::getpid());
@@ -324,7 +349,12 @@ void publish(const fs::path& tmp, const fs::path& out) {
     }
   }
   fs::remove(tmp / kWriting, ec);
-  fs::rename(tmp, out, ec);
+  if (!rename_if_absent(tmp, out, ec)) {  // (made meanwhile: the user's; the output it replaced goes back beside)
+    std::error_code restore;
+    if (!old.empty()) fs::remove(old / kReplaced, restore);
+    keep_beside(tmp, out, out.string() + ": was made by someone else just as this run was putting its output there" +
+                              (old.empty() ? std::string() : "; the output it replaced is " + old.string()));
+  }
   if (ec) {
     std::error_code restore;
     if (!old.empty()) {

@@ -154,9 +154,10 @@ Action add_checkpoint_command(CLI::App& app) {
 }
 
 Action add_generate_assets_command(CLI::App& app) {
-  auto dir = std::make_shared<std::string>(data_dir() + "/assets");
-  app.add_option("--out", *dir, "output directory")->capture_default_str();
+  auto dir = std::make_shared<std::string>();  // (empty: the bundled assets/, looked up when run)
+  app.add_option("--out", *dir, "output directory (default: the bundled meshes' own assets/ folder)");
   return [dir] {
+    if (dir->empty()) *dir = data_dir() + "/assets";
     shapes::write_bundled_assets(*dir);
     spdlog::info("wrote the bundled meshes to {}", *dir);
     return 0;

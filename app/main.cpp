@@ -10,6 +10,7 @@
 #include <csignal>
 #include <cstdlib>
 #include <filesystem>
+#include <vector>
 #include <iostream>
 #include <map>
 #include <new>
@@ -17,15 +18,25 @@
 namespace shapematch::app {
 
 std::string data_dir() {
-  // (Looked up from the executable's own path, so that an installed tree works wherever it is
-  // put and after the source tree is gone; the build tree's binary finds none and uses the source.)
-  std::error_code ec;
-  const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", ec);
-  if (!ec) {
-    const std::filesystem::path installed = exe.parent_path().parent_path() / "share" / "shapematch";
-    if (std::filesystem::is_directory(installed / "assets", ec)) return installed.string();
-  }
-  return SHAPEMATCH_SOURCE_DIR;
+  // (From the executable's own path, so that an installed tree works wherever it is put and after
+  // the source tree is gone; the build tree's binary finds none there and uses the source.)
+  static const std::string found = [] {
+    namespace fs = std::filesystem;
+    std::error_code ec;
+    const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+    if (ec || exe.parent_path() == fs::path(SHAPEMATCH_BUILD_DIR)) return std::string(SHAPEMATCH_SOURCE_DIR);
+    std::vector<fs::path> looked;
+    looked.push_back((exe.parent_path() / SHAPEMATCH_DATA_FROM_BIN).lexically_normal());
+    looked.push_back(SHAPEMATCH_INSTALL_DATA_DIR);
+    for (const fs::path& dir : looked)
+      if (fs::is_directory(dir / "assets", ec)) return dir.string();
+    // A binary outside its build tree without its data beside it (a bin/ reached through a
+    // symbolic link, e.g. /bin -> usr/bin with --prefix /): said, not silently the source's.
+    spdlog::warn("shapematch: its data (assets/, tools/) is not in {} or {}; using the source tree's, {}",
+                 looked.front().string(), looked.back().string(), SHAPEMATCH_SOURCE_DIR);
+    return std::string(SHAPEMATCH_SOURCE_DIR);
+  }();
+  return found;
 }
 std::string default_mesh_x() { return data_dir() + "/assets/dolphin_straight.off"; }
 std::string default_mesh_y() { return data_dir() + "/assets/dolphin_swimming.off"; }

@@ -488,7 +488,7 @@ TEST_CASE("cli: match replaces only an earlier output, and sweeps what a stopped
   // -o DIR made by the user while the run wrote its output: the run is stopped (SIGSTOP) while
   // its temporary output exists, DIR made with a file of the user's, and the run let go on. Its
   // output is kept beside as DIR.new-PID, named in the error; DIR is left as the user made it.
-  // (Where the run got past publishing before it was stopped, mkdir fails: tried again.)
+  // (Where the run got past its last look at DIR before it was stopped: tried again.)
   const fs::path raced = base / "raced";
   const fs::path script = base / "race.sh";
   {
@@ -497,10 +497,12 @@ TEST_CASE("cli: match replaces only an earlier output, and sweeps what a stopped
        << "for i in $(seq 20); do\n"
        << "  rm -rf raced raced.*\n"
        << "  " << SHAPEMATCH_CLI << " " << pair << "-o raced >/dev/null 2>race.err & p=$!\n"
+       << "  trap 'kill -CONT $p 2>/dev/null' EXIT\n"
        << "  while [ ! -e raced.tmp-$p/.shapematch-writing ] && kill -0 $p 2>/dev/null; do :; done\n"
-       << "  kill -STOP $p 2>/dev/null\n"
-       << "  if mkdir raced 2>/dev/null; then echo mine > raced/mine.txt; kill -CONT $p; wait $p; "
-          "echo \"$? $p\"; exit 0; fi\n"
+       << "  kill -STOP $p 2>/dev/null || { wait $p; continue; }\n"
+       // (Its marker still there once stopped: it has not yet looked at DIR for the last time.)
+       << "  if [ -e raced.tmp-$p/.shapematch-writing ] && mkdir raced 2>/dev/null; then echo mine > raced/mine.txt; "
+          "kill -CONT $p; wait $p; echo \"$? $p\"; exit 0; fi\n"
        << "  kill -CONT $p 2>/dev/null; wait $p\n"
        << "done\n"
        << "echo missed\n";

@@ -1880,6 +1880,13 @@ TEST_CASE("coarse to fine: a run gone on from an attempt of a level in progress 
     CHECK(refused(bytes.substr(0, bytes.size() - 1)).find("checksum") != std::string::npos);
     CHECK(refused(bytes.substr(0, bytes.size() - 8)).find("checksum") != std::string::npos);
     CHECK(refused(bytes.substr(0, at + 6)).find("cut short") != std::string::npos);
+    // Its version field damaged (to an earlier version, which has no checksum, or a later one):
+    // refused as damaged too, not as a file of that version.
+    for (char version : {char(16), char(17), char(50)}) {
+      std::string damaged = bytes;
+      damaged[at] = version;
+      CHECK_MESSAGE(refused(damaged).find("checksum does not match") != std::string::npos, int(version));
+    }
     // Two words swapped (same bytes, other order) differ too.
     std::string swapped = bytes;
     const size_t mid = (bytes.size() / 16) * 8;
@@ -2035,14 +2042,16 @@ TEST_CASE("coarse to fine: a run gone on from inside a refined level's first LP 
   CHECK(load_checkpoint(file).attempt.solving_watched);
   detail::save_checkpoint_as(file, late, 12);
   CHECK(load_checkpoint(file).attempt.solving.empty());
-  // Cut short inside the iterate: an error naming the file.
-  save_checkpoint(file, late);
-  {
+  // Cut short inside the iterate: an error naming the file. (Version 17, without a checksum: the
+  // reader's own length checks; from 18 on the checksum refuses it first.)
+  for (uint32_t version : {17u, 18u}) {
+    detail::save_checkpoint_as(file, late, version);
     std::ifstream in(file, std::ios::binary);
     std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     in.close();
     std::ofstream(file, std::ios::binary | std::ios::trunc) << bytes.substr(0, bytes.size() - 64);
     CHECK_THROWS_WITH_AS(load_checkpoint(file), doctest::Contains(file.c_str()), IoError);
+    CHECK_THROWS_WITH_AS(load_checkpoint(file), doctest::Contains(version == 17 ? "cut short" : "checksum"), IoError);
   }
   // An LP under way at a negative count is refused.
   LevelCheckpoint broken = late;

@@ -92,7 +92,8 @@ public:
     Checksum c = *this;
     uint64_t w = 0;
     std::memcpy(&w, pending_, fill_);
-    c.mix(w ^ length_);
+    c.mix(w);  // (the tail, zero-padded; then the length, so that padding and length never trade)
+    c.mix(length_);
     uint64_t h = c.h_;  // (splitmix64's finaliser: every bit of the state reaches every bit)
     h = (h ^ (h >> 30)) * 0xBF58476D1CE4E5B9ull;
     h = (h ^ (h >> 27)) * 0x94D049BB133111EBull;
@@ -368,18 +369,36 @@ LevelCheckpoint load_checkpoint(const std::string& path) {
   uint32_t stated = 0;
   if (bytes.size() >= sizeof kMagic - 1 + sizeof stated)
     std::memcpy(&stated, bytes.data() + sizeof kMagic - 1, sizeof stated);
-  if (stated >= kFirstChecksummed && stated <= kVersion) {
+  const std::string damaged = path + ": the checkpoint is damaged (its checksum does not match: changed or cut short "
+                                     "since it was written)";
+  // Whether the file ends in the checksum of the rest: any file of version 18 on, also one whose
+  // version field was damaged (a file without a checksum ends so by chance 1 in 2^64).
+  const auto sealed = [&](bool as_version) {
     uint64_t sum = 0;
-    if (bytes.size() < sizeof kMagic - 1 + sizeof stated + sizeof sum)
-      throw IoError(path + ": the checkpoint is cut short");
+    if (bytes.size() < sizeof kMagic - 1 + sizeof stated + sizeof sum) return false;
     const size_t body = bytes.size() - sizeof sum;
     std::memcpy(&sum, bytes.data() + body, sizeof sum);
     Checksum c;
     c.add(bytes.data(), body);
-    if (c.value() != sum)
-      throw IoError(path + ": the checkpoint is damaged (its checksum does not match: changed or cut short since "
-                           "it was written)");
-    bytes.resize(body);
+    if (c.value() == sum) return true;
+    // (As its version field says: where the rest matches with another version, that field is the damage.)
+    if (!as_version) return false;
+    for (uint32_t v = kFirstChecksummed; v <= kVersion; ++v) {
+      Checksum o;
+      o.add(bytes.data(), sizeof kMagic - 1);
+      o.add(reinterpret_cast<const char*>(&v), sizeof v);
+      o.add(bytes.data() + sizeof kMagic - 1 + sizeof v, body - (sizeof kMagic - 1 + sizeof v));
+      if (o.value() == sum) throw IoError(damaged);
+    }
+    return false;
+  };
+  if (stated >= kFirstChecksummed && stated <= kVersion) {
+    if (bytes.size() < sizeof kMagic - 1 + sizeof stated + sizeof(uint64_t))
+      throw IoError(path + ": the checkpoint is cut short");
+    if (!sealed(false)) throw IoError(damaged);
+    bytes.resize(bytes.size() - sizeof(uint64_t));
+  } else if (sealed(true) && stated < kFirstChecksummed) {  // (a later version's own file: refused below)
+    throw IoError(damaged);
   }
   Reader r(path, std::move(bytes));
   std::string magic(sizeof kMagic - 1, '\0');
