@@ -452,7 +452,7 @@ int run_bench_lp(BenchLpArgs args) {
 // each one is timed, measured and, past the time limit, killed on its own.
 
 struct ChildRun {
-  std::string status;  // "ok", "timed out" or "failed: <reason>"
+  std::string status;  // "ok", "timed out", "interrupted" (SIGINT, SIGTERM) or "failed: <reason>"
   double seconds = kNaN;
   double peak_rss_mb = kNaN;
 };
@@ -523,6 +523,8 @@ ChildRun run_child(const std::vector<std::string>& args, const std::string& out_
     r.status = "timed out";
   else if (WIFEXITED(wstatus) && WEXITSTATUS(wstatus) == 0)
     r.status = "ok";
+  else if (WIFSIGNALED(wstatus) && (WTERMSIG(wstatus) == SIGINT || WTERMSIG(wstatus) == SIGTERM))
+    r.status = "interrupted";  // (match --checkpoint saves before it goes: --resume goes on from there)
   else
     r.status = "failed: " + failure_reason(err_path, wstatus);
   return r;
@@ -1029,6 +1031,11 @@ bool resume_row(const BenchMatchArgs& args, const PairSpec& pair, const std::vec
       return false;
     }
     earlier = recorded_total;
+    // Stopped by SIGINT or SIGTERM (a Ctrl-C, a batch system): its checkpoint was saved as it went.
+    if (status->text == "interrupted") {
+      spdlog::info("{}: interrupted; running it again{}", row.name, fs::exists(checkpoint) ? ", from its checkpoint" : "");
+      return false;
+    }
     // Another backend or device: its row is not this one's, but the levels it checkpointed are
     // (a run that ran out of a GPU's time goes on from them on the CPU, or on another GPU).
     if (const std::vector<std::string> was = where_run(recorded_match); was != where_run(match)) {

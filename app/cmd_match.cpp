@@ -17,6 +17,7 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <array>
 #include <cerrno>
 #include <csignal>
 #include <filesystem>
@@ -301,20 +302,9 @@ void remove_stale_siblings(const fs::path& out) {
   }
 }
 
-// `tmp` kept as OUT.new-PID where `out` became something this run may not replace while it
-// worked; throws the error that says so (`why`), naming it.
-[[noreturn]] void keep_beside(const fs::path& tmp, const fs::path& out, const std::string& why) {
-  std::error_code ec;
-  const fs::path kept = out.string() + ".new-" + std::to_string(::getpid());
-  fs::rename(tmp, kept, ec);
-  if (ec) throw IoError(why + " (it changed while this run worked; its output could not be kept: " + ec.message() + ")");
-  fs::remove(kept / kWriting, ec);
-  throw IoError(why + " (it changed while this run worked; its output is in " + kept.string() + ")");
-}
-
 // `from` renamed to `to` only where `to` does not exist (renameat2's RENAME_NOREPLACE, so that a
 // directory made at `to` just before is never replaced or merged; where the file system cannot,
-// a plain rename, which fails on a non-empty `to`). False where `to` exists.
+// a plain rename, which fails on a non-empty `to`). False where `to` exists; `ec` any other failure.
 bool rename_if_absent(const fs::path& from, const fs::path& to, std::error_code& ec) {
   ec.clear();
   if (::renameat2(AT_FDCWD, from.c_str(), AT_FDCWD, to.c_str(), RENAME_NOREPLACE) == 0) return true;
@@ -328,9 +318,33 @@ bool rename_if_absent(const fs::path& from, const fs::path& to, std::error_code&
   return !(ec == std::errc::directory_not_empty || ec == std::errc::file_exists);
 }
 
+// `from` moved to `name`, or where that exists (a process id used again, as in a container whose
+// runs all have the same one) NAME.1, NAME.2, ...: the name it got; empty with `ec` where it
+// could not be moved.
+fs::path move_aside(const fs::path& from, const std::string& name, std::error_code& ec) {
+  for (int k = 0; k < 1000; ++k) {
+    const fs::path to = k == 0 ? fs::path(name) : fs::path(name + "." + std::to_string(k));
+    if (rename_if_absent(from, to, ec)) return ec ? fs::path() : to;
+  }
+  ec = std::make_error_code(std::errc::file_exists);
+  return {};
+}
+
+// `tmp` kept as OUT.new-PID where `out` became something this run may not replace while it
+// worked; throws the error that says so (`why`), naming where the output is. (Where it cannot be
+// moved, it stays where it is, unmarked, so that nothing removes it.)
+[[noreturn]] void keep_beside(const fs::path& tmp, const fs::path& out, const std::string& why) {
+  std::error_code ec;
+  fs::remove(tmp / kWriting, ec);
+  const fs::path kept = move_aside(tmp, out.string() + ".new-" + std::to_string(::getpid()), ec);
+  throw IoError(why + " (it changed while this run worked; its output is in " + (kept.empty() ? tmp : kept).string() + ")");
+}
+
 // Renames the finished temporary directory `tmp` into place as `out`, so that a failure never
 // leaves a half-written output directory. Where `out` has become something this run may not
-// replace meanwhile, the output is kept as OUT.new-PID and the error names it.
+// replace meanwhile, the output is kept as OUT.new-PID and the error names it. Past this point a
+// failure leaves the finished output where the error says (run_match removes `tmp` only while it
+// holds kWriting).
 void publish(const fs::path& tmp, const fs::path& out) {
   std::error_code ec;
   fs::path old;
@@ -341,27 +355,25 @@ void publish(const fs::path& tmp, const fs::path& out) {
       keep_beside(tmp, out, e.what());
     }
     write_file_atomic((out / kReplaced).string(), std::to_string(::getpid()) + "\n");
-    old = out.string() + ".old-" + std::to_string(::getpid());
-    fs::rename(out, old, ec);
-    if (ec) {
+    old = move_aside(out, out.string() + ".old-" + std::to_string(::getpid()), ec);
+    if (old.empty()) {
+      const std::string why = ec.message();
       fs::remove(out / kReplaced, ec);
-      throw IoError(out.string() + ": cannot replace (" + ec.message() + ")");
+      throw IoError(out.string() + ": cannot replace (" + why + ")");
     }
   }
   fs::remove(tmp / kWriting, ec);
-  if (!rename_if_absent(tmp, out, ec)) {  // (made meanwhile: the user's; the output it replaced goes back beside)
+  if (!rename_if_absent(tmp, out, ec)) {  // (made meanwhile: the user's; the output it replaced stays beside)
     std::error_code restore;
     if (!old.empty()) fs::remove(old / kReplaced, restore);
     keep_beside(tmp, out, out.string() + ": was made by someone else just as this run was putting its output there" +
                               (old.empty() ? std::string() : "; the output it replaced is " + old.string()));
   }
   if (ec) {
+    const std::string why = ec.message();
     std::error_code restore;
-    if (!old.empty()) {
-      fs::rename(old, out, restore);
-      fs::remove(out / kReplaced, restore);
-    }
-    throw IoError(out.string() + ": " + ec.message());
+    if (!old.empty() && rename_if_absent(old, out, restore) && !restore) fs::remove(out / kReplaced, restore);
+    throw IoError(out.string() + ": " + why + " (its output is left in " + tmp.string() + ")");
   }
   if (!old.empty() && (fs::remove_all(old, ec), ec))
     spdlog::warn("{}: could not remove the previous output ({})", old.string(), ec.message());
@@ -369,12 +381,21 @@ void publish(const fs::path& tmp, const fs::path& out) {
 
 // SIGINT and SIGTERM while a run with a checkpoint solves: the run leaves off where it can be
 // saved (PDHG's next residual check, after a snapshot of its LP where the level keeps one, or
-// its rounding's next round) and exits 128 + the signal; a second signal stops it at once (the
-// default action). Restored when the solve ends: writing the output is not stopped half-way.
+// its rounding's next round) and then dies by that signal (main.cpp); a second signal of either
+// kind stops it at once (the default action). Not installed for a signal the process inherited
+// as ignored (a background job of a script, nohup). Restored when the solve ends: writing the
+// output is not stopped half-way.
 extern "C" void on_stop_signal(int signal) {
+  const int saved = errno;
   request_stop(signal);
+  struct sigaction fallback {};
+  fallback.sa_handler = SIG_DFL;
+  sigemptyset(&fallback.sa_mask);
+  ::sigaction(SIGINT, &fallback, nullptr);
+  ::sigaction(SIGTERM, &fallback, nullptr);
   static const char said[] = "\nshapematch: stopping where the run can be saved (once more to stop at once)\n";
   [[maybe_unused]] const ssize_t n = ::write(STDERR_FILENO, said, sizeof said - 1);
+  errno = saved;
 }
 
 class StopOnSignals {
@@ -383,19 +404,28 @@ public:
     struct sigaction action {};
     action.sa_handler = on_stop_signal;
     sigemptyset(&action.sa_mask);
-    action.sa_flags = SA_RESETHAND;  // (the second signal: the default action)
-    ::sigaction(SIGINT, &action, &old_int_);
-    ::sigaction(SIGTERM, &action, &old_term_);
+    sigaddset(&action.sa_mask, SIGINT);
+    sigaddset(&action.sa_mask, SIGTERM);
+    action.sa_flags = SA_RESTART;
+    for (auto& [signal, old, set] : installed_) {
+      ::sigaction(signal, nullptr, &old);
+      set = old.sa_handler != SIG_IGN && ::sigaction(signal, &action, nullptr) == 0;
+    }
   }
   ~StopOnSignals() {
-    ::sigaction(SIGINT, &old_int_, nullptr);
-    ::sigaction(SIGTERM, &old_term_, nullptr);
+    for (auto& [signal, old, set] : installed_)
+      if (set) ::sigaction(signal, &old, nullptr);
   }
   StopOnSignals(const StopOnSignals&) = delete;
   StopOnSignals& operator=(const StopOnSignals&) = delete;
 
 private:
-  struct sigaction old_int_ {}, old_term_ {};
+  struct Installed {
+    int signal;
+    struct sigaction old;
+    bool set;
+  };
+  std::array<Installed, 2> installed_{{{SIGINT, {}, false}, {SIGTERM, {}, false}}};
 };
 
 // `solve()` with StopOnSignals where there is a checkpoint to leave off in; a Stopped it throws
@@ -935,8 +965,8 @@ int run_match(const MatchArgs& args) {
     write_file_atomic((tmp / "report.json").string(), report.dump() + "\n");
     publish(tmp, out);
   } catch (...) {
-    std::error_code ec;
-    fs::remove_all(tmp, ec);
+    std::error_code ec;  // (a finished output that publish could not put in place is kept: it says where)
+    if (fs::exists(tmp / kWriting, ec) || fs::is_empty(tmp, ec)) fs::remove_all(tmp, ec);
     throw;
   }
   spdlog::info("wrote {}", out.string());

@@ -91,9 +91,13 @@ int main(int argc, char** argv) {
     std::cerr << "shapematch: error: " << e.what() << "\n";
     return 1;
   } catch (const shapematch::Stopped& e) {  // (match's StopOnSignals)
-    std::cerr << "shapematch: " << e.what() << "\n";
-    const int signal = shapematch::stop_requested();
-    return 128 + (signal > 0 ? signal : SIGINT);
+    std::cerr << "shapematch: " << e.what() << std::endl;
+    // Dies by the signal, as without the handler, so that a script's loop stops too (its status
+    // is 128 + the signal, 130 or 143, either way).
+    const int signal = shapematch::stop_requested() > 0 ? shapematch::stop_requested() : SIGINT;
+    std::signal(signal, SIG_DFL);
+    std::raise(signal);
+    return 128 + signal;
   } catch (const std::bad_alloc&) {
     std::cerr << "shapematch: error: out of memory\n";
     return 1;

@@ -525,6 +525,17 @@ TEST_CASE("cli: bench match --pairs --resume goes on from where a run that timed
   CHECK(row().at("energy") == first.at("energy"));
   CHECK_FALSE(fs::exists(checkpoint));
 
+  // One interrupted (its match stopped by SIGINT or SIGTERM, which saves as it goes): run again
+  // from its checkpoint, whatever the checkpoint's progress.
+  fs::copy_file(dir / "saved.ckpt", checkpoint);
+  edit_record("status", "\"interrupted\"");
+  REQUIRE(run_cli(bench, err) == 0);
+  CHECK(read_text(err).find("interrupted; running it again, from its checkpoint") != std::string::npos);
+  CHECK(read_text(log).find("going on from a checkpoint after level 2 of 3") != std::string::npos);
+  CHECK(row().at("status") == "ok");
+  CHECK(row().at("resumed_after_level") == "2");
+  CHECK_FALSE(fs::exists(checkpoint));
+
   // One that timed out without getting past the checkpoint it started from keeps its row.
   fs::copy_file(dir / "saved.ckpt", checkpoint);
   CHECK(read_text(record).find("\"checkpoint_levels_before\": 2") != std::string::npos);  // it started from it

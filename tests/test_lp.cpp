@@ -6,6 +6,7 @@
 
 #include <doctest/doctest.h>
 
+#include <csignal>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -33,6 +34,31 @@ TEST_CASE("clp: tiny LPs with known optima and an infeasible one") {
     r = solve_lp(dense_lp({{1, 1}}, {3}, {1, 1}), solver);
     CHECK(r.status == LpStatus::Infeasible);
   }
+}
+
+namespace {
+volatile std::sig_atomic_t g_interrupted = 0;
+extern "C" void note_interrupt(int) { g_interrupted = 1; }
+}  // namespace
+
+TEST_CASE("clp: leaves SIGINT to the program (match's stop on a signal)") {
+  // Clp's own interrupt handling would take SIGINT during a solve (cutting the LP short) and put
+  // the program's handler back without its flags (SA_RESETHAND: a second Ctrl-C stops at once).
+  struct sigaction mine {}, before {}, after {};
+  mine.sa_handler = note_interrupt;
+  sigemptyset(&mine.sa_mask);
+  mine.sa_flags = SA_RESETHAND;
+  REQUIRE(sigaction(SIGINT, &mine, &before) == 0);
+  for (const std::string solver : {"clp-dual", "clp-barrier"}) {
+    CAPTURE(solver);
+    LpResult r = solve_lp(dense_lp({{1, 1}}, {1}, {1, 2}), solver);
+    CHECK(r.status == LpStatus::Optimal);
+    REQUIRE(sigaction(SIGINT, nullptr, &after) == 0);
+    CHECK((after.sa_handler == &note_interrupt));
+    CHECK((after.sa_flags & SA_RESETHAND) != 0);
+  }
+  sigaction(SIGINT, &before, nullptr);
+  CHECK(g_interrupted == 0);
 }
 
 TEST_CASE("clp: the dual simplex names the rows of an infeasible LP that clash") {

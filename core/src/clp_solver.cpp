@@ -48,6 +48,10 @@ LpResult ClpSolver::solve(const LpProblem& problem, const SolverParams& params) 
   } else {
     options.setSolveType(ClpSolve::useBarrier);  // with crossover to an exact vertex
   }
+  // No interrupt handling of Clp's: it would take SIGINT during the solve (an LP cut short, the
+  // run going on) and put the program's handler back without its flags (match --checkpoint's stop
+  // on a signal; test_lp).
+  options.setSpecialOption(2, 1);
   model.initialSolve(options);
 
   LpResult r;

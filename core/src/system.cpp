@@ -65,7 +65,10 @@ std::atomic<int> g_stop{0};
 static_assert(std::atomic<int>::is_always_lock_free, "request_stop is called from signal handlers");
 }  // namespace
 
-void request_stop(int signal) noexcept { g_stop.store(signal == 0 ? -1 : signal, std::memory_order_relaxed); }
+void request_stop(int signal) noexcept {
+  int none = 0;  // (the first request is the one reported)
+  g_stop.compare_exchange_strong(none, signal == 0 ? -1 : signal, std::memory_order_relaxed);
+}
 int stop_requested() noexcept { return g_stop.load(std::memory_order_relaxed); }
 
 void set_worker_threads(int threads) { g_thread_limit.store(std::max(0, threads), std::memory_order_relaxed); }
