@@ -346,7 +346,7 @@ TEST_CASE("evaluation: ground-truth readers parse the data set formats and rejec
   CHECK(map[1].y == 1);
   // A header and comments, blank lines: skipped; a pair given twice is two samples.
   const GroundTruth commented =
-      read_map_ground_truth(write(dir / "commented.txt", "# x y\n1 3\n\n  # again\n1 3\n2 2\n").string(), 2, 3);
+      read_map_ground_truth(write(dir / "commented.txt", "# x y\n1 3\n\n  # again\n1 3 # twice\n2 2#\n").string(), 2, 3);
   REQUIRE(commented.size() == 3);
   CHECK(commented[0].x == 0);
   CHECK(commented[1].y == 2);

@@ -58,16 +58,18 @@ int parse_vertex(const std::string& token, int base, int num_vertices, const std
 
 // Rows of `columns` indices each. In a list (.vts) a blank line inside the file would shift the
 // "line k ↔ line k" pairing, so it is an error rather than skipped; a file of pairs holds each
-// pair on its line, and skips blank lines and `#` comments (a header written by hand).
+// pair on its line, and skips blank lines and `#` comments (a header written by hand, a note
+// after a pair).
 std::vector<std::vector<int>> read_rows(const std::string& path, int columns, int base,
                                         const std::vector<int>& num_vertices, bool pairs = false) {
   const std::vector<std::string> lines = read_lines(path);
   std::vector<std::vector<int>> rows;
   rows.reserve(lines.size());
   for (size_t i = 0; i < lines.size(); ++i) {
-    const size_t first = lines[i].find_first_not_of(" \t");
-    if (pairs && (first == std::string::npos || lines[i][first] == '#')) continue;
-    const std::vector<std::string> tokens = split(lines[i]);
+    // (In a file of pairs, `#` starts a comment, on its own line or after a pair.)
+    const std::string line = pairs ? lines[i].substr(0, lines[i].find('#')) : lines[i];
+    if (pairs && line.find_first_not_of(" \t") == std::string::npos) continue;
+    const std::vector<std::string> tokens = split(line);
     if (static_cast<int>(tokens.size()) != columns)
       throw InvalidInputError(where(path, i) + "expected " + std::to_string(columns) + " vertex ind" +
                               (columns == 1 ? "ex" : "ices") + ", got " + std::to_string(tokens.size()));

@@ -25,7 +25,7 @@ GroundTruth identity_ground_truth(int x_vertices, int y_vertices);
 GroundTruth read_vts_ground_truth(const std::string& x_path, const std::string& y_path, int x_vertices,
                                   int y_vertices);
 // Two 1-based columns per line, "x_vertex y_vertex": column 1 is a vertex of X, column 2 of Y;
-// blank and `#` lines skipped. TOPKIDS kidXX_ref.txt maps kidXX → kid00, so X = kidXX and Y =
+// blank lines and `#` comments skipped. TOPKIDS kidXX_ref.txt maps kidXX → kid00, so X = kidXX and Y =
 // kid00. Each line is one sample: a pair written twice counts twice, as a pair repeated in .vts
 // files does (FAUST_r's and TOSCA_r's repeat pairs; the published means count every line).
 GroundTruth read_map_ground_truth(const std::string& path, int x_vertices, int y_vertices);
