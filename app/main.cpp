@@ -10,10 +10,10 @@
 #include <csignal>
 #include <cstdlib>
 #include <filesystem>
-#include <vector>
 #include <iostream>
 #include <map>
 #include <new>
+#include <vector>
 
 namespace shapematch::app {
 

@@ -814,7 +814,7 @@ TEST_CASE("cli: match --checkpoint goes on after the levels a stopped run finish
 }
 
 TEST_CASE("cli: SIGTERM (as SIGINT) stops a match with a checkpoint where it can go on from") {
-  // The run is sent SIGTERM once its first checkpoint (after level 1) exists: it leaves off in
+  // The run is sent SIGTERM a second after its first checkpoint (after level 1): it leaves off in
   // level 2 (its LP's next residual check, or its rounding's next round) after saving there,
   // says so naming the checkpoint, dies by the signal (status 143), writes no output; the same
   // command then goes on from that checkpoint to a verified result. (SIGINT is handled alike, but
@@ -830,6 +830,7 @@ TEST_CASE("cli: SIGTERM (as SIGINT) stops a match with a checkpoint where it can
   const fs::path script = tmp.path / "stop.sh";
   std::ofstream(script) << command << " >/dev/null 2>" << (tmp.path / "err.txt").string() << " & p=$!\n"
                         << "while [ ! -e " << ckpt << " ] && kill -0 $p 2>/dev/null; do sleep 0.01; done\n"
+                        << "sleep 1\n"  // (into level 2's first LP, past its set-up: a stop there saves nothing new)
                         << "kill -TERM $p 2>/dev/null\nwait $p\necho $?\n";
   const Run stopped = shapematch::test::run_command("bash " + script.string());
   const std::string err = read_file(tmp.path / "err.txt");
