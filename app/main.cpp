@@ -24,7 +24,9 @@ std::string data_dir() {
     namespace fs = std::filesystem;
     std::error_code ec;
     const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
-    if (ec || exe.parent_path() == fs::path(SHAPEMATCH_BUILD_DIR)) return std::string(SHAPEMATCH_SOURCE_DIR);
+    // (equivalent: the build folder's path as configured may pass through a symbolic link)
+    if (ec || fs::equivalent(exe.parent_path(), fs::path(SHAPEMATCH_BUILD_DIR), ec))
+      return std::string(SHAPEMATCH_SOURCE_DIR);
     std::vector<fs::path> looked;
     looked.push_back((exe.parent_path() / SHAPEMATCH_DATA_FROM_BIN).lexically_normal());
     looked.push_back(SHAPEMATCH_INSTALL_DATA_DIR);
