@@ -152,8 +152,10 @@ LpResult PdhgSolver::solve(const LpProblem& problem, const SolverParams& params)
                 result.setup_seconds, scaling_seconds, norm_seconds, estimate.steps);
   spdlog::debug("{}: {} x {}, ‖Ã‖ ≈ {:.4g}, step {:.4g}, primal weight {:.4g}, on {}", name(), m, n, norm, eta,
                 omega, result.device);
-  // (A stop asked for during the set-up, tens of seconds at full resolution: nothing new to save.)
-  if (stop_requested() != 0) throw Stopped("stopped before an LP's first iteration");
+  // A stop asked for during the set-up (tens of seconds at full resolution) leaves off here where
+  // this solve saves nothing; where it does (a snapshot: a round's LP saves the rounding's decisions
+  // with it), at the first residual check, after saving.
+  if (stop_requested() != 0 && !params.snapshot) throw Stopped("stopped before an LP's first iteration");
 
   const double restart_artificial = params.cold_restart_artificial > 0 && params.initial_x.empty()
                                         ? params.cold_restart_artificial
