@@ -699,6 +699,13 @@ JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpS
       for (size_t i = 0; i < parts[k].rows.size() && i < at.y.size(); ++i) w.y[parts[k].rows[i]] = at.y[i];
       whole_snapshot(w);
     };
+    // A stop asked for (request_stop) between two parts: the round so far saved as the timed
+    // snapshots save it (the parts before this one as they ended), then left off here, not after
+    // the rest of the round's parts (Clp's take up to a minute each at full resolution).
+    if (k > 0 && stop_requested() != 0) {
+      if (whole_snapshot) part_snapshot(SolveSnapshot{});
+      throw Stopped("stopped between the parts of a round's LP");
+    }
     auto first_order_solve = [&]() {
       SolverParams& p = first_order();
       asked = p.initial_primal_weight;
