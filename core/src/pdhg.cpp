@@ -155,7 +155,8 @@ LpResult PdhgSolver::solve(const LpProblem& problem, const SolverParams& params)
   // A stop asked for during the set-up (tens of seconds at full resolution) leaves off here where
   // this solve saves nothing; where it does (a snapshot: a round's LP saves the rounding's decisions
   // with it), at the first residual check, after saving.
-  if (stop_requested() != 0 && !params.snapshot) throw Stopped("stopped before an LP's first iteration");
+  if (stop_requested() != 0 && !(params.snapshot && params.snapshot_seconds > 0.0))
+    throw Stopped("stopped before an LP's first iteration");
 
   const double restart_artificial = params.cold_restart_artificial > 0 && params.initial_x.empty()
                                         ? params.cold_restart_artificial

@@ -701,9 +701,14 @@ JoinedSolve detail::solve_in_parts(const LpProblem& lp, SolverParams params, LpS
     };
     // A stop asked for (request_stop) between two parts: the round so far saved as the timed
     // snapshots save it (the parts before this one as they ended), then left off here, not after
-    // the rest of the round's parts (Clp's take up to a minute each at full resolution).
-    if (k > 0 && stop_requested() != 0) {
-      if (whole_snapshot) part_snapshot(SolveSnapshot{});
+    // the rest of the round's parts (Clp's take up to a minute each at full resolution). Only
+    // where that save is made: otherwise the round goes on to its end, whose decisions are saved
+    // then (a throw here would lose those since the last throttled save).
+    if (k > 0 && stop_requested() != 0 && whole_snapshot && !infeasible && !out.suspect) {
+      SolveSnapshot here;
+      // (The largest first-order part's ω so far, as a timed snapshot would carry; 0: none, PDHG's own.)
+      if (std::isfinite(out.end_weight) && out.end_weight > 0.0) here.primal_weight = out.end_weight;
+      part_snapshot(here);
       throw Stopped("stopped between the parts of a round's LP");
     }
     auto first_order_solve = [&]() {
