@@ -371,34 +371,28 @@ LevelCheckpoint load_checkpoint(const std::string& path) {
     std::memcpy(&stated, bytes.data() + sizeof kMagic - 1, sizeof stated);
   const std::string damaged = path + ": the checkpoint is damaged (its checksum does not match: changed or cut short "
                                      "since it was written)";
-  // Whether the file ends in the checksum of the rest: any file of version 18 on, also one whose
-  // version field was damaged (a file without a checksum ends so by chance 1 in 2^64).
-  const auto sealed = [&](bool as_version) {
-    uint64_t sum = 0;
-    if (bytes.size() < sizeof kMagic - 1 + sizeof stated + sizeof sum) return false;
-    const size_t body = bytes.size() - sizeof sum;
-    std::memcpy(&sum, bytes.data() + body, sizeof sum);
+  // The checksum of the file's bytes before its last 8, its version field read as `version`.
+  const size_t head = sizeof kMagic - 1 + sizeof stated;
+  const bool summed = bytes.size() >= head + sizeof(uint64_t);
+  uint64_t sum = 0;
+  if (summed) std::memcpy(&sum, bytes.data() + bytes.size() - sizeof sum, sizeof sum);
+  const auto sum_as = [&](uint32_t version) {
     Checksum c;
-    c.add(bytes.data(), body);
-    if (c.value() == sum) return true;
-    // (As its version field says: where the rest matches with another version, that field is the damage.)
-    if (!as_version) return false;
-    for (uint32_t v = kFirstChecksummed; v <= kVersion; ++v) {
-      Checksum o;
-      o.add(bytes.data(), sizeof kMagic - 1);
-      o.add(reinterpret_cast<const char*>(&v), sizeof v);
-      o.add(bytes.data() + sizeof kMagic - 1 + sizeof v, body - (sizeof kMagic - 1 + sizeof v));
-      if (o.value() == sum) throw IoError(damaged);
-    }
-    return false;
+    c.add(bytes.data(), sizeof kMagic - 1);
+    c.add(reinterpret_cast<const char*>(&version), sizeof version);
+    c.add(bytes.data() + head, bytes.size() - sizeof sum - head);
+    return c.value();
   };
   if (stated >= kFirstChecksummed && stated <= kVersion) {
-    if (bytes.size() < sizeof kMagic - 1 + sizeof stated + sizeof(uint64_t))
-      throw IoError(path + ": the checkpoint is cut short");
-    if (!sealed(false)) throw IoError(damaged);
-    bytes.resize(bytes.size() - sizeof(uint64_t));
-  } else if (sealed(true) && stated < kFirstChecksummed) {  // (a later version's own file: refused below)
-    throw IoError(damaged);
+    if (!summed) throw IoError(path + ": the checkpoint is cut short");
+    if (sum_as(stated) != sum) throw IoError(damaged);
+    bytes.resize(bytes.size() - sizeof sum);
+  } else if (summed) {
+    // A file of version 18 on whose version field alone changed: the rest matches under its own
+    // version. (A file without a checksum ends so by chance 1 in 2^64; a later version's own file
+    // matches none of these and is refused below.)
+    for (uint32_t v = kFirstChecksummed; v <= kVersion; ++v)
+      if (sum_as(v) == sum) throw IoError(damaged);
   }
   Reader r(path, std::move(bytes));
   std::string magic(sizeof kMagic - 1, '\0');
