@@ -130,6 +130,8 @@ Action add_checkpoint_command(CLI::App& app) {
           .set("solving_iterations", a.solving.empty() ? Json() : Json(a.solving_iterations))
           // (… and its divergence watch's windows in a row of the patient rule; null: none)
           .set("solving_climbing_windows", a.solving.empty() ? Json() : Json(int64_t(a.solving_watch.climbing)))
+          // (… and whether it holds that LP's whole state, to go on from exactly; null: no LP under way)
+          .set("solving_exact", a.solving.empty() ? Json() : Json(a.solving_state != nullptr))
           .set("rounding", std::move(rounding));
     };
     Json levels = reports(c.levels);

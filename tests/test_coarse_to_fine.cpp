@@ -1860,8 +1860,8 @@ TEST_CASE("coarse to fine: a run gone on from an attempt of a level in progress 
     bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
   }
   const size_t at = std::string("shapematch level checkpoint\n").size();
-  REQUIRE(bytes[at] == 18);
-  {  // Version 18's checksum: any byte changed, or the file cut short, is refused as damaged.
+  REQUIRE(bytes[at] == 19);
+  {  // The checksum (version 18 on): any byte changed, or the file cut short, is refused as damaged.
     auto refused = [&](const std::string& damaged) {
       std::ofstream(file, std::ios::binary) << damaged;
       std::string what;
@@ -1882,7 +1882,7 @@ TEST_CASE("coarse to fine: a run gone on from an attempt of a level in progress 
     CHECK(refused(bytes.substr(0, at + 6)).find("cut short") != std::string::npos);
     // Its version field damaged (to an earlier version, which has no checksum, or a later one):
     // refused as damaged too, not as a file of that version.
-    for (char version : {char(16), char(17), char(50)}) {
+    for (char version : {char(16), char(17), char(18), char(50)}) {
       std::string damaged = bytes;
       damaged[at] = version;
       CHECK_MESSAGE(refused(damaged).find("checksum does not match") != std::string::npos, int(version));
@@ -1929,7 +1929,7 @@ TEST_CASE("coarse to fine: a run gone on from an attempt of a level in progress 
   CHECK(v3.attempt.report.widened_faces == a.report.widened_faces);
   CHECK(v3.attempt.report.stuck_restarts == 0);
   CHECK(v3.levels.back().gamma == last.levels.back().gamma);
-  CHECK_THROWS_AS(detail::save_checkpoint_as(file, marked, 19), InvalidInputError);
+  CHECK_THROWS_AS(detail::save_checkpoint_as(file, marked, 20), InvalidInputError);
 }
 
 // The saves of a run made inside the first LP of level `level` (lp_checkpoint_seconds).
@@ -1940,9 +1940,11 @@ void matcher_run_saves(const CoarseToFineMatcher& matcher, int level, std::vecto
 }
 
 TEST_CASE("coarse to fine: a run gone on from inside a refined level's first LP starts that LP where it was") {
-  // lp_checkpoint_seconds: the attempt is saved with its first LP's iterate as it goes (here at
-  // every residual check); a run gone on from the last such save solves the rest of that LP, not
-  // all of it, and ends with a verified Γ of about the same energy.
+  // lp_checkpoint_seconds: the attempt is saved with its first LP's iterate and whole state as it
+  // goes (here at every residual check); a run gone on from the last such save makes the rest of
+  // that LP's iterations, exactly as the whole run did, and ends with its Γ (version 19); from the
+  // iterate alone (version 18), the rest of it, not all of it, to a verified Γ of about the same
+  // energy.
   CoarseToFineOptions o = small_levels();
   o.lookahead_levels = 0;
   o.price_widenings = 0;  // (one first LP at the finest level: the one saved)
@@ -1996,6 +1998,11 @@ TEST_CASE("coarse to fine: a run gone on from inside a refined level's first LP 
   CHECK(loaded.attempt.solving.parts().y == late.attempt.solving.parts().y);
   // Its divergence watch as it stood (version 16), which the LP gone on from it watches on from.
   CHECK(loaded.attempt.solving_watch == late.attempt.solving_watch);
+  // Its whole state (version 19), as it was, bit for bit.
+  REQUIRE(late.attempt.solving_state != nullptr);
+  REQUIRE(loaded.attempt.solving_state != nullptr);
+  CHECK(*loaded.attempt.solving_state == *late.attempt.solving_state);
+  CHECK(late.attempt.solving_state->iterations == done);
   {  // A save after the watch's first window holds what that window saw (a fresh watch before).
     CoarseToFineOptions longer = o;
     longer.rounding.lp.tolerance = 1e-7;  // (a first LP past 512 iterations)
@@ -2024,16 +2031,68 @@ TEST_CASE("coarse to fine: a run gone on from inside a refined level's first LP 
     save_checkpoint(other, near_stop);
     CHECK_THROWS_AS(load_checkpoint(other), IoError);
   }
-  std::vector<int64_t> rest;
-  const CoarseToFineResult r = matcher.run(at_finest(rest), &loaded);  // (no checkpointing: no saves)
-  REQUIRE(rest.size() == 1);
-  MESSAGE("first LP: ", firsts[0], " iterations whole, ", done, " before the save and ", rest[0], " after it");
-  CHECK(rest[0] < firsts[0]);
-  CHECK(rest[0] <= firsts[0] - done / 2);  // (it goes on, not from zero)
-  const LevelReport& f = r.levels.back();
-  CHECK(f.iterations >= rest[0] + done);  // the report counts those before the save too
-  CHECK(check_graph_surface(r.finest.space, r.rounding.gamma).ok());
-  CHECK(f.energy == doctest::Approx(whole.levels.back().energy).epsilon(0.05));
+  // From the last save and from one halfway, through a file: exactly the whole run's rest.
+  const LevelCheckpoint& halfway = solving[solving.size() / 2];
+  for (const LevelCheckpoint* save : {&late, &halfway}) {
+    const int64_t before = save->attempt.solving_iterations;
+    CAPTURE(before);
+    save_checkpoint(file, *save);
+    std::vector<int64_t> rest;
+    const LevelCheckpoint from = load_checkpoint(file);
+    const CoarseToFineResult r = matcher.run(at_finest(rest), &from);  // (no checkpointing: no saves)
+    REQUIRE(rest.size() == 1);
+    MESSAGE("first LP: ", firsts[0], " iterations whole, ", before, " before the save and ", rest[0], " after it");
+    CHECK(rest[0] == firsts[0] - before);  // the rest of it, exactly
+    const LevelReport& f = r.levels.back();
+    CHECK(f.iterations == whole.levels.back().iterations);  // the report counts those before the save too
+    CHECK(check_graph_surface(r.finest.space, r.rounding.gamma).ok());
+    CHECK(f.energy == whole.levels.back().energy);
+    CHECK(r.rounding.gamma == whole.rounding.gamma);
+    // From the iterate alone (version 18 kept no state): the rest of it, not all of it.
+    detail::save_checkpoint_as(file, *save, 18);
+    const LevelCheckpoint v18 = load_checkpoint(file);
+    CHECK(v18.attempt.solving_state == nullptr);
+    std::vector<int64_t> rest18;
+    const CoarseToFineResult r18 = matcher.run(at_finest(rest18), &v18);
+    REQUIRE(rest18.size() == 1);
+    MESSAGE("from the iterate alone: ", rest18[0], " iterations after it");
+    CHECK(rest18[0] < firsts[0]);
+    CHECK(rest18[0] <= firsts[0] - before / 2);  // (it goes on, not from zero)
+    CHECK(r18.levels.back().iterations >= rest18[0] + before);
+    CHECK(check_graph_surface(r18.finest.space, r18.rounding.gamma).ok());
+    CHECK(r18.levels.back().energy == doctest::Approx(whole.levels.back().energy).epsilon(0.05));
+  }
+  {  // A longer first LP (past 512 iterations, restarts between the saves): from the state it ends
+     // as in the whole run; from the iterate alone, at another point.
+    CoarseToFineOptions longer = o;
+    longer.rounding.lp.tolerance = 1e-7;
+    const CoarseToFineMatcher lm = finger_matcher(longer);
+    std::vector<int64_t> lfirst;
+    std::vector<LevelCheckpoint> lsaves;
+    const CoarseToFineResult lwhole = lm.run(at_finest(lfirst), nullptr, [&](const LevelCheckpoint& c) {
+      if (!c.attempt.empty() && !c.attempt.solving.empty() && c.attempt.report.level == finest) lsaves.push_back(c);
+    });
+    REQUIRE(lfirst.size() == 1);
+    REQUIRE(lsaves.size() >= 4);
+    const LevelCheckpoint& mid = lsaves[lsaves.size() / 2];
+    REQUIRE(mid.attempt.solving_state != nullptr);
+    std::vector<int64_t> exact_rest, plain_rest;
+    const CoarseToFineResult re = lm.run(at_finest(exact_rest), &mid);
+    LevelCheckpoint bare = mid;
+    bare.attempt.solving_state = nullptr;
+    const CoarseToFineResult rp = lm.run(at_finest(plain_rest), &bare);
+    REQUIRE(exact_rest.size() == 1);
+    REQUIRE(plain_rest.size() == 1);
+    MESSAGE("longer first LP: ", lfirst[0], " iterations whole, ", mid.attempt.solving_iterations,
+            " before the save, after it ", exact_rest[0], " from its state, ", plain_rest[0], " from its iterate");
+    CHECK(exact_rest[0] == lfirst[0] - mid.attempt.solving_iterations);
+    CHECK(re.rounding.gamma == lwhole.rounding.gamma);
+    CHECK(re.levels.back().energy == lwhole.levels.back().energy);
+    CHECK(re.levels.back().lower_bound == lwhole.levels.back().lower_bound);  // (its LP's bound, bit for bit)
+    // (What the state is for: from the iterate alone the LP ends at another point, its bound another.)
+    CHECK(rp.levels.back().lower_bound != lwhole.levels.back().lower_bound);
+    CHECK(check_graph_surface(rp.finest.space, rp.rounding.gamma).ok());
+  }
   // Version 13 kept the iterate but neither its seconds nor its watch flag; 12 no iterate: the
   // same attempt from zero.
   detail::save_checkpoint_as(file, late, 13);

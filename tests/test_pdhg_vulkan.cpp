@@ -293,3 +293,41 @@ TEST_CASE("pdhg-vulkan: a snapshot read from the device starts the solve again n
   CHECK(rest.iterations <= whole.iterations - last.iterations + 64);
   CHECK(std::abs(rest.objective - whole.objective) <= 1e-4 * std::abs(whole.objective));
 }
+
+TEST_CASE("pdhg-vulkan: a state read from the device goes on as the uninterrupted solve, bit for bit") {
+  // The device's iterate and anchor come back as they go into the next batch (read_state) and go
+  // up again with the problem (load_state): the solve gone on from a snapshot's state ends where
+  // the whole one did, in as many iterations. (Its step too: no Lanczos estimate of its own.)
+  if (!test::vulkan_wanted()) return;
+  const LpProblem lp = matching_lp();
+  SolverParams params = tight();
+  params.exact_state = true;
+  std::vector<SolveSnapshot> seen;
+  params.snapshot_seconds = 1e-9;  // (at every residual check)
+  params.snapshot = [&](const SolveSnapshot& s) { seen.push_back(s); };
+  const LpResult whole = solve_lp(lp, "pdhg-vulkan", params);
+  REQUIRE(whole.status == LpStatus::Optimal);
+  REQUIRE(seen.size() >= 3);
+  for (size_t k : {size_t(1), seen.size() - 1}) {
+    CAPTURE(seen[k].iterations);
+    REQUIRE(seen[k].state != nullptr);
+    CHECK(seen[k].state->solver == "pdhg-vulkan");
+    SolverParams from = params;
+    from.snapshot = {};
+    from.resume_state = seen[k].state;
+    from.max_iterations = params.max_iterations - seen[k].iterations;
+    const LpResult rest = solve_lp(lp, "pdhg-vulkan", from);
+    CHECK(rest.status == whole.status);
+    CHECK(rest.iterations == whole.iterations - seen[k].iterations);
+    CHECK(rest.x == whole.x);
+    CHECK(rest.y == whole.y);
+    CHECK(rest.primal_weight == whole.primal_weight);
+  }
+  // The CPU backend (the shaders' oracle) takes no state of the device's: another solver's.
+  SolverParams cpu = tight();
+  const LpResult plain = solve_lp(lp, "pdhg-cpu", cpu);
+  cpu.resume_state = seen.back().state;
+  const LpResult given = solve_lp(lp, "pdhg-cpu", cpu);
+  CHECK(given.iterations == plain.iterations);
+  CHECK(given.x == plain.x);
+}

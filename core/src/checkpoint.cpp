@@ -36,7 +36,9 @@ constexpr char kMagic[] = "shapematch level checkpoint\n";
 // 16: an LP under way's divergence watch (LevelAttempt::solving_watch) follows its watch flag.
 // 17: LevelReport::proof_rechecks; an attempt's last local proof region (proof_faces, proof_rings).
 // 18: the layout of 17, then a checksum (Checksum) of every byte before it.
-constexpr uint32_t kVersion = 18;
+// 19: an LP under way's whole state (LevelAttempt::solving_state: a flag, then write_state's
+// layout) follows its watch.
+constexpr uint32_t kVersion = 19;
 constexpr uint32_t kFirstChecksummed = 18;
 // More rings than a local proof's region grows (RoundingOptions::local_proof_depth).
 constexpr int kMaxProofRings = 64;
@@ -232,6 +234,66 @@ DivergenceWatchState read_watch(Reader& r, const std::string& path) {
   return s;
 }
 
+// A vector of mostly +0.0 (a PDHG iterate's columns: most product triangles are at their bound 0,
+// bit for bit): its size, then the indices and values of the others.
+void write_mostly_zero(Writer& w, const std::vector<double>& v) {
+  std::vector<uint64_t> at;
+  std::vector<double> value;
+  for (size_t j = 0; j < v.size(); ++j)
+    if (std::bit_cast<uint64_t>(v[j]) != 0) at.push_back(j), value.push_back(v[j]);
+  w(uint64_t(v.size()));
+  w.array(at), w.array(value);
+}
+void read_mostly_zero(Reader& r, std::vector<double>& v, const std::string& path) {
+  uint64_t n = 0;
+  r(n);
+  std::vector<uint64_t> at;
+  std::vector<double> value;
+  r.array(at), r.array(value);
+  // (A size past any LP's is a corrupt file: refused before it is allocated.)
+  if (n > (uint64_t(1) << 32) || at.size() != value.size() ||
+      std::any_of(at.begin(), at.end(), [n](uint64_t j) { return j >= n; }))
+    throw IoError(path + ": not a shapematch checkpoint (an LP state's vector of " + std::to_string(n) + " values)");
+  v.assign(n, 0.0);
+  for (size_t k = 0; k < at.size(); ++k) v[at[k]] = value[k];
+}
+
+// An LP under way's whole state (version >= 19).
+void write_state(Writer& w, const SolverState& s) {
+  w.array(std::vector<char>(s.solver.begin(), s.solver.end()));
+  w(s.fingerprint);
+  write_mostly_zero(w, s.x), write_mostly_zero(w, s.x0);
+  w.array(s.y), w.array(s.y0), w.array(s.window_y);
+  w(s.step), w(s.primal_weight), w(s.restart_artificial), w(s.restart_base), w(s.previous);
+  w(s.since_restart), w(s.iterations), w(s.window_left), w(s.restarts);
+  write_watch(w, s.watch);
+}
+std::shared_ptr<const SolverState> read_state(Reader& r, const std::string& path) {
+  auto s = std::make_shared<SolverState>();
+  std::vector<char> name;
+  r.array(name);
+  s->solver.assign(name.begin(), name.end());
+  r(s->fingerprint);
+  read_mostly_zero(r, s->x, path), read_mostly_zero(r, s->x0, path);
+  r.array(s->y), r.array(s->y0), r.array(s->window_y);
+  r(s->step), r(s->primal_weight), r(s->restart_artificial), r(s->restart_base), r(s->previous);
+  r(s->since_restart), r(s->iterations), r(s->window_left), r(s->restarts);
+  s->watch = read_watch(r, path);
+  // (`previous` may be +∞: no residual since the last restart.)
+  const bool sizes = s->x.size() == s->x0.size() && s->y.size() == s->y0.size() &&
+                     (s->window_y.empty() || s->window_y.size() == s->y.size());
+  const bool scalars = std::isfinite(s->step) && s->step > 0.0 && std::isfinite(s->primal_weight) &&
+                       s->primal_weight > 0.0 && std::isfinite(s->restart_artificial) &&
+                       std::isfinite(s->restart_base) && !std::isnan(s->previous);
+  const bool counts = s->since_restart >= 0 && s->since_restart <= kMaxIterations && s->iterations >= 0 &&
+                      s->iterations <= kMaxIterations && s->window_left >= -kMaxIterations &&
+                      s->window_left <= kMaxIterations && s->restarts >= 0;
+  if (!sizes || !scalars || !counts)
+    throw IoError(path + ": not a shapematch checkpoint (an LP state after " + std::to_string(s->iterations) +
+                  " iterations)");
+  return s;
+}
+
 // A flag, then (where set) the attempt (version >= 2).
 void write_attempt(Writer& w, const LevelAttempt& a, uint32_t version) {
   w(!a.empty());
@@ -267,6 +329,10 @@ void write_attempt(Writer& w, const LevelAttempt& a, uint32_t version) {
     w(a.solving_resolve);
     if (version >= 14) w(a.solving_watched);
     if (version >= 16) write_watch(w, a.solving_watch);
+    if (version >= 19) {
+      w(a.solving_state != nullptr);
+      if (a.solving_state) write_state(w, *a.solving_state);
+    }
   }
   if (!a.priced_from.empty() || !a.solving.empty()) w(a.cold_iterations), w(a.cold_seconds);
 }
@@ -315,6 +381,9 @@ void read_attempt(Reader& r, LevelAttempt& a, uint32_t version, const std::strin
     r(a.solving_resolve);
     if (version >= 14) r(a.solving_watched);
     if (version >= 16) a.solving_watch = read_watch(r, path);
+    bool state = false;
+    if (version >= 19) r(state);
+    if (state) a.solving_state = read_state(r, path);
     if (a.solving_iterations < 0 || a.solving_iterations > kMaxIterations || !(a.solving_seconds >= 0.0) ||
         !std::isfinite(a.solving_seconds))
       throw IoError(path + ": not a shapematch checkpoint (an LP under way at " + std::to_string(a.solving_iterations) +

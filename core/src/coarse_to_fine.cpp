@@ -1187,6 +1187,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
   double solving_seconds = 0.0;
   bool solving_resolve = false, solving_watched = true;
   DivergenceWatchState solving_watch;
+  std::shared_ptr<const SolverState> solving_state;
   if (resume && resume->rounding.empty() && !resume->solving.empty()) {
     solving_from = resume->solving;
     solving_done = resume->solving_iterations;
@@ -1194,11 +1195,13 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
     solving_resolve = resume->solving_resolve;
     solving_watched = resume->solving_watched;
     solving_watch = resume->solving_watch;
+    solving_state = resume->solving_state;
     feasible_seen = feasible_seen || solving_resolve;  // (the re-solve's space held an optimum)
     cold_iterations = resume->cold_iterations;
     cold_seconds = resume->cold_seconds;
-    spdlog::info("level {}: its {} goes on from the checkpointed iterate after {} iterations", l + 1,
-                 solving_resolve ? "re-solve after pricing" : "first LP", solving_done);
+    spdlog::info("level {}: its {} goes on from the checkpointed {} after {} iterations", l + 1,
+                 solving_resolve ? "re-solve after pricing" : "first LP",
+                 solving_state ? "state (exactly, where its LP is the same)" : "iterate", solving_done);
   } else if (resume && resume->rounding.empty() && !resume->priced_from.empty()) {
     priced_from = resume->priced_from;  // its re-solve, warm as it would have been
     price_warm = feasible_seen = true;
@@ -1531,6 +1534,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
         solving_from = {};
         ro.resumed_iterations = solving_done;
         ro.resumed_seconds = solving_seconds;
+        ro.resumed_state = std::move(solving_state);
         ro.feasibility_iterations = 0;  // (it had passed its pre-test)
         if (!solving_watched) ro.lp.stop_on_divergence = ro.lp.patient_divergence_watch = false;
         ro.lp.initial_watch = solving_watch;
@@ -1711,6 +1715,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
           a.solving_resolve = resolve;
           a.solving_watched = watched;
           a.solving_watch = s.watch;
+          a.solving_state = s.state;
           a.cold_iterations = cold_iterations;
           a.cold_seconds = cold_seconds;
           try {

@@ -13,6 +13,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 
 namespace shapematch {
 namespace {
@@ -74,6 +75,30 @@ bool row_bounds_infeasible(const LpProblem& p) {
   return false;
 }
 
+// Which LP a SolverState belongs to: its sizes, c and b (bits) and A's pattern and signs, mixed
+// word by word (splitmix64's finaliser over a running sum: a changed word changes the result).
+uint64_t fingerprint(const LpProblem& p) {
+  uint64_t h = 0x9e3779b97f4a7c15ull;
+  const auto mix = [&h](uint64_t v) {
+    uint64_t z = (h += v + 0x9e3779b97f4a7c15ull);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    h = z ^ (z >> 31);
+  };
+  const auto bits = [](double v) {
+    uint64_t u;
+    std::memcpy(&u, &v, sizeof u);
+    return u;
+  };
+  mix(uint64_t(p.rows())), mix(uint64_t(p.cols())), mix(uint64_t(p.nonzeros()));
+  for (double v : p.c) mix(bits(v));
+  for (double v : p.b) mix(bits(v));
+  for (uint32_t v : p.a.row_ptr) mix(v);
+  for (size_t k = 0; k + 1 < p.a.entry.size(); k += 2) mix(uint64_t(p.a.entry[k]) << 32 | p.a.entry[k + 1]);
+  if (p.a.entry.size() % 2 == 1) mix(p.a.entry.back());
+  return h;
+}
+
 }  // namespace
 
 LpResult PdhgSolver::solve(const LpProblem& problem, const SolverParams& params) {
@@ -94,16 +119,33 @@ LpResult PdhgSolver::solve(const LpProblem& problem, const SolverParams& params)
   if (!params.initial_y.empty() && params.initial_y.size() != size_t(m))
     throw InvalidInputError("warm start y has " + std::to_string(params.initial_y.size()) + " entries, expected " + std::to_string(m));
 
+  // An exact state to go on from, where it is this LP's and this solver's (else the warm start).
+  const bool exact = params.exact_state && backend_ != PdhgBackendKind::CpuF32;
+  const uint64_t print = exact || params.resume_state ? fingerprint(problem) : 0;
+  const SolverState* resume = params.resume_state.get();
+  if (resume && (resume->solver != name() || resume->fingerprint != print || resume->x.size() != size_t(n) ||
+                 resume->x0.size() != size_t(n) || resume->y.size() != size_t(m) || resume->y0.size() != size_t(m) ||
+                 !(resume->window_y.empty() || resume->window_y.size() == size_t(m)) || !(resume->step > 0.0) ||
+                 !(resume->primal_weight > 0.0))) {
+    spdlog::debug("{}: the state to go on from is another LP's or solver's ({}); going on from the warm start",
+                  name(), resume->solver);
+    resume = nullptr;
+  }
+
   std::vector<double> r, d;
   compute_scaling(problem, options_.ruiz_iterations, params.threads, r, d);
   const double scaling_seconds = clock.seconds();
   // The Lanczos estimate approaches ‖Ã‖ from below (within norm_tolerance of an eigenvalue when it
   // stops), so add a margin; Pock–Chambolle scaling with α = 1 guarantees ‖Ã‖ ≤ 1, which caps it.
-  const detail::NormEstimate estimate = detail::scaled_norm(problem.a, problem.at, r, d, options_.norm_steps,
-                                                            options_.norm_tolerance, params.threads, 1.01, 1.0);
+  // (Gone on from a state: its step, which the estimate made; ten seconds at full resolution.)
+  const detail::NormEstimate estimate =
+      resume ? detail::NormEstimate{}
+             : detail::scaled_norm(problem.a, problem.at, r, d, options_.norm_steps, options_.norm_tolerance,
+                                   params.threads, 1.01, 1.0);
   double norm = std::min(1.0, 1.01 * estimate.norm);
   if (!(norm > 1e-12)) norm = 1.0;  // no nonzeros (or no Lanczos steps): the Pock–Chambolle bound
-  const double eta = options_.step_safety / norm;
+  const double eta = resume ? resume->step : options_.step_safety / norm;
+  if (resume) norm = options_.step_safety / eta;
   const double norm_seconds = clock.seconds() - scaling_seconds;
 
   detail::ScaledLp lp;
@@ -130,23 +172,27 @@ LpResult PdhgSolver::solve(const LpProblem& problem, const SolverParams& params)
   cnorm = std::sqrt(cnorm);
   bnorm = std::sqrt(bnorm);
   bnorm_orig = std::sqrt(bnorm_orig);
-  double omega = params.initial_primal_weight > 0                            ? params.initial_primal_weight
+  double omega = resume                                                      ? resume->primal_weight
+                 : params.initial_primal_weight > 0                          ? params.initial_primal_weight
                  : params.cold_primal_weight > 0 && params.initial_x.empty() ? params.cold_primal_weight
                  : options_.initial_primal_weight > 0                        ? options_.initial_primal_weight
                  : (cnorm > 1e-10 && bnorm > 1e-10) ? cnorm / bnorm
                                                     : 1.0;
 
-  std::vector<double> x0(n, 0.0), y0(m, 0.0);
-  if (!params.initial_x.empty())
+  std::vector<double> x0(resume ? 0 : n, 0.0), y0(resume ? 0 : m, 0.0);  // (a state brings its own)
+  if (!params.initial_x.empty() && !resume)
     for (int64_t j = 0; j < n; ++j) x0[j] = std::clamp(params.initial_x[j], 0.0, 1.0) / d[j];
-  if (!params.initial_y.empty())
+  if (!params.initial_y.empty() && !resume)
     for (int64_t i = 0; i < m; ++i) y0[i] = params.initial_y[i] / r[i];
 
   auto backend = backend_ == PdhgBackendKind::Cpu      ? detail::make_cpu_backend(params.threads)
                  : backend_ == PdhgBackendKind::CpuF32 ? detail::make_cpu_f32_backend(params.threads)
                                                        : detail::make_vulkan_backend(params.device);
   result.device = backend->device();
-  backend->load(lp, x0, y0);
+  if (resume)
+    backend->load_state(lp, resume->x, resume->x0, resume->y, resume->y0);
+  else
+    backend->load(lp, x0, y0);
   result.setup_seconds = clock.seconds();
   spdlog::debug("{}: set up in {:.2f} s (scaling {:.2f} s, norm {:.2f} s in {} Lanczos steps)", name(),
                 result.setup_seconds, scaling_seconds, norm_seconds, estimate.steps);
@@ -158,24 +204,36 @@ LpResult PdhgSolver::solve(const LpProblem& problem, const SolverParams& params)
   if (stop_requested() != 0 && !(params.snapshot && params.snapshot_seconds > 0.0))
     throw Stopped("stopped before an LP's first iteration");
 
-  const double restart_artificial = params.cold_restart_artificial > 0 && params.initial_x.empty()
+  const double restart_artificial = resume ? resume->restart_artificial
+                                    : params.cold_restart_artificial > 0 && params.initial_x.empty()
                                         ? params.cold_restart_artificial
                                         : options_.restart_artificial;
-  int64_t total = 0, k = 0;
-  const int64_t before = params.initial_x.empty() ? 0 : std::max<int64_t>(params.iterations_before, 0);
-  double restart_base = -1.0, previous = std::numeric_limits<double>::infinity();
+  int64_t total = 0, k = resume ? resume->since_restart : 0;
+  const int64_t before = resume                    ? resume->iterations
+                         : params.initial_x.empty() ? 0
+                                                    : std::max<int64_t>(params.iterations_before, 0);
+  double restart_base = resume ? resume->restart_base : -1.0;
+  double previous = resume ? resume->previous : std::numeric_limits<double>::infinity();
   // Divergence watch (params.stop_on_divergence); the dual at the start of each window gives
   // the growth returned as the ray.
   // (Gone on from a snapshot's watch only with its warm start: a cold solve is a new one.)
   detail::DivergenceWatch watch(params.tolerance, params.patient_divergence_watch,
-                                params.initial_y.empty() ? DivergenceWatchState{} : params.initial_watch);
-  int64_t window_end = detail::DivergenceWatch::kWindow;
+                                resume                    ? resume->watch
+                                : params.initial_y.empty() ? DivergenceWatchState{}
+                                                           : params.initial_watch);
+  int64_t window_end = resume ? resume->window_left : detail::DivergenceWatch::kWindow;
   // (From a warm start's dual: a bound past params.divergence_bound may stop the first window, its
   // growth a change of a given dual. From a cold start the first window's "growth" would be the
   // whole dual, its ordinary duals included: it waits for a second, as the watch's own rules do.)
   std::vector<double> window_y;
-  if (params.stop_on_divergence && !params.initial_y.empty()) window_y = y0;
-  int restarts = 0;
+  if (resume)
+    window_y = resume->window_y;
+  else if (params.stop_on_divergence && !params.initial_y.empty())
+    window_y = y0;
+  int restarts = resume ? resume->restarts : 0;
+  if (resume)
+    spdlog::debug("{}: going on exactly from its state after {} iterations ({} since its last restart)", name(),
+                  before, k);
   Stopwatch since_snapshot;
   int snapshots = 0;  // taken so far (params.snapshot_first_seconds)
   result.status = LpStatus::IterationLimit;
@@ -285,7 +343,29 @@ LpResult PdhgSolver::solve(const LpProblem& problem, const SolverParams& params)
       window_end = total + detail::DivergenceWatch::kWindow;
     }
 
-    // A point to start this solve again from, for the caller's checkpoint (SolverParams::snapshot).
+    // Restarts on the fixed-point residual (cuPDLPx): sufficient decay, necessary decay without
+    // progress, or a long stretch since the last restart.
+    if (restart_base >= 0.0 &&
+        (fixed_point <= options_.restart_sufficient * restart_base ||
+         (fixed_point <= options_.restart_necessary * restart_base && fixed_point > previous) ||
+         k >= restart_artificial * (total + before))) {
+      const auto [dx2, dy2] = backend->restart();
+      const double dx = std::sqrt(dx2), dy = std::sqrt(dy2);
+      if (dx > 1e-10 && dy > 1e-10) {
+        const double theta = options_.primal_weight_smoothing;
+        omega = std::exp(theta * std::log(dy / dx) + (1.0 - theta) * std::log(omega));
+      }
+      ++restarts;
+      k = 0;
+      restart_base = fixed_point;
+      previous = std::numeric_limits<double>::infinity();
+    } else {
+      if (restart_base < 0.0) restart_base = fixed_point;
+      previous = fixed_point;
+    }
+
+    // A point to start this solve again from, for the caller's checkpoint (SolverParams::snapshot),
+    // taken where the next batch starts (after a restart) so that its exact state is whole.
     // (At once where a stop is asked for: request_stop.)
     const double wait =
         snapshots == 0 && params.snapshot_first_seconds >= 0.0 ? params.snapshot_first_seconds : params.snapshot_seconds;
@@ -299,32 +379,30 @@ LpResult PdhgSolver::solve(const LpProblem& problem, const SolverParams& params)
       snap.iterations = total;
       snap.seconds = clock.seconds();
       if (params.stop_on_divergence) snap.watch = watch.state();
+      if (exact) {
+        auto state = std::make_shared<SolverState>();
+        if (backend->read_state(state->x, state->x0, state->y, state->y0)) {
+          state->solver = name();
+          state->fingerprint = print;
+          state->window_y = window_y;
+          state->step = eta;
+          state->primal_weight = omega;
+          state->restart_artificial = restart_artificial;
+          state->restart_base = restart_base;
+          state->previous = previous;
+          state->since_restart = k;
+          state->iterations = total + before;
+          state->window_left = window_end - total;
+          state->restarts = restarts;
+          state->watch = watch.state();
+          snap.state = std::move(state);
+        }
+      }
       params.snapshot(snap);
       since_snapshot.reset();
       ++snapshots;
     }
     if (stopping) throw Stopped(fmt::format("stopped in an LP after {} iterations", total));
-
-    // Restarts on the fixed-point residual (cuPDLPx): sufficient decay, necessary decay without
-    // progress, or a long stretch since the last restart.
-    if (restart_base < 0.0) {
-      restart_base = fixed_point;
-    } else if (fixed_point <= options_.restart_sufficient * restart_base ||
-               (fixed_point <= options_.restart_necessary * restart_base && fixed_point > previous) ||
-               k >= restart_artificial * (total + before)) {
-      const auto [dx2, dy2] = backend->restart();
-      const double dx = std::sqrt(dx2), dy = std::sqrt(dy2);
-      if (dx > 1e-10 && dy > 1e-10) {
-        const double theta = options_.primal_weight_smoothing;
-        omega = std::exp(theta * std::log(dy / dx) + (1.0 - theta) * std::log(omega));
-      }
-      ++restarts;
-      k = 0;
-      restart_base = fixed_point;
-      previous = std::numeric_limits<double>::infinity();
-      continue;
-    }
-    previous = fixed_point;
   }
 
   if (result.status == LpStatus::Diverging) {

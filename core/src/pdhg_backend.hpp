@@ -25,6 +25,7 @@
 #include "shapematch/sparse.hpp"
 
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -65,6 +66,18 @@ public:
   virtual std::string device() const = 0;
   // Uploads the problem and the (scaled) starting point; the anchor starts at the same point.
   virtual void load(const ScaledLp& lp, const std::vector<double>& x, const std::vector<double>& y) = 0;
+  // An exact state (SolverState): read_state gives the iterate (x, y) and the anchor (x⁰, y⁰) as
+  // they go into the next iteration, load_state uploads the problem at such a state; iterating on
+  // from there repeats what the backend would have computed. false / not supported where the
+  // backend keeps its vectors in another form (the fp32 one).
+  virtual bool read_state(std::vector<double>& x, std::vector<double>& x0, std::vector<double>& y,
+                          std::vector<double>& y0) {
+    return false;
+  }
+  virtual void load_state(const ScaledLp& lp, const std::vector<double>& x, const std::vector<double>& x0,
+                          const std::vector<double>& y, const std::vector<double>& y0) {
+    throw std::logic_error("this PDHG backend keeps no exact state");
+  }
   // Runs `count` ≥ 1 iterations with Halpern indices k0, k0+1, …; the last one reports stats.
   virtual BatchStats iterate(int count, int64_t k0, const Step& step) = 0;
   // Restarts at the last (x̂, ŷ); returns the anchor's displacement (Σ dx², Σ dy²).

@@ -206,16 +206,27 @@ public:
   }
 
   void load(const ScaledLp& lp, const std::vector<double>& x, const std::vector<double>& y) override {
+    load_state(lp, x, x, y, y);
+  }
+
+  void load_state(const ScaledLp& lp, const std::vector<double>& x, const std::vector<double>& x0,
+                  const std::vector<double>& y, const std::vector<double>& y0) override {
     prepare(lp);
     x_ = x;
-    x0_ = x;
+    x0_ = x0;
     xhat_ = x;  // read() before any iteration returns the start
-    xr_.assign(n_, 0.0);
+    xr_.assign(n_, 0.0);  // (written by each primal step before the dual reads it)
     y_ = y;
-    y0_ = y;
+    y0_ = y0;
     yhat_ = y;
     yr_.resize(m_);
-    for (int64_t i = 0; i < m_; ++i) yr_[i] = lp.row_scale[i] * y_[i];
+    for (int64_t i = 0; i < m_; ++i) yr_[i] = lp.row_scale[i] * y_[i];  // (as the dual step makes it)
+  }
+
+  bool read_state(std::vector<double>& x, std::vector<double>& x0, std::vector<double>& y,
+                  std::vector<double>& y0) override {
+    x = x_, x0 = x0_, y = y_, y0 = y0_;
+    return true;
   }
 
   BatchStats iterate(int count, int64_t k0, const Step& step) override {

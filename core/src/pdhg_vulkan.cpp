@@ -117,6 +117,11 @@ public:
   std::string device() const override { return "vulkan: " + context_.info().name; }
 
   void load(const ScaledLp& lp, const std::vector<double>& x, const std::vector<double>& y) override {
+    load_state(lp, x, x, y, y);
+  }
+
+  void load_state(const ScaledLp& lp, const std::vector<double>& x, const std::vector<double>& x0,
+                  const std::vector<double>& y, const std::vector<double>& y0) override {
     problem_.reset();  // a failed load leaves nothing loaded; frees the old problem's memory first
     const SignedCsr& a = *lp.a;
     const SignedCsr& at = *lp.at;
@@ -127,7 +132,8 @@ public:
     if (m_ >= int64_t{SignedCsr::kNegative} || n_ >= int64_t{SignedCsr::kNegative} || at.rows != n_ || at.cols != m_ ||
         a.row_ptr.size() != size_t(m_) + 1 || at.row_ptr.size() != size_t(n_) + 1 ||
         lp.c.size() != size_t(n_) || lp.col_scale.size() != size_t(n_) || x.size() != size_t(n_) ||
-        lp.b.size() != size_t(m_) || lp.row_scale.size() != size_t(m_) || y.size() != size_t(m_))
+        x0.size() != size_t(n_) || lp.b.size() != size_t(m_) || lp.row_scale.size() != size_t(m_) ||
+        y.size() != size_t(m_) || y0.size() != size_t(m_))
       throw InvalidInputError("pdhg-vulkan: inconsistent problem of " + std::to_string(m_) + " x " +
                               std::to_string(n_));
     std::vector<uint32_t> long_rows;
@@ -151,12 +157,12 @@ public:
     };
     const auto scratch = [&](int64_t size) { return context_.addressed_buffer(uint64_t(size) * sizeof(double)); };
     std::vector<double> yr(m_);
-    for (int64_t i = 0; i < m_; ++i) yr[i] = lp.row_scale[i] * y[i];
+    for (int64_t i = 0; i < m_; ++i) yr[i] = lp.row_scale[i] * y[i];  // (as the dual kernel makes it)
     // x̂, ŷ start at the start point, so that read() before any iteration returns it.
     // Braced initialisation runs in member order, so the first failed allocation stops the rest.
     problem_.emplace(DeviceProblem{u32(a.row_ptr), u32(a.entry), u32(at.row_ptr), u32(at.entry), u32(long_rows),
-                                   f64(lp.c), f64(lp.col_scale), f64(x), f64(x), f64(x), scratch(n_),
-                                   scratch(n_), f64(lp.b), f64(lp.row_scale), f64(y), f64(y), f64(yr),
+                                   f64(lp.c), f64(lp.col_scale), f64(x), f64(x0), f64(x), scratch(n_),
+                                   scratch(n_), f64(lp.b), f64(lp.row_scale), f64(y), f64(y0), f64(yr),
                                    f64(y), scratch(m_), scratch(int64_t(kSlots) * stride_)});
     partials_.resize(size_t(kSlots) * stride_);
   }
@@ -229,6 +235,16 @@ public:
     sequence.submit_and_wait();
     download_partials();
     return {sum(kDx2, col_groups_), sum(kDy2, row_groups_)};
+  }
+
+  bool read_state(std::vector<double>& x, std::vector<double>& x0, std::vector<double>& y,
+                  std::vector<double>& y0) override {
+    const DeviceProblem& p = loaded("read_state");
+    x = context_.download<double>(p.x, size_t(n_));
+    x0 = context_.download<double>(p.x0, size_t(n_));
+    y = context_.download<double>(p.y, size_t(m_));
+    y0 = context_.download<double>(p.y0, size_t(m_));
+    return true;
   }
 
   void read(std::vector<double>& xhat, std::vector<double>& yhat) override {

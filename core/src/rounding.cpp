@@ -457,6 +457,8 @@ SolverParams pretest_params(const SolverParams& params, int64_t cap, double tole
   zp.stop_on_divergence = false;
   zp.patient_divergence_watch = false;
   zp.snapshot = {};  // (not the solve a checkpoint would go on from)
+  zp.exact_state = false;
+  zp.resume_state = nullptr;
   return zp;
 }
 
@@ -1717,6 +1719,8 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
   // (Round 1's resumed solve only, below: they belong to the LP under way that was saved.)
   base_params.initial_watch = {};
   base_params.iterations_before = 0;
+  base_params.resume_state = nullptr;  // (RoundingOptions::resumed_state)
+  base_params.exact_state = false;
   // Releases every fixing within reach of `rows` (columns_near, 2 steps, 4, 8 … where the same
   // part fails again (ReleaseReach), further until one is in reach) and propagates the rest again
   // from the state before the first round: where a part has no binary solution, the fault lies in
@@ -2351,6 +2355,7 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
       // a round 1 that is not gone on from a snapshot (an alternative's among them) watches afresh.
       params.iterations_before = options.resumed_iterations;
       if (options.resumed_iterations > 0) params.initial_watch = options.lp.initial_watch;
+      if (options.resumed_iterations > 0) params.resume_state = options.resumed_state;
     }
     // An iterate of red.lp over the whole LP: fixed variables at their values, rows it lacks at 0.
     auto full_x = [&](const std::vector<double>& reduced) {
@@ -2385,6 +2390,7 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
         whole.iterations = snapshot_iterations + s.iterations;
         whole.seconds = snapshot_seconds + s.seconds;
         whole.watch = s.watch;
+        whole.state = s.state;  // (over red.lp, which a run gone on from it builds again)
         options.first_snapshot(whole, params.stop_on_divergence);
       };
       if (options.feasibility_iterations > 0 && options.solver.rfind("pdhg", 0) == 0) {
@@ -2416,6 +2422,7 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
       if (options.first_snapshot && options.snapshot_seconds > 0.0) {
         params.snapshot_seconds = options.snapshot_seconds;
         params.snapshot = snapshot;
+        params.exact_state = true;
       }
       // The divergence bound is the whole LP's: this one leaves out what propagation fixed to 1.
       if (std::isfinite(params.divergence_bound)) params.divergence_bound -= lp.objective_scale * red.fixed_cost;
@@ -2434,6 +2441,7 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
           snapshot_seconds += p.seconds;
           params.initial_watch = {};  // (a new solve, as it is uninterrupted)
           params.iterations_before = 0;
+          params.resume_state = nullptr;
           joined.r = solver->solve(red.lp, params);
           joined.r.iterations += p.iterations;
           joined.r.seconds += p.seconds;
@@ -2828,6 +2836,7 @@ RoundingResult round_to_graph_surface(const ProductSpace& space, const LpProblem
     alt.round_snapshot = {};
     alt.resumed_iterations = 0;  // (its round 1 is that optimum's)
     alt.resumed_seconds = 0.0;
+    alt.resumed_state = nullptr;
     alt.first_max_iterations = 0;
     alt.feasibility_iterations = 0;  // (round 1 was optimal)
     alt.lp.initial_x = first.x;  // round 1 starts at its optimum: it only confirms it

@@ -548,6 +548,10 @@ struct LevelAttempt {
   // Its divergence watch at the last window before `solving` was taken, which the LP gone on from
   // there watches on from (version 16; before, its windows started over).
   DivergenceWatchState solving_watch;
+  // … and its whole state there (version 19; none before, or from pdhg-cpu-f32): a run gone on
+  // from here makes the iterations the uninterrupted LP would have made, bit for bit, where it
+  // builds the same LP with the same solver (its fingerprint); else it goes on from `solving`.
+  std::shared_ptr<const SolverState> solving_state;
   LevelReport report;            // its counts so far (widenings, widened faces, …); no Γ
   // Where the attempt's rounding had got, saved after its rounds (at most every few seconds): a
   // run gone on from it builds the same LP, fixes `ones` before its round 1 and keeps round 1's

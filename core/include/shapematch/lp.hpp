@@ -4,6 +4,7 @@
 // termination status that is separate from whether the call itself worked).
 #include "shapematch/sparse.hpp"
 
+#include <cstdint>
 #include <limits>
 #include <memory>
 #include <functional>
@@ -55,6 +56,27 @@ struct DivergenceWatchState {
   bool operator==(const DivergenceWatchState&) const = default;
 };
 
+// The whole state of a PDHG solve between two batches of iterations (SolverParams::exact_state):
+// going on from it (SolverParams::resume_state) repeats, bit for bit, the iterations the solve
+// would have made uninterrupted, on the same backend and thread count. The vectors are the
+// backend's, in its scaled space (opaque to callers: for pdhg-cpu-f32, which keeps none, no state).
+struct SolverState {
+  std::string solver;            // the solver that made it (its name())
+  uint64_t fingerprint = 0;      // of the LP it belongs to (sizes, c, b and A's pattern)
+  std::vector<double> x, x0;     // the iterate and its Halpern anchor (columns)
+  std::vector<double> y, y0;     // … (rows)
+  std::vector<double> window_y;  // the dual at the divergence watch's window start (empty: none yet)
+  double step = 0.0;             // η (from the Lanczos estimate of ‖Ã‖)
+  double primal_weight = 0.0;    // ω
+  double restart_artificial = 0.0, restart_base = -1.0, previous = 0.0;
+  int64_t since_restart = 0;     // the Halpern index k
+  int64_t iterations = 0;        // the solve's count for its artificial restarts (those before included)
+  int64_t window_left = 0;       // iterations to the watch window's end
+  int restarts = 0;
+  DivergenceWatchState watch;
+  bool operator==(const SolverState&) const = default;
+};
+
 // A point a first-order solve could start again from (SolverParams::snapshot).
 struct SolveSnapshot {
   std::vector<double> x, y;   // in the problem's units
@@ -62,6 +84,8 @@ struct SolveSnapshot {
   int64_t iterations = 0;      // so far
   double seconds = 0.0;        // so far, its set-up included
   DivergenceWatchState watch;  // at the last window's end (fresh where the solve was not watched)
+  // With SolverParams::exact_state, where the solver keeps one: its whole state, to go on exactly.
+  std::shared_ptr<const SolverState> state;
 };
 
 struct SolverParams {
@@ -98,6 +122,13 @@ struct SolverParams {
   // resolution, level 6's 12.7 M-variable first LP gone on after 7 232 iterations at ω 24.3): ω
   // went 69, 303, 1 420, 5 430 in the first 832 iterations, 72 500 by 1 984.
   int64_t iterations_before = 0;
+  // PDHG: snapshots carry the solve's whole state (SolveSnapshot::state; two copies of the
+  // iterate more than the point alone).
+  bool exact_state = false;
+  // PDHG: go on from this state (an earlier solve's snapshot of the same LP by the same solver)
+  // instead of from initial_x/initial_y and the step, ω and restarts they would get; ignored where
+  // it belongs to another LP or solver. max_iterations still counts this solve's iterations only.
+  std::shared_ptr<const SolverState> resume_state;
   // Warm start (first-order methods): both empty or of the right sizes.
   std::vector<double> initial_x;
   std::vector<double> initial_y;

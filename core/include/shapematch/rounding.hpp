@@ -369,7 +369,8 @@ struct RoundingOptions {
   // first-order solve (not its pre-test, not later rounds) with the point it would restart from,
   // over the whole LP as first_iterate's, its iterations and seconds so far (a probe's included,
   // and resumed_*), and whether that solve had the divergence watch on (the pre-test can turn it
-  // off), for a checkpoint that a later run starts that LP from (SolverParams::snapshot).
+  // off), for a checkpoint that a later run starts that LP from (SolverParams::snapshot). Its
+  // `state` is the solve's whole state over the LP round 1 solves (SolverParams::exact_state).
   std::function<void(const SolveSnapshot& whole, bool watched)> first_snapshot;
   double snapshot_seconds = 0.0;
   // Where set and snapshot_seconds > 0: called every snapshot_seconds at most during each round
@@ -386,6 +387,9 @@ struct RoundingOptions {
   // are not given) and in its snapshots.
   int64_t resumed_iterations = 0;
   double resumed_seconds = 0.0;
+  // … and from this whole state of it (a first_snapshot's), exactly, where it is that LP's: the
+  // same iterations as uninterrupted (SolverParams::resume_state); else from the warm start.
+  std::shared_ptr<const SolverState> resumed_state;
   // Where the LP has at most alternatives_below columns, the rounding runs again from round 1's
   // iterate with each of these thresholds (round 1 then only confirms that optimum), and the Γ of
   // least energy is returned, with the threshold that found it. Fixing by a threshold is greedy,
