@@ -2003,6 +2003,20 @@ TEST_CASE("coarse to fine: a run gone on from inside a refined level's first LP 
   REQUIRE(loaded.attempt.solving_state != nullptr);
   CHECK(*loaded.attempt.solving_state == *late.attempt.solving_state);
   CHECK(late.attempt.solving_state->iterations == done);
+  {  // A state whose vectors disagree in size, or hold a value that is not finite: refused.
+    for (int fault = 0; fault < 3; ++fault) {
+      CAPTURE(fault);
+      LevelCheckpoint broken = late;
+      auto state = std::make_shared<SolverState>(*late.attempt.solving_state);
+      if (fault == 0) state->y0.pop_back();
+      if (fault == 1) state->x.back() = std::numeric_limits<double>::quiet_NaN();
+      if (fault == 2) state->since_restart = -1;
+      broken.attempt.solving_state = state;
+      const std::string other = (tmp.path / "broken_state.ckpt").string();
+      save_checkpoint(other, broken);
+      CHECK_THROWS_WITH_AS(load_checkpoint(other), doctest::Contains("an LP state"), IoError);
+    }
+  }
   {  // A save after the watch's first window holds what that window saw (a fresh watch before).
     CoarseToFineOptions longer = o;
     longer.rounding.lp.tolerance = 1e-7;  // (a first LP past 512 iterations)

@@ -381,6 +381,7 @@ TEST_CASE("pdhg-cpu: going on from a snapshot's state repeats the uninterrupted 
     CAPTURE(c);
     const LpProblem& p = cases[c].lp;
     SolverParams params = tight(1e-8);
+    params.threads = 1;
     params.max_iterations = 20000;
     params.stop_on_divergence = cases[c].watched;
     params.exact_state = true;
@@ -408,15 +409,48 @@ TEST_CASE("pdhg-cpu: going on from a snapshot's state repeats the uninterrupted 
       same(rest, whole);
       ++resumed;
     }
-    // Another LP of the same sizes, or another solver: the state is not theirs, and is ignored.
-    LpProblem other = p;
-    for (double& v : other.c) v += 0.25;
+    // Another LP of the same sizes (other costs, another right-hand side, another objective scale),
+    // other options, or another solver: the state is not theirs, and is ignored.
     SolverParams plain = params;
     plain.snapshot = {};
     SolverParams given = plain;
     given.resume_state = seen[seen.size() / 2].state;
+    LpProblem other = p;
+    for (double& v : other.c) v += 0.25;
     same(solve_lp(other, "pdhg-cpu", given), solve_lp(other, "pdhg-cpu", plain));
+    other = p;
+    other.b[0] += 0.125;
+    same(solve_lp(other, "pdhg-cpu", given), solve_lp(other, "pdhg-cpu", plain));
+    other = p;
+    other.objective_scale *= 2.0;
+    same(solve_lp(other, "pdhg-cpu", given), solve_lp(other, "pdhg-cpu", plain));
+    PdhgOptions reflected;
+    reflected.reflection = 0.9;
+    PdhgSolver otherwise(PdhgBackendKind::Cpu, reflected);
+    same(otherwise.solve(p, given), otherwise.solve(p, plain));
     same(solve_lp(p, "pdhg-cpu-f32", given), solve_lp(p, "pdhg-cpu-f32", plain));
+    // On another thread count its sums add in another order: the same point goes on (the state's
+    // device says where it was made), to the same end within the tolerance.
+    CHECK(seen.back().state->device == "cpu (1 threads)");
+    if (!cases[c].watched) {
+      SolverParams wider = given;
+      wider.threads = 2;
+      const LpResult on = solve_lp(p, "pdhg-cpu", wider);
+      CHECK(on.status == LpStatus::Optimal);
+      CHECK(std::abs(on.objective - whole.objective) <= 1e-6 * (1.0 + std::abs(whole.objective)));
+    }
+  }
+  {  // At the iteration cap the loop ends: no state there (a solve gone on from it would make one more).
+    SolverParams capped = tight(1e-12);
+    capped.max_iterations = 256;
+    capped.exact_state = true;
+    std::vector<SolveSnapshot> at;
+    capped.snapshot_seconds = 1e-9;
+    capped.snapshot = [&](const SolveSnapshot& s) { at.push_back(s); };
+    REQUIRE(solve_lp(cases[0].lp, "pdhg-cpu", capped).status == LpStatus::IterationLimit);
+    REQUIRE(at.size() == 4);
+    CHECK(at[2].state != nullptr);
+    CHECK(at[3].state == nullptr);
   }
   MESSAGE(resumed << " solves gone on from a state, " << after_restart << " of them just after a restart");
   CHECK(after_restart >= 1);

@@ -250,9 +250,11 @@ void read_mostly_zero(Reader& r, std::vector<double>& v, const std::string& path
   std::vector<uint64_t> at;
   std::vector<double> value;
   r.array(at), r.array(value);
-  // (A size past any LP's is a corrupt file: refused before it is allocated.)
-  if (n > (uint64_t(1) << 32) || at.size() != value.size() ||
-      std::any_of(at.begin(), at.end(), [n](uint64_t j) { return j >= n; }))
+  // (A size past any LP's, 31-bit columns, is a corrupt file: refused before it is allocated.
+  // Indices as written: increasing.)
+  bool increasing = true;
+  for (size_t k = 0; k < at.size(); ++k) increasing = increasing && at[k] < n && (k == 0 || at[k - 1] < at[k]);
+  if (n >= (uint64_t(1) << 31) || at.size() != value.size() || !increasing)
     throw IoError(path + ": not a shapematch checkpoint (an LP state's vector of " + std::to_string(n) + " values)");
   v.assign(n, 0.0);
   for (size_t k = 0; k < at.size(); ++k) v[at[k]] = value[k];
@@ -261,6 +263,7 @@ void read_mostly_zero(Reader& r, std::vector<double>& v, const std::string& path
 // An LP under way's whole state (version >= 19).
 void write_state(Writer& w, const SolverState& s) {
   w.array(std::vector<char>(s.solver.begin(), s.solver.end()));
+  w.array(std::vector<char>(s.device.begin(), s.device.end()));
   w(s.fingerprint);
   write_mostly_zero(w, s.x), write_mostly_zero(w, s.x0);
   w.array(s.y), w.array(s.y0), w.array(s.window_y);
@@ -273,6 +276,8 @@ std::shared_ptr<const SolverState> read_state(Reader& r, const std::string& path
   std::vector<char> name;
   r.array(name);
   s->solver.assign(name.begin(), name.end());
+  r.array(name);
+  s->device.assign(name.begin(), name.end());
   r(s->fingerprint);
   read_mostly_zero(r, s->x, path), read_mostly_zero(r, s->x0, path);
   r.array(s->y), r.array(s->y0), r.array(s->window_y);
@@ -288,7 +293,11 @@ std::shared_ptr<const SolverState> read_state(Reader& r, const std::string& path
   const bool counts = s->since_restart >= 0 && s->since_restart <= kMaxIterations && s->iterations >= 0 &&
                       s->iterations <= kMaxIterations && s->window_left >= -kMaxIterations &&
                       s->window_left <= kMaxIterations && s->restarts >= 0;
-  if (!sizes || !scalars || !counts)
+  const auto finite = [](const std::vector<double>& v) {
+    return std::all_of(v.begin(), v.end(), [](double e) { return std::isfinite(e); });
+  };
+  const bool values = finite(s->x) && finite(s->x0) && finite(s->y) && finite(s->y0) && finite(s->window_y);
+  if (!sizes || !scalars || !counts || !values)
     throw IoError(path + ": not a shapematch checkpoint (an LP state after " + std::to_string(s->iterations) +
                   " iterations)");
   return s;

@@ -75,9 +75,12 @@ bool row_bounds_infeasible(const LpProblem& p) {
   return false;
 }
 
-// Which LP a SolverState belongs to: its sizes, c and b (bits) and A's pattern and signs, mixed
+// Which LP, scaling and options a SolverState belongs to: the LP's sizes, objective scale, c and b
+// (bits) and A's pattern and signs, the diagonal scaling (r, d: another build's Ruiz passes would
+// put the state's scaled vectors in another space) and every option the iterations depend on, mixed
 // word by word (splitmix64's finaliser over a running sum: a changed word changes the result).
-uint64_t fingerprint(const LpProblem& p) {
+uint64_t fingerprint(const LpProblem& p, const std::vector<double>& r, const std::vector<double>& d,
+                     const PdhgOptions& o) {
   uint64_t h = 0x9e3779b97f4a7c15ull;
   const auto mix = [&h](uint64_t v) {
     uint64_t z = (h += v + 0x9e3779b97f4a7c15ull);
@@ -90,12 +93,17 @@ uint64_t fingerprint(const LpProblem& p) {
     std::memcpy(&u, &v, sizeof u);
     return u;
   };
-  mix(uint64_t(p.rows())), mix(uint64_t(p.cols())), mix(uint64_t(p.nonzeros()));
+  mix(uint64_t(p.rows())), mix(uint64_t(p.cols())), mix(uint64_t(p.nonzeros())), mix(bits(p.objective_scale));
   for (double v : p.c) mix(bits(v));
   for (double v : p.b) mix(bits(v));
   for (uint32_t v : p.a.row_ptr) mix(v);
   for (size_t k = 0; k + 1 < p.a.entry.size(); k += 2) mix(uint64_t(p.a.entry[k]) << 32 | p.a.entry[k + 1]);
   if (p.a.entry.size() % 2 == 1) mix(p.a.entry.back());
+  for (double v : r) mix(bits(v));
+  for (double v : d) mix(bits(v));
+  for (double v : {o.reflection, o.restart_sufficient, o.restart_necessary, o.primal_weight_smoothing})
+    mix(bits(v));
+  mix(uint64_t(o.check_interval));
   return h;
 }
 
@@ -120,8 +128,12 @@ LpResult PdhgSolver::solve(const LpProblem& problem, const SolverParams& params)
     throw InvalidInputError("warm start y has " + std::to_string(params.initial_y.size()) + " entries, expected " + std::to_string(m));
 
   // An exact state to go on from, where it is this LP's and this solver's (else the warm start).
+  std::vector<double> r, d;
+  compute_scaling(problem, options_.ruiz_iterations, params.threads, r, d);
+  const double scaling_seconds = clock.seconds();
+  // An exact state to go on from, where it is this LP's, scaling's and solver's (else the warm start).
   const bool exact = params.exact_state && backend_ != PdhgBackendKind::CpuF32;
-  const uint64_t print = exact || params.resume_state ? fingerprint(problem) : 0;
+  const uint64_t print = exact || params.resume_state ? fingerprint(problem, r, d, options_) : 0;
   const SolverState* resume = params.resume_state.get();
   if (resume && (resume->solver != name() || resume->fingerprint != print || resume->x.size() != size_t(n) ||
                  resume->x0.size() != size_t(n) || resume->y.size() != size_t(m) || resume->y0.size() != size_t(m) ||
@@ -131,10 +143,6 @@ LpResult PdhgSolver::solve(const LpProblem& problem, const SolverParams& params)
                   name(), resume->solver);
     resume = nullptr;
   }
-
-  std::vector<double> r, d;
-  compute_scaling(problem, options_.ruiz_iterations, params.threads, r, d);
-  const double scaling_seconds = clock.seconds();
   // The Lanczos estimate approaches ‖Ã‖ from below (within norm_tolerance of an eigenvalue when it
   // stops), so add a margin; Pock–Chambolle scaling with α = 1 guarantees ‖Ã‖ ≤ 1, which caps it.
   // (Gone on from a state: its step, which the estimate made; ten seconds at full resolution.)
@@ -193,6 +201,12 @@ LpResult PdhgSolver::solve(const LpProblem& problem, const SolverParams& params)
     backend->load_state(lp, resume->x, resume->x0, resume->y, resume->y0);
   else
     backend->load(lp, x0, y0);
+  // Sums over threads or a device's workgroups add in their own order: elsewhere the same point
+  // goes on, not the same iterations bit for bit.
+  if (resume && resume->device != result.device)
+    spdlog::info("{}: going on from its state of {} iterations on {} where it was made on {}: the same point, but "
+                 "not bit for bit the iterations it would have made there",
+                 name(), resume->iterations, result.device, resume->device);
   result.setup_seconds = clock.seconds();
   spdlog::debug("{}: set up in {:.2f} s (scaling {:.2f} s, norm {:.2f} s in {} Lanczos steps)", name(),
                 result.setup_seconds, scaling_seconds, norm_seconds, estimate.steps);
@@ -379,10 +393,12 @@ LpResult PdhgSolver::solve(const LpProblem& problem, const SolverParams& params)
       snap.iterations = total;
       snap.seconds = clock.seconds();
       if (params.stop_on_divergence) snap.watch = watch.state();
-      if (exact) {
+      // (None at the iteration cap, where the loop ends: a solve gone on from there would make one more.)
+      if (exact && total < params.max_iterations) {
         auto state = std::make_shared<SolverState>();
         if (backend->read_state(state->x, state->x0, state->y, state->y0)) {
           state->solver = name();
+          state->device = result.device;
           state->fingerprint = print;
           state->window_y = window_y;
           state->step = eta;

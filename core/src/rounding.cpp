@@ -2429,6 +2429,9 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
       if (options.probe && options.probe_tolerance > params.tolerance) {
         SolverParams loose = params;
         loose.tolerance = options.probe_tolerance;
+        // (Its snapshots go on as iterates: a run gone on from one solves at the tight tolerance, where
+        // the uninterrupted probe would have stopped at the loose one and priced.)
+        loose.exact_state = false;
         LpResult p = solver->solve(red.lp, loose);
         if (p.status == LpStatus::Optimal && p.x.size() == red.cols.size() && p.y.size() == red.rows.size()) {
           options.probe(full_x(p.x), full_y(p.y), p.primal_weight);

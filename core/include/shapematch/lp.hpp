@@ -58,11 +58,13 @@ struct DivergenceWatchState {
 
 // The whole state of a PDHG solve between two batches of iterations (SolverParams::exact_state):
 // going on from it (SolverParams::resume_state) repeats, bit for bit, the iterations the solve
-// would have made uninterrupted, on the same backend and thread count. The vectors are the
+// would have made uninterrupted, on the same backend and device (thread count, GPU; elsewhere the
+// same point goes on, not bit for bit: sums add in another order). The vectors are the
 // backend's, in its scaled space (opaque to callers: for pdhg-cpu-f32, which keeps none, no state).
 struct SolverState {
   std::string solver;            // the solver that made it (its name())
-  uint64_t fingerprint = 0;      // of the LP it belongs to (sizes, c, b and A's pattern)
+  std::string device;            // … and where (LpResult::device: the CPU threads, the GPU)
+  uint64_t fingerprint = 0;      // of the LP, its scaling and the solver's options
   std::vector<double> x, x0;     // the iterate and its Halpern anchor (columns)
   std::vector<double> y, y0;     // … (rows)
   std::vector<double> window_y;  // the dual at the divergence watch's window start (empty: none yet)
