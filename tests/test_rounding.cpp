@@ -3,6 +3,7 @@
 #include "shapematch/matching.hpp"
 #include "shapematch/rounding.hpp"
 #include "shapematch/shapes.hpp"
+#include "shapematch/system.hpp"
 #include "certificate_blame.hpp"
 #include "failed_from.hpp"
 #include "failing_again.hpp"
@@ -15,6 +16,7 @@
 
 #include <doctest/doctest.h>
 
+#include <csignal>
 #include <map>
 #include <set>
 #include <numeric>
@@ -270,6 +272,50 @@ TEST_CASE("rounding: a round's LP under way is snapshot as the next warm start, 
   snaps.clear();
   round_to_graph_surface(m.space, m.lp, m.energy, o);
   CHECK(snaps.empty());
+}
+
+TEST_CASE("rounding: a stop in a later round's pre-test saves that round's warm start before it goes on") {
+  // A stop asked for after round 1 (its `decided` not saved, as the caller's throttle may leave it):
+  // round 2's parts are pre-tested at zero cost first, which keep no snapshot, so PDHG stops there
+  // at its set-up's end; the rounding hands round_snapshot the round's warm start (round 1's iterate,
+  // the point `decided` had) before the Stopped goes on. A stop inside a costed solve saves there.
+  const MatchingLp& m = dolphin_ball_60();
+  struct Forget {  // (whatever fails: the stop does not outlive the test)
+    ~Forget() { clear_stop(); }
+  } forget;
+  for (const bool pretested : {true, false}) {
+    CAPTURE(pretested);
+    RoundingOptions o;
+    o.solver = "pdhg-cpu";
+    o.exact_below = 0;  // (every round on PDHG)
+    o.search_below = 0;
+    o.alternative_thresholds = {};
+    o.close_pockets = false;
+    o.later_feasibility_iterations = pretested ? 4096 : 0;
+    o.later_feasibility_skip_below = 0;  // (the pre-test first)
+    std::vector<std::vector<double>> decided_x;
+    o.decided = [&](const RoundingRound&, const std::vector<int64_t>&, const std::vector<int32_t>&, double,
+                    const std::vector<double>& x, const std::vector<double>&) {
+      decided_x.push_back(x);
+      request_stop(SIGTERM);
+    };
+    o.snapshot_seconds = 1e9;  // (never by time: only the stop's)
+    std::vector<std::pair<std::vector<double>, double>> snaps;
+    o.round_snapshot = [&](const std::vector<double>& x, const std::vector<double>&, double omega) {
+      snaps.push_back({x, omega});
+    };
+    CHECK_THROWS_AS(round_to_graph_surface(m.space, m.lp, m.energy, o), Stopped);
+    clear_stop();
+    REQUIRE(decided_x.size() == 1);
+    REQUIRE(snaps.size() == 1);  // (once: not again after a costed solve's own snapshot)
+    if (pretested) {
+      CHECK(snaps[0].first == decided_x[0]);
+      CHECK(snaps[0].second == 0.0);
+    } else {
+      CHECK(snaps[0].second > 0.0);  // (the costed solve's, at its first residual check)
+    }
+  }
+  CHECK(stop_requested() == 0);
 }
 
 TEST_CASE("rounding: a rounding gone on from decisions with their steps keeps the steps apart") {

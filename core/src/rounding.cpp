@@ -2467,22 +2467,37 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
         for (size_t j = 0; j < red.cols.size(); ++j) warm_weight[j] = w_full[red.cols[j]];
       }
       // The round's iterate so far as the next round's warm start, for a checkpoint (round_snapshot).
-      if (options.round_snapshot && options.snapshot_seconds > 0.0) {
+      bool saved = false;  // (by such a snapshot in this round)
+      const bool snapshots = options.round_snapshot && options.snapshot_seconds > 0.0;
+      if (snapshots) {
         params.snapshot_seconds = options.snapshot_seconds;
         params.snapshot = [&](const SolveSnapshot& s) {
           options.round_snapshot(full_x(s.x), full_y(s.y), s.primal_weight);
+          saved = true;
         };
       }
-      joined = detail::solve_in_parts(red.lp, std::move(params), *solver, exact ? exact_solver.get() : nullptr,
-                              options.exact_below, exact_params, options.split_parts,
-                              {options.exact_pivots_per_column, options.exact_part_seconds}, &exact_cache, &warm_weight, options.slow_part,
-                              options.slow_part_seconds,
-                              {.iterations = options.later_feasibility_iterations,
-                               .tolerance = options.feasibility_tolerance,
-                               .cache = &pretest_cache,
-                               .skip_below = options.later_feasibility_skip_below,
-                               .skip_residual = options.later_feasibility_skip_residual,
-                               .skip_row = options.later_feasibility_skip_row});
+      try {
+        joined = detail::solve_in_parts(red.lp, std::move(params), *solver, exact ? exact_solver.get() : nullptr,
+                                        options.exact_below, exact_params, options.split_parts,
+                                        {options.exact_pivots_per_column, options.exact_part_seconds}, &exact_cache,
+                                        &warm_weight, options.slow_part, options.slow_part_seconds,
+                                        {.iterations = options.later_feasibility_iterations,
+                                         .tolerance = options.feasibility_tolerance,
+                                         .cache = &pretest_cache,
+                                         .skip_below = options.later_feasibility_skip_below,
+                                         .skip_residual = options.later_feasibility_skip_residual,
+                                         .skip_row = options.later_feasibility_skip_row});
+      } catch (const Stopped&) {
+        // A stop where this round saved nothing (a part's zero-cost pre-test or first short solve,
+        // which keep no snapshot): the rounds before it, whose `decided` the caller's throttle may
+        // not have saved yet, go with this round's warm start as a snapshot does, then the stop
+        // goes on. (Before, up to a minute of rounds at full resolution was lost.)
+        if (snapshots && !saved && !result.rounds.empty()) {
+          spdlog::debug("rounding: stopped in round {} before its LP saved anything: saving its warm start", round);
+          options.round_snapshot(x_full, y_full, 0.0);
+        }
+        throw;
+      }
     }
     const LpResult& r = joined.r;
     // Round 1's iterate over the whole LP, for first_iterate and (an optimum) for the alternatives.

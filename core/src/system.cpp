@@ -70,6 +70,7 @@ void request_stop(int signal) noexcept {
   g_stop.compare_exchange_strong(none, signal == 0 ? -1 : signal, std::memory_order_relaxed);
 }
 int stop_requested() noexcept { return g_stop.load(std::memory_order_relaxed); }
+void clear_stop() noexcept { g_stop.store(0, std::memory_order_relaxed); }
 
 void set_worker_threads(int threads) { g_thread_limit.store(std::max(0, threads), std::memory_order_relaxed); }
 

@@ -380,7 +380,9 @@ struct RoundingOptions {
   // to end there, over the whole LP as `decided`'s (the parts solved so far as they ended, the one
   // under way where it is, the others as they started): for a checkpoint beside the last `decided`
   // one, so that a later run starts that round there rather than from the round before's iterate.
-  // (With the primal weight of the part under way.)
+  // (With the primal weight of the part under way.) Also where a stop (request_stop) comes before
+  // the round's LP saved anything (a part's pre-test or first short solve), with the round's warm
+  // start and ω 0, before the Stopped goes on: the caller's last `decided` may not have been saved.)
   std::function<void(const std::vector<double>& x, const std::vector<double>& y, double primal_weight)> round_snapshot;
   // Round 1's LP goes on from such a snapshot (its warm start in `lp`) after these: they count in
   // round 1's iterations and seconds wherever those scale the later rounds (where reference_*

@@ -27,6 +27,8 @@ void set_worker_threads(int threads);
 // Async-signal-safe. `signal`: what asked (reported back by stop_requested; 0: none asked).
 void request_stop(int signal) noexcept;
 int stop_requested() noexcept;
+// Forgets the stop asked for (a test that asked for one; a caller that has handled it).
+void clear_stop() noexcept;
 
 class Stopwatch {
 public:
