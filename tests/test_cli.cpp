@@ -905,7 +905,31 @@ TEST_CASE("cli: checkpoint shows both chains of a run stopped inside lookahead")
   CHECK(json_number(at.out.substr(top), "cap_scale") == 4);
   CHECK(at.out.find("\"warm_resolve\": true", top) != std::string::npos);  // a pricing's iterate kept with it
   CHECK(at.out.find("\"solving_iterations\": null", top) != std::string::npos);  // no LP under way kept
+  CHECK(at.out.find("\"solving_exact\": null", top) != std::string::npos);
   CHECK(r.out.find("\"warm_resolve\"") == std::string::npos);               // (no attempt there)
+  {  // An LP under way kept with its whole state (version 19): "solving_exact" says so.
+    shapematch::LevelCheckpoint solving = inside;
+    shapematch::LevelAttempt& s = solving.chains[1].attempt;
+    s.rounding = {};
+    s.solving = s.priced_from;
+    s.priced_from = {};
+    s.solving_iterations = 128;
+    auto state = std::make_shared<shapematch::SolverState>();
+    state->solver = "pdhg-cpu";
+    state->x = state->x0 = {0.5, 0.0};
+    state->y = state->y0 = {0.25};
+    state->step = 1.0;
+    state->primal_weight = 2.0;
+    state->iterations = 128;
+    s.solving_state = state;
+    const std::string file = (tmp.path / "exact.ckpt").string();
+    shapematch::save_checkpoint(file, solving);
+    const Run e = run("checkpoint " + file);
+    REQUIRE_MESSAGE(e.code == 0, e.err);
+    const size_t t = e.out.rfind("\"attempt\"");
+    CHECK(json_number(e.out.substr(t), "solving_iterations") == 128);
+    CHECK(e.out.find("\"solving_exact\": true", t) != std::string::npos);
+  }
   // Its first level alone: neither chain goes with it.
   const Run kept = run("checkpoint " + ckpt + " --keep-levels 1 --out " + ckpt);
   REQUIRE_MESSAGE(kept.code == 0, kept.err);
