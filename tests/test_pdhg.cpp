@@ -438,6 +438,10 @@ TEST_CASE("pdhg-cpu: going on from a snapshot's state repeats the uninterrupted 
       const LpResult on = solve_lp(p, "pdhg-cpu", wider);
       CHECK(on.status == LpStatus::Optimal);
       CHECK(std::abs(on.objective - whole.objective) <= 1e-6 * (1.0 + std::abs(whole.objective)));
+      // (From the state, halfway: about the rest of the solve, not all of it.)
+      const int64_t rest = whole.iterations - seen[seen.size() / 2].iterations;
+      CHECK(on.iterations <= rest + rest / 2 + 64);
+      CHECK(on.iterations < whole.iterations);
     }
   }
   {  // At the iteration cap the loop ends: no state there (a solve gone on from it would make one more).

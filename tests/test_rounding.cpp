@@ -301,8 +301,10 @@ TEST_CASE("rounding: a stop in a later round's pre-test saves that round's warm 
     };
     o.snapshot_seconds = 1e9;  // (never by time: only the stop's)
     std::vector<std::pair<std::vector<double>, double>> snaps;
+    // (As match's checkpoint callback does: after a save where a stop is asked for, Stopped.)
     o.round_snapshot = [&](const std::vector<double>& x, const std::vector<double>&, double omega) {
       snaps.push_back({x, omega});
+      if (stop_requested() != 0) throw Stopped("after saving its checkpoint");
     };
     CHECK_THROWS_AS(round_to_graph_surface(m.space, m.lp, m.energy, o), Stopped);
     clear_stop();

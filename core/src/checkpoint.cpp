@@ -10,6 +10,7 @@
 #include <cstring>
 #include <fstream>
 #include <iterator>
+#include <new>
 #include <type_traits>
 
 namespace shapematch {
@@ -37,7 +38,8 @@ constexpr char kMagic[] = "shapematch level checkpoint\n";
 // 17: LevelReport::proof_rechecks; an attempt's last local proof region (proof_faces, proof_rings).
 // 18: the layout of 17, then a checksum (Checksum) of every byte before it.
 // 19: an LP under way's whole state (LevelAttempt::solving_state: a flag, then write_state's
-// layout) follows its watch.
+// layout) follows its watch. (As 672ff1a wrote it, without the device, it is refused: only that
+// commit's binaries, within the eighty-ninth session, wrote it.)
 constexpr uint32_t kVersion = 19;
 constexpr uint32_t kFirstChecksummed = 18;
 // More rings than a local proof's region grows (RoundingOptions::local_proof_depth).
@@ -256,7 +258,11 @@ void read_mostly_zero(Reader& r, std::vector<double>& v, const std::string& path
   for (size_t k = 0; k < at.size(); ++k) increasing = increasing && at[k] < n && (k == 0 || at[k - 1] < at[k]);
   if (n >= (uint64_t(1) << 31) || at.size() != value.size() || !increasing)
     throw IoError(path + ": not a shapematch checkpoint (an LP state's vector of " + std::to_string(n) + " values)");
-  v.assign(n, 0.0);
+  try {
+    v.assign(n, 0.0);
+  } catch (const std::bad_alloc&) {
+    throw IoError(path + ": an LP state's vector of " + std::to_string(n) + " values does not fit in memory");
+  }
   for (size_t k = 0; k < at.size(); ++k) v[at[k]] = value[k];
 }
 

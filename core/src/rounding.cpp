@@ -2472,8 +2472,8 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
       if (snapshots) {
         params.snapshot_seconds = options.snapshot_seconds;
         params.snapshot = [&](const SolveSnapshot& s) {
+          saved = true;  // (first: a caller's save may end in Stopped, as match's does on a stop)
           options.round_snapshot(full_x(s.x), full_y(s.y), s.primal_weight);
-          saved = true;
         };
       }
       try {
