@@ -127,7 +127,6 @@ LpResult PdhgSolver::solve(const LpProblem& problem, const SolverParams& params)
   if (!params.initial_y.empty() && params.initial_y.size() != size_t(m))
     throw InvalidInputError("warm start y has " + std::to_string(params.initial_y.size()) + " entries, expected " + std::to_string(m));
 
-  // An exact state to go on from, where it is this LP's and this solver's (else the warm start).
   std::vector<double> r, d;
   compute_scaling(problem, options_.ruiz_iterations, params.threads, r, d);
   const double scaling_seconds = clock.seconds();
@@ -246,7 +245,7 @@ LpResult PdhgSolver::solve(const LpProblem& problem, const SolverParams& params)
     window_y = y0;
   int restarts = resume ? resume->restarts : 0;
   if (resume)
-    spdlog::debug("{}: going on exactly from its state after {} iterations ({} since its last restart)", name(),
+    spdlog::debug("{}: going on from its state after {} iterations ({} since its last restart)", name(),
                   before, k);
   Stopwatch since_snapshot;
   int snapshots = 0;  // taken so far (params.snapshot_first_seconds)
