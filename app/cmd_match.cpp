@@ -91,6 +91,7 @@ struct MatchArgs {
   int recurring_margin = CoarseToFineOptions{}.recurring_margin;
   double recurring_max_share = CoarseToFineOptions{}.recurring_max_share;
   int recurring_beyond = CoarseToFineOptions{}.recurring_beyond;
+  int proof_beyond = CoarseToFineOptions{}.proof_beyond;
   bool watch_resolve = CoarseToFineOptions{}.watch_resolve;
   int max_suspected_widenings = CoarseToFineOptions{}.max_suspected_widenings;
   int suspicion_rings = CoarseToFineOptions{}.suspicion_rings;
@@ -488,6 +489,7 @@ int run_match(const MatchArgs& args) {
   co.recurring_margin = args.recurring_margin;
   co.recurring_max_share = args.recurring_max_share;
   co.recurring_beyond = args.recurring_beyond;
+  co.proof_beyond = args.proof_beyond;
   co.watch_resolve = args.watch_resolve;
   co.max_suspected_widenings = args.max_suspected_widenings;
   co.suspicion_rings = args.suspicion_rings;
@@ -884,6 +886,7 @@ int run_match(const MatchArgs& args) {
                               .set("recurring_margin", args.recurring_margin)
                               .set("recurring_max_share", args.recurring_max_share)
                               .set("recurring_beyond", args.recurring_beyond)
+                              .set("proof_beyond", args.proof_beyond)
                               .set("watch_resolve", args.watch_resolve)
                               .set("max_suspected_widenings", args.max_suspected_widenings)
                               .set("suspicion_rings", args.suspicion_rings)
@@ -1325,6 +1328,11 @@ Action add_match_command(CLI::App& app) {
   app.add_option("--recurring-beyond", a->recurring_beyond,
                  "with --recurring-margin: such a return widens its faces to --max-ring plus this many rings")
       ->check(CLI::Range(1, 3))
+      ->capture_default_str();
+  app.add_option("--proof-beyond", a->proof_beyond,
+                 "with --local-proof: the faces a proved-infeasible region grew from widen up to --max-ring plus this "
+                 "many rings, one per proof (the other widenings stop at 3 more)")
+      ->check(CLI::Range(1, 12))
       ->capture_default_str();
   app.add_option("--second-start-budget", a->second_start_budget,
                  "beside a refined Γ, the second start's rounding gives up once its rounds after the first did this "

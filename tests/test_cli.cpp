@@ -329,7 +329,7 @@ TEST_CASE("cli: match writes a verified, complete output directory, or nothing")
   // itself is tested in test_rounding).
   const fs::path closed = out.string() + "_pockets";
   r = run("match --faces 30 --backend cpu --close-pockets --max-rounds 9 --feasibility-skip-row 0.05 "
-          "--feasibility-skip-below 64 --max-ring 4 --suspicion-margins 3 --recurring-beyond 2 --suspicion-margin-around named --divergence-bound-factor 1.5 -o " +
+          "--feasibility-skip-below 64 --max-ring 4 --suspicion-margins 3 --recurring-beyond 2 --proof-beyond 5 --suspicion-margin-around named --divergence-bound-factor 1.5 -o " +
           closed.string());
   REQUIRE(r.code == 0);
   std::ifstream fc(closed / "report.json");
@@ -342,6 +342,7 @@ TEST_CASE("cli: match writes a verified, complete output directory, or nothing")
   CHECK(json_number(with, "max_ring") == 4);
   CHECK(json_number(with, "suspicion_margins") == 3);
   CHECK(json_number(with, "recurring_beyond") == 2);
+  CHECK(json_number(with, "proof_beyond") == 5);
   CHECK(json_string(with, "suspicion_margin_around") == "named");
   CHECK(json_number(with, "divergence_bound_factor") == 1.5);
   CHECK(json_number(with, "pockets_closed") >= 0);
@@ -713,6 +714,7 @@ TEST_CASE("cli: match --checkpoint goes on after the levels a stopped run finish
   CHECK(json_number(first, "suspicion_rings") == 2);                // the default
   CHECK(json_number(first, "suspicion_margins") == 1);              // the default
   CHECK(json_number(first, "recurring_beyond") == 3);               // the default
+  CHECK(json_number(first, "proof_beyond") == 3);                   // the default
   CHECK(json_string(first, "suspicion_margin_around") == "widened");  // the default
   CHECK(json_number(first, "divergence_bound_factor") == 2);          // the default
   CHECK(json_number(first, "lp_checkpoint_seconds") == 600);          // the default

@@ -2554,6 +2554,12 @@ TEST_CASE("coarse to fine: a true map restricts the coarsest level, and there is
   }
   beyond.recurring_beyond = 1;
   CHECK_NOTHROW(CoarseToFineMatcher(m, m, beyond));
+  for (int n : {0, 13}) {  // (a proof's own faces: up to 12)
+    beyond.proof_beyond = n;
+    CHECK_THROWS_AS(CoarseToFineMatcher(m, m, beyond), InvalidInputError);
+  }
+  beyond.proof_beyond = 12;
+  CHECK_NOTHROW(CoarseToFineMatcher(m, m, beyond));
   CoarseToFineOptions scope;
   scope.suspicion_margin_scope = static_cast<CoarseToFineOptions::MarginScope>(7);
   CHECK_THROWS_AS(CoarseToFineMatcher(m, m, scope), InvalidInputError);

@@ -196,6 +196,8 @@ constexpr int kMaxConflictPlaces = 256;
 // Where a place's faces are all at max_ring: they may grow this many rings beyond it, and then X
 // faces up to kMaxMarginBoost rings around it widen too.
 constexpr int kMaxRingBeyond = 3;
+// … and for a local proof's own faces (CoarseToFineOptions::proof_beyond) at most this.
+constexpr int kMaxProofBeyond = 12;
 constexpr int kMaxMarginBoost = 3;
 // The last local widening of a level: every X face this many rings around the earlier ones.
 constexpr int kRegionRings = 8;
@@ -536,6 +538,8 @@ CoarseToFineMatcher::CoarseToFineMatcher(const Mesh& x, const Mesh& y, CoarseToF
     throw InvalidInputError("coarse to fine: need a branch depth, rings, split and gap of 0 or more");
   if (options_.recurring_beyond < 1 || options_.recurring_beyond > kMaxRingBeyond)
     throw InvalidInputError("coarse to fine: need 1 ≤ --recurring-beyond ≤ " + std::to_string(kMaxRingBeyond));
+  if (options_.proof_beyond < 1 || options_.proof_beyond > kMaxProofBeyond)
+    throw InvalidInputError("coarse to fine: need 1 ≤ --proof-beyond ≤ " + std::to_string(kMaxProofBeyond));
   if (options_.suspicion_margin_scope != CoarseToFineOptions::MarginScope::widened &&
       options_.suspicion_margin_scope != CoarseToFineOptions::MarginScope::named)
     throw InvalidInputError("coarse to fine: unknown suspicion margin scope");
@@ -1293,7 +1297,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
     return false;
   };
   // Widens the X faces a local proof grew from (LocalInfeasible: those its first LP stalled on)
-  // by one ring, past max_ring up to kMaxRingBeyond more, before widen_at's place around them:
+  // by one ring, past max_ring up to proof_beyond more, before widen_at's place around them:
   // that widens only faces below max_ring while any is, which left the stalled faces themselves
   // as they were (measured, TOSCA_r dog3-dog8 at full resolution: 7 faces at 4 extra rings, their
   // region proved infeasible again after 8 widenings around them, of 4-334 faces each; feasible
@@ -1302,7 +1306,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
     extra.resize(lx.mesh.num_faces(), 0);
     std::vector<int> before;  // (their extra rings, to tell which grew past max_ring)
     for (int f : faces) before.push_back(extra[f]);
-    if (!widen_locally(faces, "infeasible where its first LP stalled", options_.max_ring + kMaxRingBeyond))
+    if (!widen_locally(faces, "infeasible where its first LP stalled", options_.max_ring + options_.proof_beyond))
       return false;
     last_widened.clear();  // (widen_at's next place is not one it widened again)
     for (size_t i = 0; i < faces.size(); ++i)

@@ -130,6 +130,13 @@ struct CoarseToFineOptions {
   // resolution, level 6: three returns of 639, 451 and 678 faces to ring 6, 10.6 M -> 28.9 M
   // variables in two minutes of rebuilds, seventy-seventh session).
   int recurring_beyond = 3;
+  // How far past max_ring a local proof's own faces (those its first LP stalled on, proved
+  // infeasible there) may widen, one ring per proof (1 to 12). The other widenings stop at
+  // max_ring + 3. Measured, TOSCA_r dog3-dog8 at full resolution: seven stalled faces infeasible
+  // at 4 extra rings, feasible at 5 (eighty-fifth session); horse0-horse10: a region of 186 faces,
+  // 155 of them at ring 6, proved infeasible by eight rechecks in a row whose widenings around them
+  // left it as it was (eighty-ninth session).
+  int proof_beyond = 3;
   // Let the divergence watch stop the re-solve after pricing too (as before the twenty-sixth
   // session). Off: that re-solve starts at the optimum of a space it contains, and stops at the
   // cold first LP's iterations anyway (detail::watch_divergence says why).
