@@ -134,7 +134,7 @@ struct CoarseToFineOptions {
   // infeasible there) may widen, one ring per proof (1 to 12). The other widenings stop at
   // max_ring + 3. Measured, TOSCA_r dog3-dog8 at full resolution: seven stalled faces infeasible
   // at 4 extra rings, feasible at 5 (eighty-fifth session); horse0-horse10: a region of 186 faces,
-  // 155 of them at ring 6, proved infeasible by eight rechecks in a row whose widenings around them
+  // 155 of them at ring 6, proved infeasible by twelve rechecks in a row whose widenings around them
   // left it as it was (eighty-ninth session).
   int proof_beyond = 3;
   // Let the divergence watch stop the re-solve after pricing too (as before the twenty-sixth
