@@ -1803,6 +1803,42 @@ TEST_CASE("coarse to fine: a run gone on from an attempt of a level in progress 
     CHECK(fin.widened_faces - before.widened_faces == int64_t(faces) * (fin.proof_rechecks - 1));
     CHECK(fin.propagation_widenings == before.propagation_widenings);
     CHECK(check_graph_surface(rechecked.finest.space, rechecked.rounding.gamma).ok());
+
+    // With the local widenings spent too, the region still infeasible is widened by the regional
+    // widening (around every earlier widening) and checked again before that attempt's LP: it
+    // used to be dropped there, and the LP solved unchecked.
+    po.max_local_widenings = 0;
+    const CoarseToFineMatcher none_left = finger_matcher(po);
+    const CoarseToFineResult regional = none_left.run({}, &all);
+    const LevelReport& reg = regional.levels.back();
+    MESSAGE("rechecks " << reg.proof_rechecks << ", local widenings " << reg.local_widenings << ", margins "
+                        << reg.margin_widenings << ", ring widenings " << reg.widenings);
+    CHECK(reg.proof_rechecks == 2);
+    CHECK(reg.local_widenings == before.local_widenings + 1);  // (the regional one)
+    CHECK(reg.margin_widenings == before.margin_widenings + 1);
+    CHECK(reg.widenings == before.widenings);
+    CHECK(check_graph_surface(regional.finest.space, regional.rounding.gamma).ok());
+
+    // With the regional widening given already, the ring widens: the region is kept for that
+    // attempt's recheck too, and a face widened past --max-ring keeps its rings (it used to drop
+    // to --max-ring, where a proved region's faces are infeasible again).
+    LevelCheckpoint ringed = all;
+    ringed.attempt.regional_done = true;
+    ringed.attempt.extra.resize(faces, 0);
+    REQUIRE(ringed.attempt.ring == 0);
+    ringed.attempt.extra[0] = po.max_ring + 2;
+    std::vector<LevelAttempt> seen;
+    const CoarseToFineResult ring_up = none_left.run({}, &ringed, [&](const LevelCheckpoint& c) {
+      if (!c.attempt.empty()) seen.push_back(c.attempt);
+    });
+    const LevelReport& up = ring_up.levels.back();
+    CHECK(up.proof_rechecks == 2);
+    CHECK(up.widenings == before.widenings + 1);
+    REQUIRE_FALSE(seen.empty());
+    CHECK(seen.front().ring == 1);
+    CHECK(seen.front().extra[0] == po.max_ring + 1);  // (ring 1 + extra: the same max_ring + 2 rings)
+    CHECK(seen.front().proof_faces == all.attempt.proof_faces);
+    CHECK(check_graph_surface(ring_up.finest.space, ring_up.rounding.gamma).ok());
   }
 
   // Without its attempt, the same checkpoint widens again from the coarser Γ.

@@ -64,6 +64,18 @@ RoundingOptions every_round_on_pdhg() {
   return o;
 }
 
+// Every round on PDHG and nothing but the rounds (no search, no second threshold, no pocket
+// closing): what the snapshot and stop tests follow round by round.
+RoundingOptions pdhg_rounds_alone() {
+  RoundingOptions o;
+  o.solver = "pdhg-cpu";
+  o.exact_below = 0;
+  o.search_below = 0;
+  o.alternative_thresholds = {};
+  o.close_pockets = false;
+  return o;
+}
+
 // max |A x − b| over the whole LP.
 double max_residual(const LpProblem& lp, const std::vector<double>& x) {
   std::vector<double> ax(lp.rows(), 0.0);
@@ -208,12 +220,7 @@ TEST_CASE("rounding: a round's LP under way is snapshot as the next warm start, 
   // check of the rounds from fixings (not round 1, which first_snapshot covers), each the point
   // the round would hand `decided` were it to end there.
   const MatchingLp& m = dolphin_ball_60();
-  RoundingOptions o;
-  o.solver = "pdhg-cpu";
-  o.exact_below = 0;  // (every round on PDHG)
-  o.search_below = 0;
-  o.alternative_thresholds = {};
-  o.close_pockets = false;
+  RoundingOptions o = pdhg_rounds_alone();
   o.later_feasibility_iterations = 0;  // (the costed solves alone: what a snapshot shortens)
   struct Decided {
     std::vector<int64_t> ones;
@@ -285,12 +292,7 @@ TEST_CASE("rounding: a stop in a later round's pre-test saves that round's warm 
   } forget;
   for (const bool pretested : {true, false}) {
     CAPTURE(pretested);
-    RoundingOptions o;
-    o.solver = "pdhg-cpu";
-    o.exact_below = 0;  // (every round on PDHG)
-    o.search_below = 0;
-    o.alternative_thresholds = {};
-    o.close_pockets = false;
+    RoundingOptions o = pdhg_rounds_alone();
     o.later_feasibility_iterations = pretested ? 4096 : 0;
     o.later_feasibility_skip_below = 0;  // (the pre-test first)
     std::vector<std::vector<double>> decided_x;

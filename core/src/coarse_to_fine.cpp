@@ -1116,6 +1116,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
   struct ProofRegion {
     std::vector<int> faces;
     int rings = 0;
+    int64_t rows = -1, cols = -1;  // its relaxation's size at its last recheck (-1: none yet)
   };
   std::optional<ProofRegion> proof_region;
   int local = 0;
@@ -1461,6 +1462,10 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
       }
     }
     bool watched_patiently = false;  // this attempt's first LP (its stop is not a suspicion to re-solve)
+    // A recheck's proof (thrown below): the relaxation's size, and whether it is that of the
+    // region's last recheck.
+    std::optional<std::pair<int64_t, int64_t>> rechecked;
+    bool rechecked_same = false;
     try {
       RoundingOptions ro = rounding_for(l);
       // The last local proof's region, again in this widened LP (after propagation's checks): where
@@ -1482,11 +1487,14 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
                        l + 1, region.faces.size(), region.rings, proof.rows, proof.cols,
                        proof.proved ? "still infeasible" : proof.ended, checking.seconds());
           ++rep.proof_rechecks;
-          if (proof.proved)
+          if (proof.proved) {
+            rechecked = std::pair{proof.rows, proof.cols};
+            rechecked_same = proof.rows == region.rows && proof.cols == region.cols;
             throw LocalInfeasible(fmt::format("the matching LP is infeasible ({}'s ray on {} rows over the X faces "
                                               "within {} rings of its last local proof's)",
                                               ro.local_proof_solver, proof.rows, region.rings),
                                   proof.support, region.faces, region.rings);
+          }
         }
       }
       // The stuck rounding's fixings to 1 that go on here (stuck_carry): those off the faces just
@@ -1875,13 +1883,32 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
       carried_ones.clear();  // the widenings below start afresh
       if (!s) spdlog::info("level {}: {}", l + 1, e.what());  // (a proof, or rounding giving up: the line below does not say)
       const auto* local_proof = dynamic_cast<const LocalInfeasible*>(&e);
-      if (!s && ((local_proof && widen_region(local_proof->x_faces())) ||
-                 widen_at(m, proof, e.certified() ? "infeasible" : "probably infeasible (PDHG diverging)"))) {
+      // The region to check again before the next attempt's LP, whichever widening comes next:
+      // dropped, a proved-infeasible region let a 44.45 M-variable LP run for hours (TOSCA_r
+      // horse0-horse10, after the regional widening below).
+      std::optional<ProofRegion> keep_region;
+      if (local_proof)
+        keep_region = ProofRegion{local_proof->x_faces(), local_proof->rings(), rechecked ? rechecked->first : -1,
+                                  rechecked ? rechecked->second : -1};
+      // A recheck that found the region's relaxation as its last one did: the widening since
+      // (widen_at's place, around faces of the region at its cap) left it so and would again
+      // (measured, horse0-horse10: twelve rechecks on the same 1 488 311 rows and 5 198 111
+      // columns, ~90 s each, before the local widenings ran out). Only its own faces, or the
+      // wider widenings below, change it.
+      bool grew = false;
+      if (!s && local_proof) grew = widen_region(local_proof->x_faces());
+      if (!s && !grew && rechecked_same)
+        spdlog::info("level {}: the last local proof's region is as at its last recheck and its faces are at their "
+                     "cap (--proof-beyond) or the local widenings are spent: on to the wider widenings",
+                     l + 1);
+      else if (!s && !grew)
+        grew = widen_at(m, proof, e.certified() ? "infeasible" : "probably infeasible (PDHG diverging)");
+      if (grew) {
         // A suspicion that keeps coming back is checked: the next first LPs are watched patiently.
         // A proof restores the watch.
         if (e.certified()) {
           suspicions.proof();
-          if (local_proof) proof_region = ProofRegion{local_proof->x_faces(), local_proof->rings()};
+          if (keep_region) proof_region = std::move(keep_region);
           // The pre-test's proof stands in for the suspicion the watch would have raised on this
           // LP: the same margin, once per ring (zero_cost_proof_rings says why).
           if (dynamic_cast<const ZeroCostInfeasible*>(&e) && !zero_cost_margin_given &&
@@ -1933,17 +1960,28 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
         regional_done = true;
         if (widen_around(kRegionRings, "infeasible")) {
           spdlog::info("level {}: widened around all earlier local widenings ({} rings)", l + 1, kRegionRings);
+          if (keep_region) proof_region = std::move(keep_region);
           continue;
         }
       }
-      if (ring >= options_.max_ring) throw;
+      if (ring >= options_.max_ring) {
+        if (local_proof)
+          throw LocalInfeasible(fmt::format("{}; its faces at ring {} or past it and the ring at --max-ring {}: "
+                                            "--proof-beyond or --max-local-widenings may let it widen further",
+                                            e.what(), options_.max_ring + options_.proof_beyond, options_.max_ring),
+                                e.rows(), local_proof->x_faces(), local_proof->rings());
+        throw;
+      }
       ++rep.widenings;
       spdlog::warn("level {}: the reduced LP at ring {} is infeasible; widening to ring {}", l + 1, ring, ring + 1);
       ++ring;
       feasible_seen = false;
       zero_cost_margin_given = false;
       suspicion_margins = 0;
-      for (int& x : extra) x = std::max(0, std::min(x, options_.max_ring - ring));
+      // Every face at least at the new ring; one widened past it keeps its rings (a proved region's
+      // faces past --max-ring too: clamped to it, the region would be infeasible again).
+      for (int& x : extra) x = std::max({0, std::min(x, options_.max_ring - ring), x - 1});
+      if (keep_region) proof_region = std::move(keep_region);
     }
   }
   widened = std::move(extra);  // what the next level inherits
