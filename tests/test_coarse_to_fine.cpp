@@ -179,6 +179,38 @@ TEST_CASE("coarse to fine: the fine neighbourhood is smaller than eq. (17)'s, gr
   }
 }
 
+TEST_CASE("coarse to fine: a face keeps its reach on Y where the ring grows") {
+  // Every face with the same extra rings, so that the whole space shows one face's reach: the
+  // space after the ring step holds the space before it, for faces below max_ring and past it.
+  const Mesh m = lumpy_sphere(2, 4);
+  const MeshHierarchy h = build_hierarchy(m, {80, 320});
+  const MeshLevel& fine = h.levels[1];
+  const Mesh& coarse = h.levels[0].mesh;
+  const ProductSpace full = ProductSpace::full(fine.mesh, fine.mesh);
+  const auto id = identity_matching(coarse);
+  const int max_ring = 3;
+  for (int y_margin : {0, 1})
+    for (int ring : {1, 2, 3})
+      for (int extra : {0, 1, 2, 3, 5}) {
+        CAPTURE(y_margin);
+        CAPTURE(ring);
+        CAPTURE(extra);
+        const int after = extra_rings_after_ring_step(extra, ring, max_ring, Neighbourhood::Fine, y_margin);
+        CHECK(after >= 0);
+        CHECK(after <= extra);
+        const auto space = [&](int r, int e) {
+          return full_indices(full, reduced_product_space(fine, fine, coarse, coarse, id, r, Neighbourhood::Fine,
+                                                          std::vector<int>(fine.mesh.num_faces(), e), y_margin));
+        };
+        const auto before = space(ring - 1, extra), now = space(ring, after);
+        CHECK(std::includes(now.begin(), now.end(), before.begin(), before.end()));
+      }
+  // On the coarse neighbourhood the ring is a coarse one: the extra rings past max_ring all kept.
+  CHECK(extra_rings_after_ring_step(5, 2, max_ring, Neighbourhood::Coarse) == 5);
+  CHECK(extra_rings_after_ring_step(2, 2, max_ring, Neighbourhood::Coarse) == 2);
+  CHECK(extra_rings_after_ring_step(1, 2, max_ring, Neighbourhood::Coarse) == 1);
+}
+
 TEST_CASE("coarse to fine: a shape against itself is matched to the identity at every level") {
   const Mesh m = lumpy_sphere(2, 5);
   CoarseToFineOptions o;

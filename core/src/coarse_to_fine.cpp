@@ -527,6 +527,15 @@ void accept(const MatchingLp& m, const RoundingResult& rr, LevelReport& rep, std
 
 }  // namespace
 
+int extra_rings_after_ring_step(int extra, int ring, int max_ring, Neighbourhood neighbourhood, int y_margin) {
+  // The fine rings on Y a face has at r before its extra rings (reduced_product_space); on the
+  // coarse neighbourhood the ring is a coarse one, counted as none (the extra rings all kept).
+  auto base = [&](int r) {
+    return neighbourhood == Neighbourhood::Fine && r > 0 ? std::max(1, r - 1) + std::max(0, y_margin) : 0;
+  };
+  return std::max({0, std::min(extra, max_ring - ring), extra - (base(ring) - base(ring - 1))});
+}
+
 CoarseToFineMatcher::CoarseToFineMatcher(const Mesh& x, const Mesh& y, CoarseToFineOptions options)
     : options_(std::move(options)) {
   if (options_.ring < 0 || options_.max_ring < options_.ring)
@@ -1183,7 +1192,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
   // A first LP at this level was feasible: every later attempt's space contains its space (a
   // widening only adds columns, and the rows it adds are those of new product edges, all of whose
   // columns are new), so it is feasible too, and the zero-cost pre-test would only cost. (Not
-  // after the ring grows: the extra rings beyond max_ring are cut back there.)
+  // after the ring grows: the extra rings of faces below max_ring are cut back there.)
   bool feasible_seen = false;
   // A checkpointed attempt's first LP under way (LevelAttempt::solving): the first attempt here
   // starts it where it was, `solving_done` iterations in.
@@ -1965,11 +1974,18 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
         }
       }
       if (ring >= options_.max_ring) {
-        if (local_proof)
-          throw LocalInfeasible(fmt::format("{}; its faces at ring {} or past it and the ring at --max-ring {}: "
-                                            "--proof-beyond or --max-local-widenings may let it widen further",
-                                            e.what(), options_.max_ring + options_.proof_beyond, options_.max_ring),
-                                e.rows(), local_proof->x_faces(), local_proof->rings());
+        if (local_proof) {
+          const bool capped = std::all_of(local_proof->x_faces().begin(), local_proof->x_faces().end(), [&](int f) {
+            return ring + extra[f] >= options_.max_ring + options_.proof_beyond;
+          });
+          throw LocalInfeasible(
+              fmt::format("{}; the ring at --max-ring {} and {}", e.what(), options_.max_ring,
+                          capped ? fmt::format("the region's faces at ring {} (--proof-beyond {})",
+                                               options_.max_ring + options_.proof_beyond, options_.proof_beyond)
+                                 : fmt::format("the local widenings spent (--max-local-widenings {})",
+                                               options_.max_local_widenings)),
+              e.rows(), local_proof->x_faces(), local_proof->rings());
+        }
         throw;
       }
       ++rep.widenings;
@@ -1978,9 +1994,10 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
       feasible_seen = false;
       zero_cost_margin_given = false;
       suspicion_margins = 0;
-      // Every face at least at the new ring; one widened past it keeps its rings (a proved region's
-      // faces past --max-ring too: clamped to it, the region would be infeasible again).
-      for (int& x : extra) x = std::max({0, std::min(x, options_.max_ring - ring), x - 1});
+      // Every face at least at the new ring; one widened past it keeps its reach on Y (a proved
+      // region's faces past --max-ring too: cut back to it, the region would be infeasible again).
+      for (int& x : extra)
+        x = extra_rings_after_ring_step(x, ring, options_.max_ring, options_.neighbourhood, options_.y_margin);
       if (keep_region) proof_region = std::move(keep_region);
     }
   }

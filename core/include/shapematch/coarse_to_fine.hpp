@@ -425,6 +425,13 @@ std::vector<ProductTriangle> reduced_product_space(const MeshLevel& fine_x, cons
                                                    Neighbourhood neighbourhood,
                                                    const std::vector<int>& extra_rings = {}, int y_margin = 0);
 
+// The extra rings a fine X face keeps where the reduced space's ring grows from ring − 1 to `ring`
+// (coarse to fine's ring widening): its extra rings on top of the new ring up to `max_ring`, and
+// at least its reach on Y as reduced_product_space gives it (on the fine neighbourhood ring 1 and
+// ring 2 reach alike: a face widened past max_ring, cut back to it, would lose what a proof there
+// needed).
+int extra_rings_after_ring_step(int extra, int ring, int max_ring, Neighbourhood neighbourhood, int y_margin = 0);
+
 // The product triangles of x × y each of whose corners (a, b) has b within `rings` edges of
 // image[a] (one entry per vertex of x; -1: any b). At rings 0 with the identity as image, the
 // identity matching (and degenerate triangles never qualify there: their corners repeat on one
