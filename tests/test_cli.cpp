@@ -978,6 +978,8 @@ TEST_CASE("cli: checkpoint --keep-levels drops the attempt of the level in progr
     p.attempt.proof_faces = {1, 3};
     p.attempt.proof_rings = 1;
     p.attempt.report.proof_rechecks = 4;
+    p.attempt.proof_rows = 12;
+    p.attempt.proof_cols = 34;
     const std::string region = (tmp.path / "region.ckpt").string();
     shapematch::save_checkpoint(region, p);
     const Run q = run("checkpoint " + region);
@@ -985,6 +987,8 @@ TEST_CASE("cli: checkpoint --keep-levels drops the attempt of the level in progr
     CHECK(q.out.find("\"faces\": 2") != std::string::npos);
     CHECK(q.out.find("\"rings\": 1") != std::string::npos);
     CHECK(q.out.find("\"proof_rechecks\": 4") != std::string::npos);
+    CHECK(q.out.find("\"rechecked_rows\": 12") != std::string::npos);
+    CHECK(q.out.find("\"rechecked_columns\": 34") != std::string::npos);
   }
   const std::string two = (tmp.path / "two.ckpt").string(), one = (tmp.path / "one.ckpt").string();
   r = run("checkpoint " + ckpt + " --keep-levels 2 --out " + two);

@@ -1763,8 +1763,23 @@ TEST_CASE("coarse to fine: a run gone on from an attempt of a level in progress 
     const LevelCheckpoint back = load_checkpoint(other);
     CHECK(back.attempt.proof_faces == given.attempt.proof_faces);
     CHECK(back.attempt.proof_rings == 2);
+    CHECK(back.attempt.proof_rows == -1);  // (not rechecked yet)
     CHECK(back.attempt.report.proof_rechecks == 5);
     CHECK(back.attempt.extra == a.extra);
+    given.attempt.proof_rows = 1'488'311;  // (its size at its last recheck, version 20, not 19)
+    given.attempt.proof_cols = 5'198'111;
+    save_checkpoint(other, given);
+    CHECK(load_checkpoint(other).attempt.proof_rows == 1'488'311);
+    CHECK(load_checkpoint(other).attempt.proof_cols == 5'198'111);
+    CHECK(load_checkpoint(other).attempt.proof_faces == given.attempt.proof_faces);
+    detail::save_checkpoint_as(other, given, 19);
+    CHECK(load_checkpoint(other).attempt.proof_rows == -1);
+    CHECK(load_checkpoint(other).attempt.proof_cols == -1);
+    CHECK(load_checkpoint(other).attempt.proof_faces == given.attempt.proof_faces);
+    given.attempt.proof_cols = -1;  // (one without the other: refused)
+    save_checkpoint(other, given);
+    CHECK_THROWS_AS(load_checkpoint(other), IoError);
+    given.attempt.proof_rows = given.attempt.proof_cols = -1;
     given.attempt.proof_rings = 65;  // (more than a proof grows: refused, as a negative face is)
     save_checkpoint(other, given);
     CHECK_THROWS_AS(load_checkpoint(other), IoError);
@@ -1928,7 +1943,7 @@ TEST_CASE("coarse to fine: a run gone on from an attempt of a level in progress 
     bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
   }
   const size_t at = std::string("shapematch level checkpoint\n").size();
-  REQUIRE(bytes[at] == 19);
+  REQUIRE(bytes[at] == 20);
   {  // The checksum (version 18 on): any byte changed, or the file cut short, is refused as damaged.
     auto refused = [&](const std::string& damaged) {
       std::ofstream(file, std::ios::binary) << damaged;
@@ -1966,7 +1981,7 @@ TEST_CASE("coarse to fine: a run gone on from an attempt of a level in progress 
     detail::save_checkpoint_as(file, marked, 17);
     CHECK(load_checkpoint(file).levels.back().gamma == marked.levels.back().gamma);
   }
-  bytes[at] = 20;  // a later version than this build's
+  bytes[at] = 21;  // a later version than this build's
   std::ofstream(file, std::ios::binary) << bytes;
   CHECK_THROWS_AS(load_checkpoint(file), IoError);
   {  // The fifteenth: a carried start's rounding without a bound (NaN); the fourteenth has 15's layout.
@@ -1997,7 +2012,7 @@ TEST_CASE("coarse to fine: a run gone on from an attempt of a level in progress 
   CHECK(v3.attempt.report.widened_faces == a.report.widened_faces);
   CHECK(v3.attempt.report.stuck_restarts == 0);
   CHECK(v3.levels.back().gamma == last.levels.back().gamma);
-  CHECK_THROWS_AS(detail::save_checkpoint_as(file, marked, 20), InvalidInputError);
+  CHECK_THROWS_AS(detail::save_checkpoint_as(file, marked, 21), InvalidInputError);
 }
 
 // The saves of a run made inside the first LP of level `level` (lp_checkpoint_seconds).

@@ -40,7 +40,8 @@ constexpr char kMagic[] = "shapematch level checkpoint\n";
 // 19: an LP under way's whole state (LevelAttempt::solving_state: a flag, then write_state's
 // layout) follows its watch. (As 672ff1a wrote it, without the device, it is refused: only that
 // commit's binaries, within the eighty-ninth session, wrote it.)
-constexpr uint32_t kVersion = 19;
+// 20: the local proof region's size at its last recheck (proof_rows, proof_cols) follows its rings.
+constexpr uint32_t kVersion = 20;
 constexpr uint32_t kFirstChecksummed = 18;
 // More rings than a local proof's region grows (RoundingOptions::local_proof_depth).
 constexpr int kMaxProofRings = 64;
@@ -318,6 +319,7 @@ void write_attempt(Writer& w, const LevelAttempt& a, uint32_t version) {
   if (version >= 9) w(a.zero_cost_margin_given);
   if (version >= 11) w(a.suspicion_margins);
   if (version >= 17) w.array(a.proof_faces), w(a.proof_rings);
+  if (version >= 20) w(a.proof_rows), w(a.proof_cols);
   each_field(a.report, w, version);
   w.array(a.extra);
   if (version < 3) return;
@@ -360,6 +362,7 @@ void read_attempt(Reader& r, LevelAttempt& a, uint32_t version, const std::strin
   if (version >= 9) r(a.zero_cost_margin_given);
   if (version >= 11) r(a.suspicion_margins);
   if (version >= 17) r.array(a.proof_faces), r(a.proof_rings);
+  if (version >= 20) r(a.proof_rows), r(a.proof_cols);
   each_field(a.report, r, version);
   r.array(a.extra);
   LevelAttempt::Rounding& g = a.rounding;
@@ -384,6 +387,9 @@ void read_attempt(Reader& r, LevelAttempt& a, uint32_t version, const std::strin
                   " rings out)");
   if (std::any_of(a.proof_faces.begin(), a.proof_faces.end(), [](int f) { return f < 0; }))
     throw IoError(path + ": not a shapematch checkpoint (a local proof's region on a negative face)");
+  if (a.proof_rows < -1 || a.proof_cols < -1 || (a.proof_rows < 0) != (a.proof_cols < 0))
+    throw IoError(path + ": not a shapematch checkpoint (a local proof's region of " + std::to_string(a.proof_rows) +
+                  " rows and " + std::to_string(a.proof_cols) + " columns)");
   if (version < 13) return;
   bool priced = false, solving = false;
   r(priced);

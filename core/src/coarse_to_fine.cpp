@@ -1155,7 +1155,7 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
     // (A region with faces past this level's is another run's: left out, its LP is solved.)
     const std::vector<int>& pf = resume->proof_faces;
     if (!pf.empty() && std::all_of(pf.begin(), pf.end(), [&](int f) { return f < lx.mesh.num_faces(); }))
-      proof_region = ProofRegion{pf, resume->proof_rings};
+      proof_region = ProofRegion{pf, resume->proof_rings, resume->proof_rows, resume->proof_cols};
     spdlog::info("level {}: going on from its checkpointed attempt: ring {}, {} faces with extra rings{}", l + 1, ring,
                  std::count_if(extra.begin(), extra.end(), [](int e) { return e > 0; }),
                  resume->rounding.empty() ? std::string()
@@ -1361,6 +1361,8 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
     if (proof_region) {
       a.proof_faces = proof_region->faces;
       a.proof_rings = proof_region->rings;
+      a.proof_rows = proof_region->rows;
+      a.proof_cols = proof_region->cols;
     }
     if (price_warm) {  // (the re-solve after a pricing, about to start)
       a.priced_from = priced_from;

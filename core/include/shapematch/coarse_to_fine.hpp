@@ -539,6 +539,9 @@ struct LevelAttempt {
   // attempt checks again before its LP (version 17; before, none: its LP was solved). Empty: none.
   std::vector<int> proof_faces;
   int proof_rings = 0;
+  // Its relaxation's rows and columns at its last recheck (version 20; -1: none yet): a recheck of
+  // the same size after a widening elsewhere goes on to the wider widenings (solve_refined).
+  int64_t proof_rows = -1, proof_cols = -1;
   // Where the attempt is the re-solve after a pricing widened the space: the iterate it starts
   // from (the priced LP's), and the cold first LP's iterations and seconds, which cap it and scale
   // its rounding (version 13; before, a run gone on from here solved it cold: TOSCA_r
