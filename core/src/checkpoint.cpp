@@ -387,7 +387,8 @@ void read_attempt(Reader& r, LevelAttempt& a, uint32_t version, const std::strin
                   " rings out)");
   if (std::any_of(a.proof_faces.begin(), a.proof_faces.end(), [](int f) { return f < 0; }))
     throw IoError(path + ": not a shapematch checkpoint (a local proof's region on a negative face)");
-  if (a.proof_rows < -1 || a.proof_cols < -1 || (a.proof_rows < 0) != (a.proof_cols < 0))
+  if (a.proof_rows < -1 || a.proof_cols < -1 || (a.proof_rows < 0) != (a.proof_cols < 0) ||
+      (a.proof_rows >= 0 && a.proof_faces.empty()))
     throw IoError(path + ": not a shapematch checkpoint (a local proof's region of " + std::to_string(a.proof_rows) +
                   " rows and " + std::to_string(a.proof_cols) + " columns)");
   if (version < 13) return;

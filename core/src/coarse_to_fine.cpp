@@ -1191,8 +1191,9 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
   bool price_warm = false;
   // A first LP at this level was feasible: every later attempt's space contains its space (a
   // widening only adds columns, and the rows it adds are those of new product edges, all of whose
-  // columns are new), so it is feasible too, and the zero-cost pre-test would only cost. (Not
-  // after the ring grows: the extra rings of faces below max_ring are cut back there.)
+  // columns are new), so it is feasible too, and the zero-cost pre-test would only cost. (Reset
+  // where the ring grows all the same, though extra_rings_after_ring_step now keeps each face's
+  // reach there: the pre-test costs little next to that space's LP.)
   bool feasible_seen = false;
   // A checkpointed attempt's first LP under way (LevelAttempt::solving): the first attempt here
   // starts it where it was, `solving_done` iterations in.

@@ -429,7 +429,7 @@ std::vector<ProductTriangle> reduced_product_space(const MeshLevel& fine_x, cons
 // (coarse to fine's ring widening): its extra rings on top of the new ring up to `max_ring`, and
 // at least its reach on Y as reduced_product_space gives it (on the fine neighbourhood ring 1 and
 // ring 2 reach alike: a face widened past max_ring, cut back to it, would lose what a proof there
-// needed).
+// needed). On the coarse neighbourhood, whose ring is a coarse one, every extra ring is kept.
 int extra_rings_after_ring_step(int extra, int ring, int max_ring, Neighbourhood neighbourhood, int y_margin = 0);
 
 // The product triangles of x × y each of whose corners (a, b) has b within `rings` edges of
