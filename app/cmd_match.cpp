@@ -626,13 +626,17 @@ int run_match(const MatchArgs& args) {
   const CoarseToFineResult c2f = stoppable(args.checkpoint, [&] { return matcher.run([&](const LevelReport& level, const RoundingRound& r) {
     const std::string at = matcher.x_levels().size() > 1 ? fmt::format("level {} ", level.level + 1) : std::string();
     const std::string parts = r.parts > 1 ? fmt::format(" in {} parts", r.parts) : std::string();
+    // A release around a part: how much of what was fixed it freed, and how far it reached.
+    const std::string around = r.release_depth > 0 ? fmt::format("released {} of {} fixings within {} LP steps around",
+                                                                 r.released, r.release_pool, r.release_depth)
+                                                   : fmt::format("released {} fixings around", r.released);
     if (r.search) {  // a search round (RoundingOptions::search_below)
       spdlog::info("{}round {:>2}: {:>9} variables{}, searched: {} parts finished in {} nodes, net fixed {} to 1 and "
                    "{} to 0{} ({:.2f} s)",
                    at, r.round, r.variables, parts, r.searched_parts, r.iterations, r.fixed_to_one, r.fixed_to_zero,
                    r.search_proof_released > 0
                        ? fmt::format(", released {} fixings that the proofs of the rest rest on", r.released)
-                   : r.released > 0 ? fmt::format(", released {} fixings around the rest", r.released)
+                   : r.released > 0 ? fmt::format(", {} the rest", around)
                                     : std::string(),
                    r.seconds);
       return;
@@ -646,9 +650,7 @@ int run_match(const MatchArgs& args) {
         r.certificate_released > 0
             ? fmt::format(" (its proof survives undoing the last fixing: released {} fixings that carry it)",
                           r.certificate_released)
-        : r.released > 0 ? fmt::format(" (a part failed away from the last fixing or again after trims: released {} "
-                                     "fixings around it)",
-                                     r.released)
+        : r.released > 0 ? fmt::format(" (a part failed away from the last fixing or again after trims: {} it)", around)
         : r.undone     ? std::string(" (undone: fixed fewer)")
                        : std::string();
     const std::string zero_cost =
@@ -766,6 +768,8 @@ int run_match(const MatchArgs& args) {
                       .set("search", r.search)
                       .set("searched_parts", r.searched_parts)
                       .set("released", r.released)
+                      .set("release_depth", r.release_depth)
+                      .set("release_pool", r.release_pool)
                       .set("certificate_released", r.certificate_released)
                       .set("search_proof_released", r.search_proof_released)
                       .set("seconds", r.seconds));

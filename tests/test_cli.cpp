@@ -281,6 +281,9 @@ TEST_CASE("cli: match writes a verified, complete output directory, or nothing")
   CHECK(report.find("\"verified\": true") != std::string::npos);
   CHECK(json_number(report, "energy") >= json_number(report, "lower_bound") - 1e-9);
   CHECK(json_number(report, "rounds") >= 1);
+  // Every round's log says how far a release around a part reached, and of how many fixings.
+  CHECK(json_number(report, "release_depth") >= 0.0);
+  CHECK(json_number(report, "release_pool") >= 0.0);
   const double vx = json_number(report, "vertices");  // X's first
   auto count_lines = [](const fs::path& p) {
     std::ifstream in(p);

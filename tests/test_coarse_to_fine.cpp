@@ -2138,8 +2138,10 @@ TEST_CASE("coarse to fine: a run gone on from inside a refined level's first LP 
     const LevelCheckpoint from = load_checkpoint(file);
     const CoarseToFineResult r = matcher.run(at_finest(rest), &from);  // (no checkpointing: no saves)
     REQUIRE(rest.size() == 1);
-    MESSAGE("first LP: ", firsts[0], " iterations whole, ", before, " before the save and ", rest[0], " after it");
-    CHECK(rest[0] == firsts[0] - before);  // the rest of it, exactly
+    // (Round 1 is reported with the iterations before the save: the LP's whole count.)
+    MESSAGE("first LP: ", firsts[0], " iterations whole, ", before, " before the save and ", rest[0] - before,
+            " after it");
+    CHECK(rest[0] == firsts[0]);  // the rest of it, exactly
     const LevelReport& f = r.levels.back();
     CHECK(f.iterations == whole.levels.back().iterations);  // the report counts those before the save too
     CHECK(check_graph_surface(r.finest.space, r.rounding.gamma).ok());
@@ -2152,10 +2154,11 @@ TEST_CASE("coarse to fine: a run gone on from inside a refined level's first LP 
     std::vector<int64_t> rest18;
     const CoarseToFineResult r18 = matcher.run(at_finest(rest18), &v18);
     REQUIRE(rest18.size() == 1);
-    MESSAGE("from the iterate alone: ", rest18[0], " iterations after it");
-    CHECK(rest18[0] < firsts[0]);
-    CHECK(rest18[0] <= firsts[0] - before / 2);  // (it goes on, not from zero)
-    CHECK(r18.levels.back().iterations >= rest18[0] + before);
+    const int64_t after18 = rest18[0] - before;  // (reported with those before the save)
+    MESSAGE("from the iterate alone: ", after18, " iterations after it");
+    CHECK(after18 < firsts[0]);
+    CHECK(after18 <= firsts[0] - before / 2);  // (it goes on, not from zero)
+    CHECK(r18.levels.back().iterations >= rest18[0]);
     CHECK(check_graph_surface(r18.finest.space, r18.rounding.gamma).ok());
     CHECK(r18.levels.back().energy == doctest::Approx(whole.levels.back().energy).epsilon(0.05));
   }
@@ -2181,8 +2184,8 @@ TEST_CASE("coarse to fine: a run gone on from inside a refined level's first LP 
     REQUIRE(exact_rest.size() == 1);
     REQUIRE(plain_rest.size() == 1);
     MESSAGE("longer first LP: ", lfirst[0], " iterations whole, ", mid.attempt.solving_iterations,
-            " before the save, after it ", exact_rest[0], " from its state, ", plain_rest[0], " from its iterate");
-    CHECK(exact_rest[0] == lfirst[0] - mid.attempt.solving_iterations);
+            " before the save, in all ", exact_rest[0], " from its state, ", plain_rest[0], " from its iterate");
+    CHECK(exact_rest[0] == lfirst[0]);  // (those before the save and the rest, exactly)
     CHECK(re.rounding.gamma == lwhole.rounding.gamma);
     CHECK(re.levels.back().energy == lwhole.levels.back().energy);
     CHECK(re.levels.back().lower_bound == lwhole.levels.back().lower_bound);  // (its LP's bound, bit for bit)
@@ -2852,9 +2855,12 @@ TEST_CASE("coarse to fine: a rounding's round under way is saved as its warm sta
     const LevelCheckpoint loaded = load_checkpoint(file);
     REQUIRE_FALSE(loaded.attempt.rounding.warm.empty());
     iterations = -1;
+    int first_shown = -1;
     const CoarseToFineResult r = matcher.run([&](const LevelReport& l, const RoundingRound& q) {
-      if (l.level == levels - 1 && iterations < 0) iterations = q.iterations;
+      if (l.level == levels - 1 && iterations < 0) iterations = q.iterations, first_shown = q.round;
     }, &loaded);
+    // Its rounds are reported as the level's: on from the checkpoint's, not from 1 again.
+    CHECK(first_shown == from.attempt.rounding.rounds + 1);
     // (Theorem 1's conditions; on this pair at ring 0 with every round on PDHG the whole run's Γ
     // is not continuous either.)
     CHECK(satisfies_exactly(r.finest.lp, r.rounding.gamma));

@@ -1359,6 +1359,8 @@ TEST_CASE("rounding: a stalled remainder is finished by search, releasing the fi
   CHECK(r.rounds[1].search);
   CHECK(!r.rounds[0].search);
   CHECK(r.rounds[1].released == 1);       // a again free
+  CHECK(r.rounds[1].search_proof_released == 1);  // by the search's proofs:
+  CHECK(r.rounds[1].release_depth == 0);          // no reach around the part
   CHECK(r.rounds[1].fixed_to_one == -1);
   CHECK(r.rounds[2].variables == 5);
   CHECK(r.rounds[2].searched_parts == 1);
@@ -1406,6 +1408,9 @@ TEST_CASE("rounding: the rounds after a search released fixings are not counted 
   REQUIRE(seen.size() == 3);  // round 4 threw before reporting
   CHECK(seen[1].search);
   CHECK(seen[1].released == 1);
+  CHECK(seen[1].release_depth == 2);  // around the part (not by proofs): the first reach, 2 LP steps
+  CHECK(seen[1].release_pool == 1);   // of the one fixing made
+  CHECK(seen[0].release_depth == 0);
   CHECK(!seen[2].search);
   CHECK(seen[2].variables == 5);
   CHECK(seen[2].fixed_to_one == 1);
@@ -2059,6 +2064,9 @@ TEST_CASE("rounding: a part failing again after a trim releases the fixings arou
   CHECK(r.rounds[0].released == 0);  // a trim
   CHECK(r.rounds[1].status == LpStatus::Infeasible);
   CHECK(r.rounds[1].released == 1);  // cB; around the whole part: cB and c3
+  CHECK(r.rounds[1].release_pool == 2);  // of cB and c3 (cA trimmed)
+  CHECK(r.rounds[1].release_depth == 2);
+  CHECK(r.rounds[0].release_depth == 0);  // (a trim releases nothing around)
   CHECK(r.rounds[1].fixed_to_one == -1);
   CHECK(r.rounds[2].status != LpStatus::Infeasible);
   auto in_gamma = [&](int64_t j) { return std::find(r.gamma.begin(), r.gamma.end(), j) != r.gamma.end(); };

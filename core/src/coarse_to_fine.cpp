@@ -1779,7 +1779,17 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
                                                      reference_iterations = cold_iterations;
                                                      reference_seconds = cold_seconds;
                                                    }
-                                                   if (progress) progress(rep, r);
+                                                   if (progress) {
+                                                     // Reported as the level's rounds and round 1's whole LP:
+                                                     // a run gone on from a checkpoint counts on from it.
+                                                     RoundingRound shown = r;
+                                                     if (going_on) shown.round += going_on->rounds;
+                                                     if (from_solving && r.round == 1) {
+                                                       shown.iterations += solving_done;
+                                                       shown.seconds += solving_seconds;
+                                                     }
+                                                     progress(rep, shown);
+                                                   }
                                                    if (pricing && !probing && r.round == 1) {
                                                      if (r.status == LpStatus::Optimal &&
                                                          first_y.size() == size_t(m.lp.rows()) && price_and_widen(m))

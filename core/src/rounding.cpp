@@ -1742,7 +1742,7 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
       for (uint32_t k = lp.a.row_ptr[i]; k < lp.a.row_ptr[i + 1]; ++k) cols.push_back(col_of(lp.a.entry[k]));
     return cols;
   };
-  auto release_around = [&](const std::vector<int64_t>& rows, bool refute) -> int64_t {
+  auto release_around = [&](const std::vector<int64_t>& rows, bool refute, RoundingRound& info) -> int64_t {
     std::vector<int64_t> cols = columns_of(rows);
     const bool again = reach.same_part(cols);
     // (Before the count: a capped part uses up no release.)
@@ -1782,9 +1782,9 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
         rest.batch = shrink_and_fix(fixer, kept, rest.mark, true);
         history.push_back(std::move(rest));
       }
-      spdlog::debug("rounding: released {} fixings within {} steps of the part",
-                    all - static_cast<int64_t>(kept.size()), depth);
       reach.released(std::move(cols), depth);
+      info.release_depth = depth;
+      info.release_pool = all;
       return all - static_cast<int64_t>(kept.size());
     }
     throw InfeasibleError("rounding: no binary solution around a part, and no fixing near it",
@@ -2167,7 +2167,7 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
         spdlog::debug("rounding: released {} fixings that {} of the search's {} proofs rest on", info.released, used,
                       stuck_proofs.size());
       } else {
-        info.released = release_around(stuck, false);
+        info.released = release_around(stuck, false, info);
       }
     }
     info.fixed_to_one = fixer.state().ones - ones;
@@ -2669,7 +2669,7 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
         spdlog::debug("round {}: a part failed {} ({} rows, the proof {}): releasing the fixings around it", round,
                       touched == 0 ? "away from the last fixing" : "again after a trim", failed.size(),
                       proof_rows.size());
-        info.released = release_around(around, true);
+        info.released = release_around(around, true, info);
         throw_if_reach_capped();
         info.fixed_to_one = fixer.state().ones - ones;
         info.fixed_to_zero = fixer.state().zeros - zeros;
