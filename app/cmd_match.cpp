@@ -749,10 +749,12 @@ int run_match(const MatchArgs& args) {
     seconds.set("output", stage.seconds());
     seconds.set("total", total.seconds());
 
+    // Numbered as the log numbers them: on from the rounds before a checkpoint or stuck restart.
+    const int64_t rounds_before = std::max<int64_t>(0, finest_rounds - static_cast<int64_t>(rr.rounds.size()));
     Json rounds = Json::array();
     for (const auto& r : rr.rounds)
       rounds.push(Json::object()
-                      .set("round", r.round)
+                      .set("round", r.round + rounds_before)
                       .set("variables", r.variables)
                       .set("constraints", r.constraints)
                       .set("status", to_string(r.status))
@@ -793,7 +795,7 @@ int run_match(const MatchArgs& args) {
     report.set("first_lp_objective", rr.first_lp.objective).set("first_lp_status", to_string(rr.first_lp.status));
     report.set("rounds", finest_rounds);
     // (first_lp_* and the log per round then describe the rounds after the checkpoint or restart.)
-    report.set("rounds_before_checkpoint", finest_rounds - static_cast<int64_t>(rr.rounds.size()));
+    report.set("rounds_before_checkpoint", rounds_before);
     report.set("verified", true);
     report.set("theorem1", Json::object()
                                .set("covers_x", theorem.covers_x)

@@ -1782,6 +1782,8 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
         rest.batch = shrink_and_fix(fixer, kept, rest.mark, true);
         history.push_back(std::move(rest));
       }
+      spdlog::debug("rounding: released {} of {} fixings within {} steps of the part",
+                    all - static_cast<int64_t>(kept.size()), all, depth);
       reach.released(std::move(cols), depth);
       info.release_depth = depth;
       info.release_pool = all;

@@ -674,9 +674,10 @@ public:
   // `checkpoint`: called after every level that can be a checkpoint, before each later attempt
   // of the level after it, and after that attempt's rounds (at most every
   // rounding_checkpoint_seconds).
-  // `progress`: after every round, numbered as the level's rounds (gone on from a rounding's
-  // checkpoint after round k, the first is k + 1); round 1 gone on from inside its first LP counts
-  // that LP's iterations and seconds before the save too.
+  // `progress`: after every round of a level's attempt, numbered on from the rounds before a
+  // rounding checkpoint it went on from or a stuck restart (after round k, the first is k + 1;
+  // the second start's own rounding counts from 1); round 1 gone on from inside its first LP
+  // counts that LP's iterations and seconds before the save too.
   CoarseToFineResult run(const Progress& progress = {}, const LevelCheckpoint* resume = nullptr,
                          const Checkpointing& checkpoint = {}) const;
   // A hash of both hierarchies (every level's faces and input vertices): equal for equal inputs
