@@ -443,7 +443,7 @@ struct RoundingRound {
                                // or around a failed part no fixing of the last round touched
   // Of a release around a part (released, not by proofs): how far it reached, in LP steps, and
   // the fixings made before it. A far release frees most of them (TOSCA_r cat2-cat9 without WKS at
-  // full resolution: 8 830 after 390, 280 and 950 around the same remainder); the log says so.
+  // full resolution: 8 830, after releases of 390, 280 and 950 in its end game); the log says so.
   int release_depth = 0;
   int64_t release_pool = 0;
   int64_t search_proof_released = 0;  // fixings released that a search's proofs rest on
