@@ -3127,6 +3127,9 @@ TEST_CASE("rounding: a local proof of infeasibility is found where the clash lie
   CHECK(std::string(capped.ended) == "column cap");
   CHECK(capped.depth == 1);
   CHECK(capped.cols == 4);
+  CHECK(capped.capped_rows == 5);  // (depth 2's, rows 0-4 on x0..x5: not solved)
+  CHECK(capped.capped_cols == 6);
+  CHECK(p.capped_cols == 0);
   // Without row 11 the chain is feasible: no proof, however far out.
   a.pop_back();
   b.pop_back();
@@ -3272,8 +3275,12 @@ TEST_CASE("rounding: a local proof over an X region certifies a matching LP's cl
   const detail::LocalProof feasible = detail::proof_over_x_region(m.space, m.lp, {}, seeds, p.depth, 1'000'000, *clp, 600.0);
   CHECK_FALSE(feasible.proved);
   CHECK(std::string(feasible.ended) == "feasible");
-  CHECK(std::string(detail::proof_over_x_region(m.space, clash, {}, seeds, p.depth, 5, *clp, 600.0).ended) ==
-        "column cap");
+  const detail::LocalProof over = detail::proof_over_x_region(m.space, clash, {}, seeds, p.depth, 5, *clp, 600.0);
+  CHECK(std::string(over.ended) == "column cap");
+  CHECK(over.depth == -1);  // (nothing solved, so its size is the capped one's)
+  CHECK(over.rows == 0);
+  CHECK(over.capped_rows == p.rows);
+  CHECK(over.capped_cols == p.cols);
 }
 
 TEST_CASE("rounding: the X faces of stalled rows: where their iterate lies, else all their columns'") {

@@ -1494,10 +1494,13 @@ void CoarseToFineMatcher::solve_refined(int l, const EnergyModel& model, LevelRe
           const detail::LocalProof proof =
               detail::proof_over_x_region(m.space, m.lp, {}, region.faces, region.rings, ro.local_proof_columns,
                                           *solver, ro.local_proof_seconds);
+          // (At the column cap nothing was solved: the size that passed it.)
+          const bool capped = proof.capped_cols > 0;
           spdlog::info("level {}: the last local proof's region ({} X faces, {} rings out: {} rows, {} columns) "
-                       "checked again before its LP: {} ({:.2f} s)",
-                       l + 1, region.faces.size(), region.rings, proof.rows, proof.cols,
-                       proof.proved ? "still infeasible" : proof.ended, checking.seconds());
+                       "checked again before its LP: {}{} ({:.2f} s)",
+                       l + 1, region.faces.size(), region.rings, capped ? proof.capped_rows : proof.rows,
+                       capped ? proof.capped_cols : proof.cols, proof.proved ? "still infeasible" : proof.ended,
+                       capped ? fmt::format(" of {}", ro.local_proof_columns) : "", checking.seconds());
           ++rep.proof_rechecks;
           if (proof.proved) {
             rechecked = std::pair{proof.rows, proof.cols};

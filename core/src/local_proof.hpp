@@ -26,6 +26,9 @@ struct LocalProof {
   const char* ended = "no rows";
   int depth = -1;                // of the last relaxation solved (-1: none)
   int64_t rows = 0, cols = 0;    // its size
+  // "column cap": the size of the relaxation that passed the cap (not solved; 0 otherwise), so a
+  // log can say how far past it the region had grown.
+  int64_t capped_rows = 0, capped_cols = 0;
   std::vector<int64_t> support;  // proved: the rows of `lp` the ray needs, increasing
   // Its value on each: a ray of the relaxation. Where nothing was merged it is one of `lp` itself
   // (zero elsewhere); where a merged row has a positive value it is not (each merged column counts
@@ -162,6 +165,8 @@ LocalProof local_infeasibility_on(const LpProblem& lp, RowsAt&& rows_at, int max
     const int64_t cols = static_cast<int64_t>(relaxed.cols.size() + relaxed.slack_rows.size());
     if (cols > max_cols) {  // (before building it)
       p.ended = "column cap";
+      p.capped_rows = static_cast<int64_t>(keep.size());
+      p.capped_cols = cols;
       break;
     }
     build_relaxation(lp, keep, relaxed);

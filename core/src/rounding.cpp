@@ -2592,8 +2592,12 @@ RoundingResult round_once(const ProductSpace& space, const LpProblem& lp, const 
                                            options.local_proof_columns, *local_solver, options.local_proof_seconds, true);
         for (int64_t& i : proof.support) i = red.rows[i];
         spdlog::debug("rounding: local proof near the stalled rows ({} X faces): {}; last solved {} rings out, {} rows and "
-                      "{} columns ({:.2f} s)",
-                      seed_faces.size(), proof.ended, proof.depth, proof.rows, proof.cols, local_clock.seconds());
+                      "{} columns{} ({:.2f} s)",
+                      seed_faces.size(), proof.ended, proof.depth, proof.rows, proof.cols,
+                      proof.capped_cols > 0 ? fmt::format("; the next, {} rows and {} columns, past the cap",
+                                                          proof.capped_rows, proof.capped_cols)
+                                            : "",
+                      local_clock.seconds());
         if (proof.proved) {
           spdlog::debug("rounding: its Farkas ray needs {} rows", proof.support.size());
           throw LocalInfeasible(fmt::format("rounding: the matching LP is infeasible ({}'s ray on {} rows over the X "
