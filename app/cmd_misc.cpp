@@ -9,6 +9,7 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <cmath>
 #include <iostream>
 #include <memory>
 #include <string>
@@ -91,7 +92,20 @@ Action add_checkpoint_command(CLI::App& app) {
                         .set("seconds", r.seconds));
       return levels;
     };
-    auto attempt_json = [](const LevelAttempt& a) {
+    // The first LP under way: its divergence watch's last window (unit-free: the relative primal
+    // residual and gap PDHG stops on, and how far the dual bound lay above the objective, over
+    // 1 + |objective|).
+    auto last_window = [](const LevelAttempt& a) {
+      const DivergenceWatchState& w = a.solving_watch;
+      if (a.solving.empty() || w.windows == 0) return Json();
+      const double objective = w.bound - w.excess[1];
+      return Json(Json::object()
+                      .set("windows", w.windows)
+                      .set("primal_residual", w.primal)
+                      .set("gap", w.gap)
+                      .set("bound_above_objective", w.excess[1] / (1.0 + std::abs(objective))));
+    };
+    auto attempt_json = [&last_window](const LevelAttempt& a) {
       Json attempt;  // null where no level is in progress
       if (a.empty()) return attempt;
       Json rounding;
@@ -135,6 +149,9 @@ Action add_checkpoint_command(CLI::App& app) {
           .set("solving_climbing_windows", a.solving.empty() ? Json() : Json(int64_t(a.solving_watch.climbing)))
           // (… and whether it holds that LP's whole state, to go on from exactly; null: no LP under way)
           .set("solving_exact", a.solving.empty() ? Json() : Json(a.solving_state != nullptr))
+          // (… and where its divergence watch's last window left it, against the tolerance: after
+          // hours in one LP, whether it is closing in; null: no LP under way, or none watched yet)
+          .set("solving_last_window", last_window(a))
           .set("rounding", std::move(rounding));
     };
     Json levels = reports(c.levels);

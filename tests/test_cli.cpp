@@ -947,6 +947,23 @@ TEST_CASE("cli: checkpoint shows both chains of a run stopped inside lookahead")
     const size_t t = e.out.rfind("\"attempt\"");
     CHECK(json_number(e.out.substr(t), "solving_iterations") == 128);
     CHECK(e.out.find("\"solving_exact\": true", t) != std::string::npos);
+    CHECK(e.out.find("\"solving_last_window\": null", t) != std::string::npos);  // (not watched yet)
+    // Watched: its last window, unit-free (the bound 0.5 above an objective of 3: 0.5 / 4).
+    s.solving_watch.windows = 3;
+    s.solving_watch.primal = 4e-3;
+    s.solving_watch.gap = 2e-3;
+    s.solving_watch.bound = 3.5;
+    s.solving_watch.excess[0] = 0.25;
+    s.solving_watch.excess[1] = 0.5;
+    shapematch::save_checkpoint(file, solving);
+    const Run w = run("checkpoint " + file);
+    REQUIRE_MESSAGE(w.code == 0, w.err);
+    const size_t lw = w.out.find("\"solving_last_window\": {", w.out.rfind("\"attempt\""));
+    REQUIRE(lw != std::string::npos);
+    CHECK(json_number(w.out.substr(lw), "windows") == 3);
+    CHECK(json_number(w.out.substr(lw), "primal_residual") == doctest::Approx(4e-3));
+    CHECK(json_number(w.out.substr(lw), "gap") == doctest::Approx(2e-3));
+    CHECK(json_number(w.out.substr(lw), "bound_above_objective") == doctest::Approx(0.125));
   }
   // Its first level alone: neither chain goes with it.
   const Run kept = run("checkpoint " + ckpt + " --keep-levels 1 --out " + ckpt);
