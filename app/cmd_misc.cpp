@@ -92,9 +92,9 @@ Action add_checkpoint_command(CLI::App& app) {
                         .set("seconds", r.seconds));
       return levels;
     };
-    // The first LP under way: its divergence watch's last window (unit-free: the relative primal
-    // residual and gap PDHG stops on, and how far the dual bound lay above the objective, over
-    // 1 + |objective|).
+    // The first LP under way: its divergence watch's last window (the relative primal residual
+    // and gap PDHG stops on, and how far the dual bound lay above the objective, over
+    // 1 + |objective|, in the LP's scaled costs as the watch's rules see it).
     auto last_window = [](const LevelAttempt& a) {
       const DivergenceWatchState& w = a.solving_watch;
       if (a.solving.empty() || w.windows == 0) return Json();
