@@ -948,7 +948,7 @@ TEST_CASE("cli: checkpoint shows both chains of a run stopped inside lookahead")
     CHECK(json_number(e.out.substr(t), "solving_iterations") == 128);
     CHECK(e.out.find("\"solving_exact\": true", t) != std::string::npos);
     CHECK(e.out.find("\"solving_last_window\": null", t) != std::string::npos);  // (not watched yet)
-    // Watched: its last window, unit-free (the bound 0.5 above an objective of 3: 0.5 / 4).
+    // Watched: its last window (the bound 0.5 above an objective of 3: 0.5 / (1 + 3)).
     s.solving_watch.windows = 3;
     s.solving_watch.primal = 4e-3;
     s.solving_watch.gap = 2e-3;
